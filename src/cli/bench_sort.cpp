@@ -1,0 +1,204 @@
+// `snell bench sort`: pairs per second of the GPU radix sort, from GPU
+// timestamps, median of many runs after warm-up; every size is also checked
+// against std::sort so a fast wrong sort never makes the table.
+#include "cli/cli.h"
+
+#include "render/radix_sort.h"
+#include "vk/buffer.h"
+#include "vk/commands.h"
+#include "vk/context.h"
+
+#include <algorithm>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <numeric>
+#include <random>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace snell::cli {
+
+namespace {
+
+struct Options {
+  unsigned minLog = 16;
+  unsigned maxLog = 24;
+  unsigned runs = 20;
+  unsigned warmup = 3;
+  std::vector<unsigned> keyBits = {32, 64};
+  std::string json;
+  render::RadixSortTuning tuning;
+};
+
+constexpr const char* kHelp = R"(usage: snell bench sort [options]
+
+Sorts random key-value pairs (32-bit values) on the GPU and prints pairs per
+second from GPU timestamps: the median over --runs runs after --warmup runs.
+Each size is checked against std::sort before it is reported.
+
+options:
+  --min-log N          smallest size, 2^N pairs (default 16)
+  --max-log N          largest size, 2^N pairs (default 24)
+  --runs N             timed runs per size, at least 10 (default 20)
+  --warmup N           untimed runs first (default 3)
+  --keys 32|64|both    key width (default both)
+  --json FILE          also write the results as JSON
+  --workgroup N        override the workgroup size (tuning)
+  --keys-per-thread N  override keys per invocation (tuning)
+)";
+
+Options parse(const Args& args) {
+  Options o;
+  for (size_t i = 0; i < args.size(); ++i) {
+    const std::string& a = args[i];
+    if (a == "--help" || a == "-h") {
+      std::fputs(kHelp, stdout);
+      std::exit(0);
+    }
+    if (i + 1 >= args.size()) throw UsageError{"bench sort: " + a + " needs a value (or is unknown)"};
+    const std::string& v = args[++i];
+    if (a == "--min-log") o.minLog = static_cast<unsigned>(parseCount(a, v));
+    else if (a == "--max-log") o.maxLog = static_cast<unsigned>(parseCount(a, v));
+    else if (a == "--runs") o.runs = static_cast<unsigned>(parseCount(a, v));
+    else if (a == "--warmup") o.warmup = static_cast<unsigned>(parseCount(a, v));
+    else if (a == "--json") o.json = v;
+    else if (a == "--workgroup") o.tuning.workgroupSize = static_cast<uint32_t>(parseCount(a, v));
+    else if (a == "--keys-per-thread") o.tuning.keysPerThread = static_cast<uint32_t>(parseCount(a, v));
+    else if (a == "--keys") {
+      if (v == "32") o.keyBits = {32};
+      else if (v == "64") o.keyBits = {64};
+      else if (v == "both") o.keyBits = {32, 64};
+      else throw UsageError{"bench sort: --keys takes 32, 64 or both"};
+    } else {
+      throw UsageError{"bench sort: unknown option " + a};
+    }
+  }
+  if (o.minLog > o.maxLog || o.maxLog > 30) throw UsageError{"bench sort: need --min-log <= --max-log <= 30"};
+  if (o.runs < 10) throw UsageError{"bench sort: --runs must be at least 10 for a meaningful median"};
+  return o;
+}
+
+struct Row {
+  uint64_t pairs;
+  unsigned keyBits;
+  double medianMs, minMs, maxMs;
+  bool correct;
+};
+
+template <typename Key>
+Row measure(vk::Context& context, const render::RadixSort& sort, uint64_t count, const Options& o) {
+  std::mt19937_64 random(count * 131 + sizeof(Key));
+  std::vector<Key> keys(count);
+  for (Key& k : keys) k = static_cast<Key>(random());
+  std::vector<uint32_t> values(count);
+  std::iota(values.begin(), values.end(), 0u);
+
+  const VkBufferUsageFlags usage =
+      VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT;
+  vk::Buffer pristineKeys(context, {count * sizeof(Key), usage, vk::MemoryDomain::Device, "bench pristine keys"});
+  vk::Buffer pristineValues(context, {count * 4, usage, vk::MemoryDomain::Device, "bench pristine values"});
+  vk::Buffer workKeys(context, {count * sizeof(Key), usage, vk::MemoryDomain::Device, "bench keys"});
+  vk::Buffer workValues(context, {count * 4, usage, vk::MemoryDomain::Device, "bench values"});
+  vk::upload(context, pristineKeys, keys.data(), count * sizeof(Key));
+  vk::upload(context, pristineValues, values.data(), count * 4);
+  render::RadixSort::Scratch scratch = sort.makeScratch(count);
+
+  vk::Commands commands(context, "bench sort");
+  std::vector<double> times;
+  for (unsigned run = 0; run < o.warmup + o.runs; ++run) {
+    commands.begin();
+    // Every run sorts the same unsorted input: sorted input would flatter the scatter.
+    commands.copyBuffer(pristineKeys, workKeys, count * sizeof(Key));
+    commands.copyBuffer(pristineValues, workValues, count * 4);
+    commands.transferToCompute();
+    commands.beginPass("sort");
+    sort.record(commands, workKeys, workValues, count, scratch);
+    commands.endPass();
+    commands.submitAndWait();
+    if (run >= o.warmup && !commands.passTimes().empty()) times.push_back(commands.passTimes()[0].milliseconds);
+  }
+  if (times.empty()) throw std::runtime_error("this device's queue has no timestamps; cannot time the sort");
+
+  std::vector<Key> gotKeys(count);
+  std::vector<uint32_t> gotValues(count);
+  vk::download(context, workKeys, gotKeys.data(), count * sizeof(Key));
+  vk::download(context, workValues, gotValues.data(), count * 4);
+  // Values are the original positions, so the stable order is (key, value) order.
+  std::vector<std::pair<Key, uint32_t>> expected(count);
+  for (uint64_t i = 0; i < count; ++i) expected[i] = {keys[i], values[i]};
+  std::sort(expected.begin(), expected.end());
+  bool correct = true;
+  for (uint64_t i = 0; i < count && correct; ++i) {
+    correct = gotKeys[i] == expected[i].first && gotValues[i] == expected[i].second;
+  }
+
+  std::sort(times.begin(), times.end());
+  return {count, static_cast<unsigned>(sizeof(Key) * 8), times[times.size() / 2], times.front(), times.back(), correct};
+}
+
+}  // namespace
+
+int runBenchSort(const Args& args) {
+  Options o = parse(args);
+  vk::ContextDesc desc;
+  desc.validation = std::getenv("SNELL_VALIDATION") && std::string(std::getenv("SNELL_VALIDATION")) == "1";
+  auto context = vk::Context::create(desc);
+  const vk::DeviceFacts& device = context->facts();
+  std::printf("device: %s (%s %s), Vulkan %s\n", device.name.c_str(), device.driverName.c_str(),
+              device.driverInfo.c_str(), vk::versionString(device.apiVersion).c_str());
+
+  std::vector<Row> rows;
+  bool allCorrect = true;
+  uint32_t workgroup = 0, keysPerThread = 0;
+  std::printf("%12s %5s %11s %11s %11s %13s %8s\n", "pairs", "bits", "median ms", "min ms", "max ms", "Gpairs/s", "correct");
+  for (unsigned bits : o.keyBits) {
+    render::RadixSort sort(*context, bits == 64 ? render::KeyWidth::Bits64 : render::KeyWidth::Bits32, o.tuning);
+    workgroup = sort.workgroupSize();
+    keysPerThread = sort.keysPerThread();
+    for (unsigned log = o.minLog; log <= o.maxLog; ++log) {
+      uint64_t count = uint64_t(1) << log;
+      if (count > sort.maxCount()) {
+        std::printf("%12llu %5u   skipped: above this device's %llu-pair limit\n", (unsigned long long)count, bits,
+                    (unsigned long long)sort.maxCount());
+        continue;
+      }
+      Row row = bits == 64 ? measure<uint64_t>(*context, sort, count, o) : measure<uint32_t>(*context, sort, count, o);
+      allCorrect = allCorrect && row.correct;
+      std::printf("%12llu %5u %11.4f %11.4f %11.4f %13.3f %8s\n", (unsigned long long)row.pairs, row.keyBits, row.medianMs,
+                  row.minMs, row.maxMs, static_cast<double>(row.pairs) / (row.medianMs * 1e6), row.correct ? "yes" : "NO");
+      std::fflush(stdout);
+      rows.push_back(row);
+    }
+  }
+
+  if (!o.json.empty()) {
+    std::string temporary = o.json + ".partial";
+    {
+      std::ofstream out(temporary);
+      if (!out) throw std::runtime_error("cannot write " + temporary);
+      out << "{\n  \"benchmark\": \"sort\",\n  \"device\": \"" << device.name << "\",\n  \"driver\": \"" << device.driverName
+          << " " << device.driverInfo << "\",\n  \"vulkan\": \"" << vk::versionString(device.apiVersion)
+          << "\",\n  \"workgroup_size\": " << workgroup << ",\n  \"keys_per_thread\": " << keysPerThread
+          << ",\n  \"runs\": " << o.runs << ",\n  \"warmup\": " << o.warmup << ",\n  \"results\": [\n";
+      for (size_t i = 0; i < rows.size(); ++i) {
+        const Row& r = rows[i];
+        out << "    {\"pairs\": " << r.pairs << ", \"key_bits\": " << r.keyBits << ", \"median_ms\": " << r.medianMs
+            << ", \"min_ms\": " << r.minMs << ", \"max_ms\": " << r.maxMs
+            << ", \"gpairs_per_s\": " << static_cast<double>(r.pairs) / (r.medianMs * 1e6) << ", \"correct\": " << (r.correct ? "true" : "false")
+            << "}" << (i + 1 < rows.size() ? "," : "") << "\n";
+      }
+      out << "  ]\n}\n";
+    }
+    if (std::rename(temporary.c_str(), o.json.c_str()) != 0) throw std::runtime_error("cannot write " + o.json);
+    std::printf("wrote %s\n", o.json.c_str());
+  }
+  if (!allCorrect) {
+    std::fprintf(stderr, "snell: error: the GPU sort disagreed with std::sort (rows marked NO)\n");
+    return 1;
+  }
+  return 0;
+}
+
+}  // namespace snell::cli

@@ -1,0 +1,23 @@
+// The `snell` command's subcommands; main.cpp routes to them.
+#pragma once
+
+#include <string>
+#include <vector>
+
+namespace snell::cli {
+
+/// The words after the subcommand's name.
+using Args = std::vector<std::string>;
+
+/// Thrown for a bad command line; main prints it with the usage hint, exit 2.
+struct UsageError {
+  std::string message;
+};
+
+int runInfo(const Args& args);
+int runBenchSort(const Args& args);
+
+/// Parses an unsigned integer option value or throws UsageError naming the option.
+unsigned long long parseCount(const std::string& option, const std::string& value);
+
+}  // namespace snell::cli

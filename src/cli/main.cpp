@@ -1,0 +1,71 @@
+// `snell`: the command-line front end. Each subcommand lives in its own file.
+#include "cli/cli.h"
+
+#include "vk/error.h"
+
+#include <charconv>
+#include <cstdio>
+#include <exception>
+
+namespace snell::cli {
+
+namespace {
+
+constexpr const char* kUsage = R"(snell - refraction through deforming meshes, on Vulkan compute
+
+usage: snell <command> [options]
+
+commands:
+  info --devices        list every Vulkan device, which one snell picks and why
+  bench sort [options]  time the GPU radix sort (see 'snell bench sort --help')
+  help                  show this text
+
+environment:
+  SNELL_DEVICE=<index|name>  use this device (an index from 'snell info --devices',
+                             or part of its name)
+  SNELL_VALIDATION=1         turn on the Khronos validation layer
+)";
+
+int runBench(const Args& args) {
+  if (args.empty() || args[0] == "--help" || args[0] == "-h") {
+    std::printf("usage: snell bench sort [options]\n\nbenchmarks:\n  sort   GPU radix sort, pairs per second\n");
+    return args.empty() ? 2 : 0;
+  }
+  Args rest(args.begin() + 1, args.end());
+  if (args[0] == "sort") return runBenchSort(rest);
+  throw UsageError{"unknown benchmark '" + args[0] + "' (try: sort)"};
+}
+
+}  // namespace
+
+unsigned long long parseCount(const std::string& option, const std::string& value) {
+  unsigned long long result = 0;
+  auto [end, error] = std::from_chars(value.data(), value.data() + value.size(), result);
+  if (value.empty() || error != std::errc() || end != value.data() + value.size()) {
+    throw UsageError{option + " expects a whole number, got '" + value + "'"};
+  }
+  return result;
+}
+
+}  // namespace snell::cli
+
+int main(int argc, char** argv) {
+  using namespace snell::cli;
+  Args args(argv + 1, argv + argc);
+  try {
+    if (args.empty() || args[0] == "help" || args[0] == "--help" || args[0] == "-h") {
+      std::fputs(kUsage, args.empty() ? stderr : stdout);
+      return args.empty() ? 2 : 0;
+    }
+    Args rest(args.begin() + 1, args.end());
+    if (args[0] == "info") return runInfo(rest);
+    if (args[0] == "bench") return runBench(rest);
+    throw UsageError{"unknown command '" + args[0] + "'"};
+  } catch (const UsageError& e) {
+    std::fprintf(stderr, "snell: %s\nRun 'snell help' for usage.\n", e.message.c_str());
+    return 2;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "snell: error: %s\n", e.what());
+    return 1;
+  }
+}

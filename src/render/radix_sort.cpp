@@ -1,0 +1,177 @@
+// Host side of the radix sort (shaders/comp/sort_histogram.comp, sort_scatter.comp).
+#include "render/radix_sort.h"
+
+#include "shared/radix_sort.h"
+#include "vk/error.h"
+
+#include "sort_histogram.spv.h"
+#include "sort_scatter.spv.h"
+
+#include <algorithm>
+
+namespace snell::render {
+
+namespace {
+
+uint32_t sharedBytes(uint32_t workgroup, uint32_t keysPerThread, uint32_t minSubgroup) {
+  uint32_t subgroups = workgroup / minSubgroup;
+  return 4 * (subgroups * gpu::kSortRadix   // per-subgroup digit counters
+              + 2 * gpu::kSortRadix         // digit starts and outputs
+              + workgroup * keysPerThread   // the exchange tile
+              + subgroups + 1);             // the workgroup scan's partial sums
+}
+
+}  // namespace
+
+RadixSort::RadixSort(vk::Context& context, KeyWidth width, RadixSortTuning tuning)
+    : context_(context), width_(width), scan_(context) {
+  const vk::DeviceCaps& caps = context.caps();
+  // The widest workgroup and the most keys per invocation that fit in shared
+  // memory: larger tiles mean fewer blocks, so a smaller histogram to scan.
+  workgroupSize_ = tuning.workgroupSize;
+  keysPerThread_ = tuning.keysPerThread;
+  if (!workgroupSize_) {
+    for (uint32_t preferred : {256u, 128u, 64u}) {
+      uint32_t w = fullSubgroupWorkgroupSize(caps, preferred);
+      uint32_t k = keysPerThread_ ? keysPerThread_ : 8u;
+      if (sharedBytes(w, k, caps.minSubgroupSize) <= caps.maxComputeSharedMemoryBytes) {
+        workgroupSize_ = w;
+        break;
+      }
+    }
+  }
+  if (!keysPerThread_) {
+    keysPerThread_ = 1;
+    for (uint32_t k : {16u, 12u, 8u, 4u, 2u}) {
+      if (workgroupSize_ && sharedBytes(workgroupSize_, k, caps.minSubgroupSize) <= caps.maxComputeSharedMemoryBytes) {
+        keysPerThread_ = k;
+        break;
+      }
+    }
+  }
+  if (!workgroupSize_ || sharedBytes(workgroupSize_, keysPerThread_, caps.minSubgroupSize) > caps.maxComputeSharedMemoryBytes) {
+    throw vk::VulkanError("the radix sort does not fit in " + std::to_string(caps.maxComputeSharedMemoryBytes) +
+                          " bytes of shared memory");
+  }
+  std::vector<vk::SpecConstant> spec = {
+      {gpu::kSortSpecWorkgroupSize, workgroupSize_},
+      {gpu::kSortSpecKeysPerThread, keysPerThread_},
+      {gpu::kSortSpecMaxSubgroups, workgroupSize_ / caps.minSubgroupSize},
+      {gpu::kSortSpecKeyWords, static_cast<uint32_t>(width)},
+  };
+  histogram_ = std::make_unique<vk::ComputeProgram>(context, vk::ComputeProgramDesc{"sort_histogram", kSpvSortHistogram, spec, true});
+  scatter_ = std::make_unique<vk::ComputeProgram>(context, vk::ComputeProgramDesc{"sort_scatter", kSpvSortScatter, spec, true});
+}
+
+uint64_t RadixSort::maxCount() const {
+  uint64_t byRange = context_.caps().maxStorageBufferRange / (4ull * static_cast<uint32_t>(width_));
+  uint64_t byIndex = UINT32_MAX - tileSize();  // positions are 32-bit, padding included
+  return std::min(byRange, byIndex);
+}
+
+RadixSort::Scratch RadixSort::makeScratch(uint64_t capacity) const {
+  if (capacity > maxCount()) {
+    throw vk::VulkanError("cannot sort " + std::to_string(capacity) + " pairs; this device sorts at most " +
+                          std::to_string(maxCount()));
+  }
+  uint64_t blocks = std::max<uint64_t>(1, (capacity + tileSize() - 1) / tileSize());
+  uint64_t keyBytes = capacity * 4 * static_cast<uint32_t>(width_);
+  Scratch scratch;
+  scratch.capacity = capacity;
+  scratch.keys = vk::Buffer(context_, {keyBytes, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT,
+                                       vk::MemoryDomain::Device, "sort keys ping-pong"});
+  scratch.values = vk::Buffer(context_, {capacity * 4, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT,
+                                         vk::MemoryDomain::Device, "sort values ping-pong"});
+  scratch.histogram = vk::Buffer(context_, {blocks * gpu::kSortRadix * 4, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
+                                            vk::MemoryDomain::Device, "sort histogram"});
+  scratch.scan = scan_.makeScratch(blocks * gpu::kSortRadix);
+  return scratch;
+}
+
+void RadixSort::record(vk::Commands& commands, const vk::Buffer& keys, const vk::Buffer& values, uint64_t count,
+                       const Scratch& scratch, uint32_t keyBits) const {
+  uint32_t widthBits = 32u * static_cast<uint32_t>(width_);
+  if (keyBits == 0 || keyBits > widthBits) {
+    throw vk::VulkanError("radix sort of " + std::to_string(widthBits) + "-bit keys asked to sort by " +
+                          std::to_string(keyBits) + " bits");
+  }
+  if (count > scratch.capacity) {
+    throw vk::VulkanError("radix sort of " + std::to_string(count) + " pairs given scratch for " +
+                          std::to_string(scratch.capacity));
+  }
+  uint64_t keyBytes = count * 4 * static_cast<uint32_t>(width_);
+  if (keys.size() < keyBytes || values.size() < count * 4) {
+    throw vk::VulkanError("radix sort of " + std::to_string(count) + " pairs: '" + keys.name() + "' or '" +
+                          values.name() + "' is too small");
+  }
+  if (count <= 1) return;
+
+  uint32_t blocks = static_cast<uint32_t>((count + tileSize() - 1) / tileSize());
+  uint32_t passes = (keyBits + gpu::kSortRadixBits - 1) / gpu::kSortRadixBits;
+  const vk::Buffer* keysIn = &keys;
+  const vk::Buffer* keysOut = &scratch.keys;
+  const vk::Buffer* valuesIn = &values;
+  const vk::Buffer* valuesOut = &scratch.values;
+  for (uint32_t pass = 0; pass < passes; ++pass) {
+    gpu::SortPush push{static_cast<uint32_t>(count), blocks, pass * gpu::kSortRadixBits, 0};
+    histogram_->dispatchGroups(commands,
+                               {{gpu::kSortBindingKeysIn, keysIn}, {gpu::kSortBindingHistogram, &scratch.histogram}},
+                               push, blocks);
+    commands.computeToCompute();
+    scan_.record(commands, scratch.histogram, uint64_t(blocks) * gpu::kSortRadix, scratch.scan);
+    commands.computeToCompute();
+    scatter_->dispatchGroups(commands,
+                             {{gpu::kSortBindingKeysIn, keysIn},
+                              {gpu::kSortBindingKeysOut, keysOut},
+                              {gpu::kSortBindingValuesIn, valuesIn},
+                              {gpu::kSortBindingValuesOut, valuesOut},
+                              {gpu::kSortBindingHistogram, &scratch.histogram}},
+                             push, blocks);
+    commands.computeToCompute();
+    std::swap(keysIn, keysOut);
+    std::swap(valuesIn, valuesOut);
+  }
+  if (passes % 2 == 1) {
+    // The result sits in the scratch buffers; bring it home.
+    commands.computeToTransfer();
+    commands.copyBuffer(scratch.keys, keys, keyBytes);
+    commands.copyBuffer(scratch.values, values, count * 4);
+    commands.transferToCompute();
+  }
+}
+
+namespace {
+
+template <typename Key>
+void sortHostPairs(vk::Context& context, std::vector<Key>& keys, std::vector<uint32_t>& values) {
+  if (keys.size() != values.size()) throw vk::VulkanError("sortPairs: keys and values differ in length");
+  if (keys.size() <= 1) return;
+  RadixSort sort(context, sizeof(Key) == 8 ? KeyWidth::Bits64 : KeyWidth::Bits32);
+  uint64_t count = keys.size();
+  const VkBufferUsageFlags usage =
+      VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT;
+  vk::Buffer keyBuffer(context, {count * sizeof(Key), usage, vk::MemoryDomain::Device, "keys"});
+  vk::Buffer valueBuffer(context, {count * 4, usage, vk::MemoryDomain::Device, "values"});
+  vk::upload(context, keyBuffer, keys.data(), count * sizeof(Key));
+  vk::upload(context, valueBuffer, values.data(), count * 4);
+  RadixSort::Scratch scratch = sort.makeScratch(count);
+  vk::Commands commands(context, "sortPairs");
+  commands.begin();
+  commands.transferToCompute();
+  sort.record(commands, keyBuffer, valueBuffer, count, scratch);
+  commands.submitAndWait();
+  vk::download(context, keyBuffer, keys.data(), count * sizeof(Key));
+  vk::download(context, valueBuffer, values.data(), count * 4);
+}
+
+}  // namespace
+
+void sortPairs(vk::Context& context, std::vector<uint32_t>& keys, std::vector<uint32_t>& values) {
+  sortHostPairs(context, keys, values);
+}
+
+void sortPairs(vk::Context& context, std::vector<uint64_t>& keys, std::vector<uint32_t>& values) {
+  sortHostPairs(context, keys, values);
+}
+
+}  // namespace snell::render

@@ -1,0 +1,200 @@
+// Buffer and image allocation: one VkDeviceMemory each, which is plenty for a
+// renderer with a few dozen long-lived resources.
+#include "vk/buffer.h"
+
+#include "vk/error.h"
+
+#include <utility>
+
+namespace snell::vk {
+
+namespace {
+
+VkDeviceMemory allocate(Context& context, const VkMemoryRequirements& needs, MemoryDomain domain, const std::string& name) {
+  VkMemoryPropertyFlags required = 0;
+  VkMemoryPropertyFlags preferred = 0;
+  switch (domain) {
+    case MemoryDomain::Device:
+      required = VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT;
+      break;
+    case MemoryDomain::Upload:
+      required = VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT;
+      break;
+    case MemoryDomain::Readback:
+      required = VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT;
+      preferred = VK_MEMORY_PROPERTY_HOST_CACHED_BIT;
+      break;
+  }
+  uint32_t type = context.findMemoryType(needs.memoryTypeBits, required, preferred);
+  if (type == UINT32_MAX && domain == MemoryDomain::Device) {
+    type = context.findMemoryType(needs.memoryTypeBits, 0, 0);  // a device with no device-local heap
+  }
+  if (type == UINT32_MAX) throw VulkanError("no memory type suits '" + name + "'");
+  if (context.caps().maxMemoryAllocationSize && needs.size > context.caps().maxMemoryAllocationSize) {
+    throw VulkanError("'" + name + "' needs " + std::to_string(needs.size) + " bytes, more than the device's " +
+                      std::to_string(context.caps().maxMemoryAllocationSize) + "-byte allocation limit");
+  }
+  VkMemoryAllocateInfo info{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
+  info.allocationSize = needs.size;
+  info.memoryTypeIndex = type;
+  VkDeviceMemory memory = VK_NULL_HANDLE;
+  VkResult result = vkAllocateMemory(context.device(), &info, nullptr, &memory);
+  if (result != VK_SUCCESS) {
+    throw VulkanError("allocating " + std::to_string(needs.size) + " bytes for '" + name + "' failed with " +
+                          std::string(resultName(result)),
+                      result);
+  }
+  context.setName(VK_OBJECT_TYPE_DEVICE_MEMORY, memory, name);
+  return memory;
+}
+
+}  // namespace
+
+Buffer::Buffer(Context& context, const BufferDesc& desc)
+    : context_(&context), size_(desc.size), domain_(desc.domain), name_(desc.name) {
+  VkBufferCreateInfo info{VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO};
+  info.size = desc.size ? desc.size : 16;  // Vulkan forbids empty buffers
+  info.usage = desc.usage;
+  info.sharingMode = VK_SHARING_MODE_EXCLUSIVE;
+  VkResult created = vkCreateBuffer(context.device(), &info, nullptr, &buffer_);
+  if (created != VK_SUCCESS) {
+    throw VulkanError("creating buffer '" + desc.name + "' of " + std::to_string(desc.size) + " bytes failed with " +
+                          std::string(resultName(created)),
+                      created);
+  }
+  try {
+    VkMemoryRequirements needs{};
+    vkGetBufferMemoryRequirements(context.device(), buffer_, &needs);
+    memory_ = allocate(context, needs, desc.domain, desc.name);
+    VK_CHECK(vkBindBufferMemory(context.device(), buffer_, memory_, 0));
+    if (desc.domain != MemoryDomain::Device) VK_CHECK(vkMapMemory(context.device(), memory_, 0, VK_WHOLE_SIZE, 0, &mapped_));
+  } catch (...) {
+    release();
+    throw;
+  }
+  context.setName(VK_OBJECT_TYPE_BUFFER, buffer_, desc.name);
+}
+
+Buffer::~Buffer() { release(); }
+
+Buffer::Buffer(Buffer&& other) noexcept { *this = std::move(other); }
+
+Buffer& Buffer::operator=(Buffer&& other) noexcept {
+  if (this != &other) {
+    release();
+    context_ = std::exchange(other.context_, nullptr);
+    buffer_ = std::exchange(other.buffer_, VK_NULL_HANDLE);
+    memory_ = std::exchange(other.memory_, VK_NULL_HANDLE);
+    size_ = std::exchange(other.size_, 0);
+    domain_ = other.domain_;
+    mapped_ = std::exchange(other.mapped_, nullptr);
+    name_ = std::move(other.name_);
+  }
+  return *this;
+}
+
+void Buffer::release() {
+  if (!context_) return;
+  VkDevice device = context_->device();
+  VkBuffer buffer = std::exchange(buffer_, VK_NULL_HANDLE);
+  VkDeviceMemory memory = std::exchange(memory_, VK_NULL_HANDLE);
+  mapped_ = nullptr;
+  context_->retire([device, buffer, memory] {
+    if (buffer) vkDestroyBuffer(device, buffer, nullptr);
+    if (memory) vkFreeMemory(device, memory, nullptr);  // unmaps implicitly
+  });
+  context_ = nullptr;
+}
+
+Image::Image(Context& context, const ImageDesc& desc)
+    : context_(&context), format_(desc.format), width_(desc.width), height_(desc.height), name_(desc.name) {
+  VkImageCreateInfo info{VK_STRUCTURE_TYPE_IMAGE_CREATE_INFO};
+  info.imageType = VK_IMAGE_TYPE_2D;
+  info.format = desc.format;
+  info.extent = {desc.width, desc.height, 1};
+  info.mipLevels = 1;
+  info.arrayLayers = 1;
+  info.samples = VK_SAMPLE_COUNT_1_BIT;
+  info.tiling = VK_IMAGE_TILING_OPTIMAL;
+  info.usage = desc.usage;
+  info.initialLayout = VK_IMAGE_LAYOUT_UNDEFINED;
+  VkImageFormatProperties limits{};
+  VkResult supported = vkGetPhysicalDeviceImageFormatProperties(context.physicalDevice(), info.format, info.imageType,
+                                                                info.tiling, info.usage, 0, &limits);
+  if (supported != VK_SUCCESS || desc.width == 0 || desc.height == 0 || desc.width > limits.maxExtent.width ||
+      desc.height > limits.maxExtent.height) {
+    throw VulkanError("image '" + desc.name + "' of " + std::to_string(desc.width) + "x" + std::to_string(desc.height) +
+                          " is not supported by this device (largest: " + std::to_string(limits.maxExtent.width) + "x" +
+                          std::to_string(limits.maxExtent.height) + ")",
+                      supported);
+  }
+  VK_CHECK(vkCreateImage(context.device(), &info, nullptr, &image_));
+  try {
+    VkMemoryRequirements needs{};
+    vkGetImageMemoryRequirements(context.device(), image_, &needs);
+    memory_ = allocate(context, needs, MemoryDomain::Device, desc.name);
+    VK_CHECK(vkBindImageMemory(context.device(), image_, memory_, 0));
+    VkImageViewCreateInfo viewInfo{VK_STRUCTURE_TYPE_IMAGE_VIEW_CREATE_INFO};
+    viewInfo.image = image_;
+    viewInfo.viewType = VK_IMAGE_VIEW_TYPE_2D;
+    viewInfo.format = desc.format;
+    viewInfo.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
+    VK_CHECK(vkCreateImageView(context.device(), &viewInfo, nullptr, &view_));
+  } catch (...) {
+    release();
+    throw;
+  }
+  context.setName(VK_OBJECT_TYPE_IMAGE, image_, desc.name);
+  context.setName(VK_OBJECT_TYPE_IMAGE_VIEW, view_, desc.name + " view");
+}
+
+Image::~Image() { release(); }
+
+Image::Image(Image&& other) noexcept { *this = std::move(other); }
+
+Image& Image::operator=(Image&& other) noexcept {
+  if (this != &other) {
+    release();
+    context_ = std::exchange(other.context_, nullptr);
+    image_ = std::exchange(other.image_, VK_NULL_HANDLE);
+    view_ = std::exchange(other.view_, VK_NULL_HANDLE);
+    memory_ = std::exchange(other.memory_, VK_NULL_HANDLE);
+    format_ = other.format_;
+    width_ = other.width_;
+    height_ = other.height_;
+    name_ = std::move(other.name_);
+  }
+  return *this;
+}
+
+void Image::release() {
+  if (!context_) return;
+  VkDevice device = context_->device();
+  VkImage image = std::exchange(image_, VK_NULL_HANDLE);
+  VkImageView view = std::exchange(view_, VK_NULL_HANDLE);
+  VkDeviceMemory memory = std::exchange(memory_, VK_NULL_HANDLE);
+  context_->retire([device, image, view, memory] {
+    if (view) vkDestroyImageView(device, view, nullptr);
+    if (image) vkDestroyImage(device, image, nullptr);
+    if (memory) vkFreeMemory(device, memory, nullptr);
+  });
+  context_ = nullptr;
+}
+
+uint32_t Image::bytesPerPixel() const {
+  switch (format_) {
+    case VK_FORMAT_R8G8B8A8_UNORM:
+    case VK_FORMAT_R8G8B8A8_SRGB:
+    case VK_FORMAT_R32_UINT:
+    case VK_FORMAT_R32_SFLOAT:
+      return 4;
+    case VK_FORMAT_R16G16B16A16_SFLOAT:
+      return 8;
+    case VK_FORMAT_R32G32B32A32_SFLOAT:
+      return 16;
+    default:
+      throw VulkanError("image '" + name_ + "' has a format snell cannot size");
+  }
+}
+
+}  // namespace snell::vk

@@ -1,0 +1,101 @@
+// RAII buffers and images with memory domains. Destruction is deferred until
+// the GPU has finished every submission made before it.
+#pragma once
+
+#include "vk/context.h"
+
+#include <vulkan/vulkan.h>
+
+#include <cstddef>
+#include <cstdint>
+#include <span>
+#include <string>
+
+namespace snell::vk {
+
+/// Where a resource's memory lives.
+enum class MemoryDomain {
+  Device,    ///< GPU-local, not mapped: every pass's working data
+  Upload,    ///< host-visible and coherent, mapped: host writes, GPU reads
+  Readback,  ///< host-visible, cached where possible, mapped: GPU writes, host reads
+};
+
+struct BufferDesc {
+  VkDeviceSize size = 0;  ///< bytes; 0 is allowed and allocates a small placeholder
+  VkBufferUsageFlags usage =
+      VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT;
+  MemoryDomain domain = MemoryDomain::Device;
+  std::string name;  ///< shown by validation messages and debuggers
+};
+
+/// A VkBuffer with its own memory.
+class Buffer {
+ public:
+  Buffer() = default;
+  Buffer(Context& context, const BufferDesc& desc);
+  ~Buffer();
+  Buffer(Buffer&& other) noexcept;
+  Buffer& operator=(Buffer&& other) noexcept;
+  Buffer(const Buffer&) = delete;
+  Buffer& operator=(const Buffer&) = delete;
+
+  VkBuffer handle() const { return buffer_; }
+  VkDeviceSize size() const { return size_; }
+  MemoryDomain domain() const { return domain_; }
+  const std::string& name() const { return name_; }
+  /// Host view of a mapped (Upload or Readback) buffer; empty for Device.
+  std::span<std::byte> mapped() const { return {static_cast<std::byte*>(mapped_), mapped_ ? size_ : 0}; }
+
+ private:
+  void release();
+  Context* context_ = nullptr;
+  VkBuffer buffer_ = VK_NULL_HANDLE;
+  VkDeviceMemory memory_ = VK_NULL_HANDLE;
+  VkDeviceSize size_ = 0;
+  MemoryDomain domain_ = MemoryDomain::Device;
+  void* mapped_ = nullptr;
+  std::string name_;
+};
+
+struct ImageDesc {
+  uint32_t width = 1;
+  uint32_t height = 1;
+  VkFormat format = VK_FORMAT_R16G16B16A16_SFLOAT;
+  VkImageUsageFlags usage =
+      VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT;
+  std::string name;
+};
+
+/// A 2D VkImage in device memory with a view of its one mip level.
+class Image {
+ public:
+  Image() = default;
+  Image(Context& context, const ImageDesc& desc);
+  ~Image();
+  Image(Image&& other) noexcept;
+  Image& operator=(Image&& other) noexcept;
+  Image(const Image&) = delete;
+  Image& operator=(const Image&) = delete;
+
+  VkImage handle() const { return image_; }
+  VkImageView view() const { return view_; }
+  VkFormat format() const { return format_; }
+  uint32_t width() const { return width_; }
+  uint32_t height() const { return height_; }
+  const std::string& name() const { return name_; }
+  /// Bytes one pixel takes in the formats snell uses.
+  uint32_t bytesPerPixel() const;
+
+ private:
+  void release();
+  Context* context_ = nullptr;
+  VkImage image_ = VK_NULL_HANDLE;
+  VkImageView view_ = VK_NULL_HANDLE;
+  VkDeviceMemory memory_ = VK_NULL_HANDLE;
+  VkFormat format_ = VK_FORMAT_UNDEFINED;
+  uint32_t width_ = 0;
+  uint32_t height_ = 0;
+  std::string name_;
+};
+
+}  // namespace snell::vk

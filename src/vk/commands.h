@@ -1,0 +1,101 @@
+// Command recording and submission: one command buffer with its fence, the
+// descriptor sets its dispatches use, and GPU timestamps per named pass.
+#pragma once
+
+#include "vk/buffer.h"
+#include "vk/context.h"
+
+#include <vulkan/vulkan.h>
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace snell::vk {
+
+/// GPU time of one named pass of a completed submission.
+struct PassTime {
+  std::string name;
+  double milliseconds = 0;
+};
+
+/// Records commands, submits them and waits; reusable after wait().
+class Commands {
+ public:
+  Commands(Context& context, std::string name);
+  ~Commands();
+  Commands(const Commands&) = delete;
+  Commands& operator=(const Commands&) = delete;
+
+  /// Starts recording. Waits for a previous submission of this object first.
+  void begin();
+  /// Ends recording and submits to the context's queue with this object's fence.
+  void submit();
+  /// Waits for the submission, then reads back its pass timings.
+  void wait();
+  /// submit() then wait().
+  void submitAndWait();
+
+  VkCommandBuffer handle() const { return buffer_; }
+  Context& context() const { return *context_; }
+
+  /// Writes of compute shaders become visible to later compute shaders.
+  void computeToCompute();
+  /// Transfers (copies, fills) become visible to compute shaders, and compute
+  /// reads finish before later transfers overwrite their data.
+  void transferToCompute();
+  /// Compute writes become visible to transfers (copies to readback buffers).
+  void computeToTransfer();
+  /// Transfer writes become visible to the host after wait().
+  void transferToHost();
+  /// Transfer writes become visible to later transfers.
+  void transferToTransfer();
+  /// Moves a whole colour image between layouts with a full memory barrier.
+  void imageLayout(const Image& image, VkImageLayout from, VkImageLayout to);
+
+  void copyBuffer(const Buffer& from, const Buffer& to, VkDeviceSize bytes, VkDeviceSize fromOffset = 0,
+                  VkDeviceSize toOffset = 0);
+  void fillBuffer(const Buffer& buffer, uint32_t word);
+
+  /// Starts timing a pass; passes do not nest. No-op where the queue has no timestamps.
+  void beginPass(const std::string& name);
+  void endPass();
+  /// The timings of the last completed submission, in recording order.
+  const std::vector<PassTime>& passTimes() const { return times_; }
+
+  /// A descriptor set that lives until this object is next begun.
+  VkDescriptorSet allocateSet(VkDescriptorSetLayout layout);
+
+ private:
+  void memoryBarrier(VkPipelineStageFlags srcStage, VkAccessFlags srcAccess, VkPipelineStageFlags dstStage,
+                     VkAccessFlags dstAccess);
+  void readTimestamps();
+  VkDescriptorPool addDescriptorPool();
+
+  Context* context_;
+  std::string name_;
+  VkCommandPool pool_ = VK_NULL_HANDLE;
+  VkCommandBuffer buffer_ = VK_NULL_HANDLE;
+  VkFence fence_ = VK_NULL_HANDLE;
+  VkQueryPool queries_ = VK_NULL_HANDLE;
+  std::vector<VkDescriptorPool> descriptorPools_;
+  size_t currentPool_ = 0;
+  uint64_t serial_ = 0;  ///< of the submission in flight; 0 when none
+  bool recording_ = false;
+  uint32_t queryCount_ = 0;
+  std::vector<std::string> passNames_;
+  bool passOpen_ = false;
+  std::vector<PassTime> times_;
+};
+
+/// Copies bytes into a buffer: directly when it is mapped, else through a staging
+/// buffer and a submission that is waited for.
+void upload(Context& context, const Buffer& destination, const void* data, VkDeviceSize bytes, VkDeviceSize offset = 0);
+/// Copies a buffer's first `bytes` to host memory, through a readback buffer.
+void download(Context& context, const Buffer& source, void* data, VkDeviceSize bytes, VkDeviceSize offset = 0);
+/// Fills a whole image from tightly packed pixels; leaves it in GENERAL layout.
+void uploadImage(Context& context, const Image& image, const void* pixels);
+/// Reads a whole image (in GENERAL layout) into tightly packed pixels.
+void downloadImage(Context& context, const Image& image, void* pixels);
+
+}  // namespace snell::vk

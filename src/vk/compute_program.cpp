@@ -1,0 +1,145 @@
+// Compute pipeline creation from reflected SPIR-V, and checked dispatches.
+#include "vk/compute_program.h"
+
+#include "vk/error.h"
+
+#include <algorithm>
+
+namespace snell::vk {
+
+ComputeProgram::ComputeProgram(Context& context, const ComputeProgramDesc& desc) : context_(&context), name_(desc.name) {
+  try {
+    reflection_ = reflectCompute(desc.spirv, desc.specialization, desc.name);
+  } catch (const std::runtime_error& e) {
+    throw VulkanError(e.what());
+  }
+  const DeviceCaps& caps = context.caps();
+  uint64_t invocations = uint64_t(reflection_.localSize[0]) * reflection_.localSize[1] * reflection_.localSize[2];
+  if (invocations > caps.maxComputeWorkgroupInvocations) {
+    throw VulkanError("program '" + name_ + "' asks for workgroups of " + std::to_string(invocations) +
+                      " invocations; the device allows " + std::to_string(caps.maxComputeWorkgroupInvocations));
+  }
+  if (desc.requireFullSubgroups && reflection_.localSize[0] % caps.maxSubgroupSize != 0) {
+    throw VulkanError("program '" + name_ + "': full subgroups need a workgroup width that is a multiple of " +
+                      std::to_string(caps.maxSubgroupSize));
+  }
+  if (reflection_.pushConstantBytes > caps.maxPushConstantsSize) {
+    throw VulkanError("program '" + name_ + "' has " + std::to_string(reflection_.pushConstantBytes) +
+                      " bytes of push constants; the device allows " + std::to_string(caps.maxPushConstantsSize));
+  }
+
+  VkDevice device = context.device();
+  VkShaderModuleCreateInfo moduleInfo{VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO};
+  moduleInfo.codeSize = desc.spirv.size_bytes();
+  moduleInfo.pCode = desc.spirv.data();
+  VK_CHECK(vkCreateShaderModule(device, &moduleInfo, nullptr, &module_));
+  context.setName(VK_OBJECT_TYPE_SHADER_MODULE, module_, name_);
+
+  std::vector<VkDescriptorSetLayoutBinding> layoutBindings;
+  for (const ReflectedBinding& b : reflection_.bindings) {
+    if (b.set != 0) throw VulkanError("program '" + name_ + "' uses descriptor set " + std::to_string(b.set) + "; only set 0 is supported");
+    layoutBindings.push_back({b.binding, b.type, 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr});
+  }
+  VkDescriptorSetLayoutCreateInfo setInfo{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO};
+  setInfo.bindingCount = static_cast<uint32_t>(layoutBindings.size());
+  setInfo.pBindings = layoutBindings.data();
+  VK_CHECK(vkCreateDescriptorSetLayout(device, &setInfo, nullptr, &setLayout_));
+  context.setName(VK_OBJECT_TYPE_DESCRIPTOR_SET_LAYOUT, setLayout_, name_);
+
+  VkPushConstantRange range{VK_SHADER_STAGE_COMPUTE_BIT, 0, reflection_.pushConstantBytes};
+  VkPipelineLayoutCreateInfo layoutInfo{VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO};
+  layoutInfo.setLayoutCount = 1;
+  layoutInfo.pSetLayouts = &setLayout_;
+  layoutInfo.pushConstantRangeCount = reflection_.pushConstantBytes ? 1 : 0;
+  layoutInfo.pPushConstantRanges = &range;
+  VK_CHECK(vkCreatePipelineLayout(device, &layoutInfo, nullptr, &pipelineLayout_));
+  context.setName(VK_OBJECT_TYPE_PIPELINE_LAYOUT, pipelineLayout_, name_);
+
+  std::vector<VkSpecializationMapEntry> entries;
+  std::vector<uint32_t> values;
+  for (const SpecConstant& s : desc.specialization) {
+    entries.push_back({s.id, static_cast<uint32_t>(values.size() * sizeof(uint32_t)), sizeof(uint32_t)});
+    values.push_back(s.value);
+  }
+  VkSpecializationInfo specInfo{static_cast<uint32_t>(entries.size()), entries.data(), values.size() * sizeof(uint32_t),
+                                values.data()};
+  VkPipelineShaderStageCreateInfo stage{VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO};
+  stage.flags = desc.requireFullSubgroups ? VK_PIPELINE_SHADER_STAGE_CREATE_REQUIRE_FULL_SUBGROUPS_BIT : 0;
+  stage.stage = VK_SHADER_STAGE_COMPUTE_BIT;
+  stage.module = module_;
+  stage.pName = "main";
+  stage.pSpecializationInfo = entries.empty() ? nullptr : &specInfo;
+  VkComputePipelineCreateInfo pipelineInfo{VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO};
+  pipelineInfo.stage = stage;
+  pipelineInfo.layout = pipelineLayout_;
+  VK_CHECK(vkCreateComputePipelines(device, VK_NULL_HANDLE, 1, &pipelineInfo, nullptr, &pipeline_));
+  context.setName(VK_OBJECT_TYPE_PIPELINE, pipeline_, name_);
+}
+
+ComputeProgram::~ComputeProgram() {
+  VkDevice device = context_->device();
+  VkPipeline pipeline = pipeline_;
+  VkPipelineLayout layout = pipelineLayout_;
+  VkDescriptorSetLayout setLayout = setLayout_;
+  VkShaderModule module = module_;
+  context_->retire([=] {
+    vkDestroyPipeline(device, pipeline, nullptr);
+    vkDestroyPipelineLayout(device, layout, nullptr);
+    vkDestroyDescriptorSetLayout(device, setLayout, nullptr);
+    vkDestroyShaderModule(device, module, nullptr);
+  });
+}
+
+void ComputeProgram::record(Commands& commands, std::initializer_list<BufferBinding> buffers, const void* push,
+                            size_t pushBytes, uint64_t groups) const {
+  if (pushBytes != reflection_.pushConstantBytes && !(reflection_.pushConstantBytes == 0 && push == nullptr)) {
+    throw VulkanError("program '" + name_ + "' takes " + std::to_string(reflection_.pushConstantBytes) +
+                      " bytes of push constants; the call gave " + std::to_string(pushBytes));
+  }
+  if (buffers.size() != reflection_.bindings.size()) {
+    throw VulkanError("program '" + name_ + "' has " + std::to_string(reflection_.bindings.size()) +
+                      " bindings; the call gave " + std::to_string(buffers.size()));
+  }
+  if (groups == 0) return;
+
+  std::vector<VkDescriptorBufferInfo> infos;
+  std::vector<VkWriteDescriptorSet> writes;
+  infos.reserve(buffers.size());
+  VkDescriptorSet set = commands.allocateSet(setLayout_);
+  for (const BufferBinding& b : buffers) {
+    auto reflected = std::find_if(reflection_.bindings.begin(), reflection_.bindings.end(),
+                                  [&](const ReflectedBinding& r) { return r.binding == b.slot; });
+    if (reflected == reflection_.bindings.end()) {
+      throw VulkanError("program '" + name_ + "' has no binding " + std::to_string(b.slot));
+    }
+    if (!b.buffer || !b.buffer->handle()) {
+      throw VulkanError("program '" + name_ + "': binding " + std::to_string(b.slot) + " has no buffer");
+    }
+    infos.push_back({b.buffer->handle(), 0, VK_WHOLE_SIZE});
+    VkWriteDescriptorSet write{VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
+    write.dstSet = set;
+    write.dstBinding = b.slot;
+    write.descriptorCount = 1;
+    write.descriptorType = reflected->type;
+    write.pBufferInfo = &infos.back();
+    writes.push_back(write);
+  }
+  vkUpdateDescriptorSets(context_->device(), static_cast<uint32_t>(writes.size()), writes.data(), 0, nullptr);
+
+  VkCommandBuffer cmd = commands.handle();
+  vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline_);
+  vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, pipelineLayout_, 0, 1, &set, 0, nullptr);
+  if (reflection_.pushConstantBytes) {
+    vkCmdPushConstants(cmd, pipelineLayout_, VK_SHADER_STAGE_COMPUTE_BIT, 0, reflection_.pushConstantBytes, push);
+  }
+  const DeviceCaps& caps = context_->caps();
+  uint64_t maxX = caps.maxComputeWorkgroupCount[0];
+  uint64_t x = std::min<uint64_t>(groups, maxX);
+  uint64_t y = (groups + x - 1) / x;
+  if (y > caps.maxComputeWorkgroupCount[1]) {
+    throw VulkanError("program '" + name_ + "': " + std::to_string(groups) + " workgroups exceed the device's limits");
+  }
+  vkCmdDispatch(cmd, static_cast<uint32_t>(x), static_cast<uint32_t>(y), 1);
+}
+
+}  // namespace snell::vk

@@ -1,0 +1,76 @@
+// A compute pipeline built from embedded SPIR-V that knows its own layout:
+// workgroup size, bindings and push-constant size come from reflection, so call
+// sites give thread counts and buffers, never group counts or binding tables.
+#pragma once
+
+#include "vk/buffer.h"
+#include "vk/commands.h"
+#include "vk/context.h"
+#include "vk/spirv_reflect.h"
+
+#include <vulkan/vulkan.h>
+
+#include <array>
+#include <cstdint>
+#include <initializer_list>
+#include <span>
+#include <string>
+#include <vector>
+
+namespace snell::vk {
+
+struct ComputeProgramDesc {
+  std::string name;
+  std::span<const uint32_t> spirv;
+  std::vector<SpecConstant> specialization;
+  /// Every subgroup is full and the subgroup numbering is dense; needed by
+  /// shaders that rank or scan in (gl_SubgroupID, gl_SubgroupInvocationID) order.
+  bool requireFullSubgroups = false;
+};
+
+/// One buffer bound to a binding slot of set 0.
+struct BufferBinding {
+  uint32_t slot;
+  const Buffer* buffer;
+};
+
+class ComputeProgram {
+ public:
+  ComputeProgram(Context& context, const ComputeProgramDesc& desc);
+  ~ComputeProgram();
+  ComputeProgram(const ComputeProgram&) = delete;
+  ComputeProgram& operator=(const ComputeProgram&) = delete;
+
+  const std::string& name() const { return name_; }
+  std::array<uint32_t, 3> localSize() const { return reflection_.localSize; }
+  const ShaderReflection& reflection() const { return reflection_; }
+
+  /// Dispatches enough workgroups to cover `threads` invocations along x.
+  template <typename Push>
+  void dispatchThreads(Commands& commands, std::initializer_list<BufferBinding> buffers, const Push& push,
+                       uint64_t threads) const {
+    uint64_t groups = (threads + reflection_.localSize[0] - 1) / reflection_.localSize[0];
+    record(commands, buffers, &push, sizeof(Push), groups);
+  }
+  /// Dispatches `groups` workgroups; above the device's x limit they are split
+  /// over y, and shaders flatten (x, y) back into one block index.
+  template <typename Push>
+  void dispatchGroups(Commands& commands, std::initializer_list<BufferBinding> buffers, const Push& push,
+                      uint64_t groups) const {
+    record(commands, buffers, &push, sizeof(Push), groups);
+  }
+
+ private:
+  void record(Commands& commands, std::initializer_list<BufferBinding> buffers, const void* push, size_t pushBytes,
+              uint64_t groups) const;
+
+  Context* context_;
+  std::string name_;
+  ShaderReflection reflection_;
+  VkShaderModule module_ = VK_NULL_HANDLE;
+  VkDescriptorSetLayout setLayout_ = VK_NULL_HANDLE;
+  VkPipelineLayout pipelineLayout_ = VK_NULL_HANDLE;
+  VkPipeline pipeline_ = VK_NULL_HANDLE;
+};
+
+}  // namespace snell::vk

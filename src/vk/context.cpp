@@ -1,0 +1,341 @@
+// Instance and device creation, adoption of a host's device, the validation
+// messenger and deferred destruction.
+#include "vk/context.h"
+
+#include "vk/error.h"
+
+#include <algorithm>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <iomanip>
+#include <sstream>
+
+namespace snell::vk {
+
+namespace {
+
+constexpr const char* kValidationLayer = "VK_LAYER_KHRONOS_validation";
+
+bool hasLayer(const char* name) {
+  uint32_t count = 0;
+  VK_CHECK(vkEnumerateInstanceLayerProperties(&count, nullptr));
+  std::vector<VkLayerProperties> layers(count);
+  VK_CHECK(vkEnumerateInstanceLayerProperties(&count, layers.data()));
+  return std::any_of(layers.begin(), layers.end(), [&](const VkLayerProperties& l) { return std::strcmp(l.layerName, name) == 0; });
+}
+
+bool hasInstanceExtension(const char* name) {
+  uint32_t count = 0;
+  VK_CHECK(vkEnumerateInstanceExtensionProperties(nullptr, &count, nullptr));
+  std::vector<VkExtensionProperties> extensions(count);
+  VK_CHECK(vkEnumerateInstanceExtensionProperties(nullptr, &count, extensions.data()));
+  return std::any_of(extensions.begin(), extensions.end(),
+                     [&](const VkExtensionProperties& e) { return std::strcmp(e.extensionName, name) == 0; });
+}
+
+std::string overrideOrEnvironment(const std::string& given) {
+  if (!given.empty()) return given;
+  const char* env = std::getenv("SNELL_DEVICE");
+  return env ? env : "";
+}
+
+struct InstanceRequest {
+  std::string applicationName = "snell";
+  bool validation = false;
+  bool synchronizationValidation = false;
+};
+
+VkInstance createInstance(const InstanceRequest& request, bool& debugUtils) {
+  uint32_t loaderVersion = VK_API_VERSION_1_0;
+  VK_CHECK(vkEnumerateInstanceVersion(&loaderVersion));
+  if (loaderVersion < VK_API_VERSION_1_3) {
+    throw VulkanError("the Vulkan loader supports " + versionString(loaderVersion) +
+                      "; snell needs 1.3 (Debian 12: apt-get install libvulkan1)");
+  }
+  std::vector<const char*> layers;
+  if (request.validation) {
+    if (!hasLayer(kValidationLayer)) {
+      throw VulkanError(std::string("validation was requested but ") + kValidationLayer +
+                        " is not installed (Debian 12: apt-get install vulkan-validationlayers)");
+    }
+    layers.push_back(kValidationLayer);
+  }
+  std::vector<const char*> extensions;
+  debugUtils = hasInstanceExtension(VK_EXT_DEBUG_UTILS_EXTENSION_NAME);
+  if (debugUtils) extensions.push_back(VK_EXT_DEBUG_UTILS_EXTENSION_NAME);
+
+  VkApplicationInfo app{VK_STRUCTURE_TYPE_APPLICATION_INFO};
+  app.pApplicationName = request.applicationName.c_str();
+  app.pEngineName = "snell";
+  app.apiVersion = VK_API_VERSION_1_3;
+
+  VkValidationFeatureEnableEXT syncFeature = VK_VALIDATION_FEATURE_ENABLE_SYNCHRONIZATION_VALIDATION_EXT;
+  VkValidationFeaturesEXT features{VK_STRUCTURE_TYPE_VALIDATION_FEATURES_EXT};
+  features.enabledValidationFeatureCount = 1;
+  features.pEnabledValidationFeatures = &syncFeature;
+
+  VkInstanceCreateInfo info{VK_STRUCTURE_TYPE_INSTANCE_CREATE_INFO};
+  info.pNext = (request.validation && request.synchronizationValidation) ? &features : nullptr;
+  info.pApplicationInfo = &app;
+  info.enabledLayerCount = static_cast<uint32_t>(layers.size());
+  info.ppEnabledLayerNames = layers.data();
+  info.enabledExtensionCount = static_cast<uint32_t>(extensions.size());
+  info.ppEnabledExtensionNames = extensions.data();
+  VkInstance instance = VK_NULL_HANDLE;
+  VK_CHECK(vkCreateInstance(&info, nullptr, &instance));
+  return instance;
+}
+
+std::vector<DeviceFacts> readAllFacts(VkInstance instance, std::vector<VkPhysicalDevice>& handles) {
+  uint32_t count = 0;
+  VK_CHECK(vkEnumeratePhysicalDevices(instance, &count, nullptr));
+  handles.resize(count);
+  VK_CHECK(vkEnumeratePhysicalDevices(instance, &count, handles.data()));
+  std::vector<DeviceFacts> facts;
+  for (uint32_t i = 0; i < count; ++i) facts.push_back(readDeviceFacts(handles[i], i));
+  return facts;
+}
+
+std::string mebibytes(uint64_t bytes) {
+  std::ostringstream text;
+  text << (bytes >> 20) << " MiB";
+  return text.str();
+}
+
+}  // namespace
+
+std::string DeviceReport::table() const {
+  std::ostringstream out;
+  if (devices.empty()) {
+    out << "no Vulkan device found (Debian 12: apt-get install mesa-vulkan-drivers for lavapipe)\n";
+    return out.str();
+  }
+  for (size_t i = 0; i < devices.size(); ++i) {
+    const DeviceFacts& d = devices[i];
+    bool chosen = choice.chosen && *choice.chosen == i;
+    out << (chosen ? "* " : "  ") << "[" << d.index << "] " << d.name << "\n"
+        << "      type " << deviceTypeName(d.type) << ", Vulkan " << versionString(d.apiVersion) << ", driver "
+        << (d.driverName.empty() ? "?" : d.driverName) << " " << d.driverInfo << "\n"
+        << "      subgroup " << d.subgroupSize << " lanes (" << d.minSubgroupSize << "-" << d.maxSubgroupSize
+        << " in compute), device-local memory " << mebibytes(d.deviceLocalBytes) << "\n"
+        << "      " << choice.verdicts[i] << "\n";
+  }
+  return out.str();
+}
+
+DeviceReport surveyDevices(const std::string& deviceOverride) {
+  DeviceReport report;
+  report.override = overrideOrEnvironment(deviceOverride);
+  bool debugUtils = false;
+  VkInstance instance = createInstance({}, debugUtils);
+  try {
+    std::vector<VkPhysicalDevice> handles;
+    report.devices = readAllFacts(instance, handles);
+  } catch (...) {
+    vkDestroyInstance(instance, nullptr);
+    throw;
+  }
+  vkDestroyInstance(instance, nullptr);
+  report.choice = chooseDevice(report.devices, report.override);
+  return report;
+}
+
+std::unique_ptr<Context> Context::create(const ContextDesc& desc) {
+  std::unique_ptr<Context> context(new Context());
+  Context& c = *context;
+  c.owned_ = true;
+  bool debugUtils = false;
+  c.instance_ = createInstance({desc.applicationName, desc.validation, desc.synchronizationValidation}, debugUtils);
+  c.validation_ = desc.validation;
+
+  if (debugUtils) {
+    auto createMessenger = reinterpret_cast<PFN_vkCreateDebugUtilsMessengerEXT>(
+        vkGetInstanceProcAddr(c.instance_, "vkCreateDebugUtilsMessengerEXT"));
+    VkDebugUtilsMessengerCreateInfoEXT info{VK_STRUCTURE_TYPE_DEBUG_UTILS_MESSENGER_CREATE_INFO_EXT};
+    info.messageSeverity = VK_DEBUG_UTILS_MESSAGE_SEVERITY_WARNING_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT;
+    info.messageType = VK_DEBUG_UTILS_MESSAGE_TYPE_VALIDATION_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_TYPE_PERFORMANCE_BIT_EXT |
+                       VK_DEBUG_UTILS_MESSAGE_TYPE_GENERAL_BIT_EXT;
+    info.pfnUserCallback = &Context::onDebugMessage;
+    info.pUserData = &c;
+    if (createMessenger) VK_CHECK(createMessenger(c.instance_, &info, nullptr, &c.messenger_));
+  }
+
+  std::vector<VkPhysicalDevice> handles;
+  std::vector<DeviceFacts> facts = readAllFacts(c.instance_, handles);
+  std::string override = overrideOrEnvironment(desc.deviceOverride);
+  DeviceChoice choice = chooseDevice(facts, override);
+  if (!choice.chosen) {
+    DeviceReport report{facts, choice, override};
+    throw VulkanError("no Vulkan device meets snell's requirements" +
+                      (override.empty() ? std::string() : " among those SNELL_DEVICE=" + override + " names") +
+                      ":\n" + report.table());
+  }
+  const DeviceFacts& chosen = facts[*choice.chosen];
+  VkPhysicalDevice physical = handles[*choice.chosen];
+
+  float priority = 1.0f;
+  VkDeviceQueueCreateInfo queueInfo{VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO};
+  queueInfo.queueFamilyIndex = chosen.computeQueueFamily;
+  queueInfo.queueCount = 1;
+  queueInfo.pQueuePriorities = &priority;
+
+  VkPhysicalDeviceVulkan13Features features13{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_3_FEATURES};
+  features13.subgroupSizeControl = VK_TRUE;
+  features13.computeFullSubgroups = VK_TRUE;
+  features13.maintenance4 = VK_TRUE;
+  VkPhysicalDeviceFeatures2 features{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2, &features13};
+
+  VkDeviceCreateInfo info{VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO};
+  info.pNext = &features;
+  info.queueCreateInfoCount = 1;
+  info.pQueueCreateInfos = &queueInfo;
+  VK_CHECK(vkCreateDevice(physical, &info, nullptr, &c.device_));
+  c.queueFamily_ = chosen.computeQueueFamily;
+  vkGetDeviceQueue(c.device_, c.queueFamily_, 0, &c.queue_);
+  if (debugUtils) {
+    c.setObjectName_ = reinterpret_cast<PFN_vkSetDebugUtilsObjectNameEXT>(
+        vkGetInstanceProcAddr(c.instance_, "vkSetDebugUtilsObjectNameEXT"));
+  }
+  c.initialise(physical, chosen);
+  return context;
+}
+
+std::unique_ptr<Context> Context::adopt(const AdoptedDevice& host) {
+  if (!host.instance || !host.physicalDevice || !host.device || !host.queue) {
+    throw VulkanError("adopting a host device needs its VkInstance, VkPhysicalDevice, VkDevice and VkQueue; one is null");
+  }
+  DeviceFacts facts = readDeviceFacts(host.physicalDevice, 0);
+  if (!host.enabled13.subgroupSizeControl) facts.unmet.push_back("the host did not enable subgroupSizeControl");
+  if (!host.enabled13.computeFullSubgroups) facts.unmet.push_back("the host did not enable computeFullSubgroups");
+  if (!host.enabled13.maintenance4) facts.unmet.push_back("the host did not enable maintenance4");
+  uint32_t familyCount = 0;
+  vkGetPhysicalDeviceQueueFamilyProperties(host.physicalDevice, &familyCount, nullptr);
+  std::vector<VkQueueFamilyProperties> families(familyCount);
+  vkGetPhysicalDeviceQueueFamilyProperties(host.physicalDevice, &familyCount, families.data());
+  if (host.queueFamily >= familyCount || !(families[host.queueFamily].queueFlags & VK_QUEUE_COMPUTE_BIT)) {
+    facts.unmet.push_back("queue family " + std::to_string(host.queueFamily) + " does not support compute");
+  }
+  if (!facts.unmet.empty()) {
+    std::string reasons;
+    for (const std::string& u : facts.unmet) reasons += "\n  - " + u;
+    throw VulkanError("cannot adopt the host's device " + facts.name + ":" + reasons);
+  }
+  std::unique_ptr<Context> context(new Context());
+  Context& c = *context;
+  c.owned_ = false;
+  c.instance_ = host.instance;
+  c.device_ = host.device;
+  c.queue_ = host.queue;
+  c.queueFamily_ = host.queueFamily;
+  facts.computeQueueFamily = host.queueFamily;
+  // Present only if the host enabled VK_EXT_debug_utils; otherwise names are skipped.
+  c.setObjectName_ = reinterpret_cast<PFN_vkSetDebugUtilsObjectNameEXT>(
+      vkGetInstanceProcAddr(host.instance, "vkSetDebugUtilsObjectNameEXT"));
+  c.initialise(host.physicalDevice, facts);
+  return context;
+}
+
+void Context::initialise(VkPhysicalDevice physicalDevice, const DeviceFacts& facts) {
+  physicalDevice_ = physicalDevice;
+  facts_ = facts;
+  VkPhysicalDeviceProperties props{};
+  vkGetPhysicalDeviceProperties(physicalDevice, &props);
+  VkPhysicalDeviceMaintenance3Properties maintenance3{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_MAINTENANCE_3_PROPERTIES};
+  VkPhysicalDeviceProperties2 props2{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2, &maintenance3};
+  vkGetPhysicalDeviceProperties2(physicalDevice, &props2);
+  const VkPhysicalDeviceLimits& limits = props.limits;
+  caps_.minSubgroupSize = facts.minSubgroupSize;
+  caps_.maxSubgroupSize = facts.maxSubgroupSize;
+  caps_.maxComputeSharedMemoryBytes = limits.maxComputeSharedMemorySize;
+  caps_.maxComputeWorkgroupInvocations = limits.maxComputeWorkGroupInvocations;
+  for (int i = 0; i < 3; ++i) caps_.maxComputeWorkgroupCount[i] = limits.maxComputeWorkGroupCount[i];
+  caps_.maxStorageBufferRange = limits.maxStorageBufferRange;
+  caps_.maxMemoryAllocationSize = maintenance3.maxMemoryAllocationSize;
+  caps_.maxPushConstantsSize = limits.maxPushConstantsSize;
+  caps_.timestampPeriodNs = limits.timestampPeriod;
+
+  uint32_t familyCount = 0;
+  vkGetPhysicalDeviceQueueFamilyProperties(physicalDevice, &familyCount, nullptr);
+  std::vector<VkQueueFamilyProperties> families(familyCount);
+  vkGetPhysicalDeviceQueueFamilyProperties(physicalDevice, &familyCount, families.data());
+  caps_.timestampValidBits = families[queueFamily_].timestampValidBits;
+
+  vkGetPhysicalDeviceMemoryProperties(physicalDevice, &memory_);
+  setName(VK_OBJECT_TYPE_DEVICE, device_, "snell device");
+  setName(VK_OBJECT_TYPE_QUEUE, queue_, "snell queue");
+}
+
+Context::~Context() {
+  if (device_) vkDeviceWaitIdle(device_);  // the host's device too: our handles die with us
+  for (Retired& r : retired_) r.destroy();
+  retired_.clear();
+  if (!owned_) return;
+  if (device_) vkDestroyDevice(device_, nullptr);
+  if (messenger_) {
+    auto destroyMessenger = reinterpret_cast<PFN_vkDestroyDebugUtilsMessengerEXT>(
+        vkGetInstanceProcAddr(instance_, "vkDestroyDebugUtilsMessengerEXT"));
+    if (destroyMessenger) destroyMessenger(instance_, messenger_, nullptr);
+  }
+  if (instance_) vkDestroyInstance(instance_, nullptr);
+}
+
+VkBool32 VKAPI_PTR Context::onDebugMessage(VkDebugUtilsMessageSeverityFlagBitsEXT severity,
+                                           VkDebugUtilsMessageTypeFlagsEXT types,
+                                           const VkDebugUtilsMessengerCallbackDataEXT* data, void* user) {
+  auto* context = static_cast<Context*>(user);
+  // General messages come from the loader (a stray ICD file, say), not from our use of the API.
+  if (types & (VK_DEBUG_UTILS_MESSAGE_TYPE_VALIDATION_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_TYPE_PERFORMANCE_BIT_EXT)) {
+    context->validationMessages_.fetch_add(1);
+  }
+  const char* level = (severity & VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT) ? "error" : "warning";
+  std::fprintf(stderr, "[vulkan %s] %s\n", level, data && data->pMessage ? data->pMessage : "(no message)");
+  return VK_FALSE;
+}
+
+void Context::setName(VkObjectType type, uint64_t handle, const std::string& name) const {
+  if (!setObjectName_ || handle == 0) return;
+  VkDebugUtilsObjectNameInfoEXT info{VK_STRUCTURE_TYPE_DEBUG_UTILS_OBJECT_NAME_INFO_EXT};
+  info.objectType = type;
+  info.objectHandle = handle;
+  info.pObjectName = name.c_str();
+  VK_CHECK(setObjectName_(device_, &info));
+}
+
+void Context::retire(std::function<void()> destroy) {
+  retired_.push_back({submitted_, std::move(destroy)});
+  collectRetired();
+}
+
+uint64_t Context::noteSubmitted() {
+  inFlight_.insert(++submitted_);
+  return submitted_;
+}
+
+void Context::noteCompleted(uint64_t serial) {
+  inFlight_.erase(serial);
+  collectRetired();
+}
+
+void Context::collectRetired() {
+  // Everything up to the oldest submission still in flight has finished.
+  uint64_t safe = inFlight_.empty() ? submitted_ : *inFlight_.begin() - 1;
+  auto done = std::stable_partition(retired_.begin(), retired_.end(), [&](const Retired& r) { return r.serial > safe; });
+  std::vector<Retired> ready(std::make_move_iterator(done), std::make_move_iterator(retired_.end()));
+  retired_.erase(done, retired_.end());
+  for (Retired& r : ready) r.destroy();
+}
+
+uint32_t Context::findMemoryType(uint32_t typeBits, VkMemoryPropertyFlags required, VkMemoryPropertyFlags preferred) const {
+  uint32_t fallback = UINT32_MAX;
+  for (uint32_t i = 0; i < memory_.memoryTypeCount; ++i) {
+    if (!(typeBits & (1u << i))) continue;
+    VkMemoryPropertyFlags flags = memory_.memoryTypes[i].propertyFlags;
+    if ((flags & required) != required) continue;
+    if ((flags & preferred) == preferred) return i;
+    if (fallback == UINT32_MAX) fallback = i;
+  }
+  return fallback;
+}
+
+}  // namespace snell::vk

@@ -1,0 +1,147 @@
+// The Vulkan context: instance, physical device, device and queue, either
+// created by snell or adopted from a host application that keeps ownership.
+#pragma once
+
+#include "vk/device_selection.h"
+
+#include <vulkan/vulkan.h>
+
+#include <atomic>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <set>
+#include <string>
+#include <vector>
+
+namespace snell::vk {
+
+/// How snell creates its own context.
+struct ContextDesc {
+  std::string applicationName = "snell";
+  /// Turn on VK_LAYER_KHRONOS_validation; creation fails if the layer is missing.
+  bool validation = false;
+  /// With validation: also check synchronization (missing barriers, hazards).
+  bool synchronizationValidation = false;
+  /// An index or a name substring; empty means use the SNELL_DEVICE variable.
+  std::string deviceOverride;
+};
+
+/// Handles a host application created; snell uses them and never destroys them.
+/// The device must have been created with Vulkan 1.3 and its features
+/// subgroupSizeControl, computeFullSubgroups and maintenance4 enabled, on a queue family with
+/// compute; `enabled13` states what the host enabled so snell can check it.
+struct AdoptedDevice {
+  VkInstance instance = VK_NULL_HANDLE;
+  VkPhysicalDevice physicalDevice = VK_NULL_HANDLE;
+  VkDevice device = VK_NULL_HANDLE;
+  uint32_t queueFamily = 0;
+  VkQueue queue = VK_NULL_HANDLE;
+  VkPhysicalDeviceVulkan13Features enabled13{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_3_FEATURES};
+};
+
+/// Limits and properties the passes size themselves by.
+struct DeviceCaps {
+  uint32_t minSubgroupSize = 0;
+  uint32_t maxSubgroupSize = 0;
+  uint32_t maxComputeSharedMemoryBytes = 0;
+  uint32_t maxComputeWorkgroupInvocations = 0;
+  uint32_t maxComputeWorkgroupCount[3] = {0, 0, 0};
+  uint64_t maxStorageBufferRange = 0;
+  uint64_t maxMemoryAllocationSize = 0;
+  uint32_t maxPushConstantsSize = 0;
+  float timestampPeriodNs = 0;  ///< nanoseconds per timestamp tick
+  uint32_t timestampValidBits = 0;  ///< 0: the queue cannot time passes
+};
+
+/// Every devices' facts and the verdict on each, without creating a device.
+struct DeviceReport {
+  std::vector<DeviceFacts> devices;
+  DeviceChoice choice;
+  std::string override;
+  /// A table with one row per device and its verdict.
+  std::string table() const;
+};
+
+/// Surveys the Vulkan devices as Context::create would choose among them.
+DeviceReport surveyDevices(const std::string& deviceOverride = "");
+
+/// Owns (or borrows) the Vulkan device everything else runs on, counts
+/// validation messages, and defers destruction of handles the GPU may still use.
+class Context {
+ public:
+  /// Creates an instance and device; throws VulkanError listing every device
+  /// and why it was rejected when none qualifies.
+  static std::unique_ptr<Context> create(const ContextDesc& desc = {});
+  /// Wraps a host application's device; throws if it misses a requirement.
+  static std::unique_ptr<Context> adopt(const AdoptedDevice& host);
+
+  ~Context();
+  Context(const Context&) = delete;
+  Context& operator=(const Context&) = delete;
+
+  VkInstance instance() const { return instance_; }
+  VkPhysicalDevice physicalDevice() const { return physicalDevice_; }
+  VkDevice device() const { return device_; }
+  VkQueue queue() const { return queue_; }
+  uint32_t queueFamily() const { return queueFamily_; }
+  const DeviceFacts& facts() const { return facts_; }
+  const DeviceCaps& caps() const { return caps_; }
+  bool ownsDevice() const { return owned_; }
+
+  /// Validation warnings and errors seen so far (0 when validation is off).
+  uint64_t validationMessageCount() const { return validationMessages_.load(); }
+  /// Whether VK_LAYER_KHRONOS_validation is active on this context.
+  bool validationEnabled() const { return validation_; }
+
+  /// Gives a Vulkan object a name that validation messages and tools show;
+  /// does nothing when VK_EXT_debug_utils is unavailable.
+  void setName(VkObjectType type, uint64_t handle, const std::string& name) const;
+  template <typename Handle>
+  void setName(VkObjectType type, Handle handle, const std::string& name) const {
+    setName(type, reinterpret_cast<uint64_t>(handle), name);
+  }
+
+  /// Runs `destroy` once every submission made so far has completed.
+  void retire(std::function<void()> destroy);
+  /// Submission bookkeeping for Commands: a serial per queue submission.
+  uint64_t noteSubmitted();
+  void noteCompleted(uint64_t serial);
+  /// Destroys what no in-flight submission can use any more.
+  void collectRetired();
+
+  /// Memory type for `typeBits` with `required` flags, preferring `preferred`;
+  /// UINT32_MAX when none has them.
+  uint32_t findMemoryType(uint32_t typeBits, VkMemoryPropertyFlags required, VkMemoryPropertyFlags preferred) const;
+
+ private:
+  Context() = default;
+  void initialise(VkPhysicalDevice physicalDevice, const DeviceFacts& facts);
+  static VkBool32 VKAPI_PTR onDebugMessage(VkDebugUtilsMessageSeverityFlagBitsEXT severity,
+                                           VkDebugUtilsMessageTypeFlagsEXT types,
+                                           const VkDebugUtilsMessengerCallbackDataEXT* data, void* user);
+
+  VkInstance instance_ = VK_NULL_HANDLE;
+  VkDebugUtilsMessengerEXT messenger_ = VK_NULL_HANDLE;
+  VkPhysicalDevice physicalDevice_ = VK_NULL_HANDLE;
+  VkDevice device_ = VK_NULL_HANDLE;
+  VkQueue queue_ = VK_NULL_HANDLE;
+  uint32_t queueFamily_ = 0;
+  bool owned_ = false;
+  bool validation_ = false;
+  DeviceFacts facts_;
+  DeviceCaps caps_;
+  VkPhysicalDeviceMemoryProperties memory_{};
+  PFN_vkSetDebugUtilsObjectNameEXT setObjectName_ = nullptr;
+  std::atomic<uint64_t> validationMessages_{0};
+
+  uint64_t submitted_ = 0;
+  std::set<uint64_t> inFlight_;
+  struct Retired {
+    uint64_t serial;
+    std::function<void()> destroy;
+  };
+  std::vector<Retired> retired_;
+};
+
+}  // namespace snell::vk

@@ -1,0 +1,162 @@
+// Device facts, requirements and ranking (see device_selection.h).
+#include "vk/device_selection.h"
+
+#include <algorithm>
+#include <cctype>
+#include <charconv>
+#include <sstream>
+
+namespace snell::vk {
+
+namespace {
+
+int typeRank(VkPhysicalDeviceType type) {
+  switch (type) {
+    case VK_PHYSICAL_DEVICE_TYPE_DISCRETE_GPU: return 0;
+    case VK_PHYSICAL_DEVICE_TYPE_INTEGRATED_GPU: return 1;
+    case VK_PHYSICAL_DEVICE_TYPE_VIRTUAL_GPU: return 2;
+    case VK_PHYSICAL_DEVICE_TYPE_CPU: return 3;
+    default: return 4;
+  }
+}
+
+std::string lower(std::string text) {
+  std::transform(text.begin(), text.end(), text.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return text;
+}
+
+bool isIndex(const std::string& text, uint32_t& index) {
+  if (text.empty()) return false;
+  auto [end, error] = std::from_chars(text.data(), text.data() + text.size(), index);
+  return error == std::errc() && end == text.data() + text.size();
+}
+
+}  // namespace
+
+const char* deviceTypeName(VkPhysicalDeviceType type) {
+  switch (type) {
+    case VK_PHYSICAL_DEVICE_TYPE_DISCRETE_GPU: return "discrete GPU";
+    case VK_PHYSICAL_DEVICE_TYPE_INTEGRATED_GPU: return "integrated GPU";
+    case VK_PHYSICAL_DEVICE_TYPE_VIRTUAL_GPU: return "virtual GPU";
+    case VK_PHYSICAL_DEVICE_TYPE_CPU: return "CPU";
+    default: return "other";
+  }
+}
+
+std::string versionString(uint32_t v) {
+  std::ostringstream text;
+  text << VK_API_VERSION_MAJOR(v) << "." << VK_API_VERSION_MINOR(v) << "." << VK_API_VERSION_PATCH(v);
+  return text.str();
+}
+
+DeviceFacts readDeviceFacts(VkPhysicalDevice device, uint32_t index) {
+  DeviceFacts facts;
+  facts.index = index;
+  VkPhysicalDeviceProperties basic{};
+  vkGetPhysicalDeviceProperties(device, &basic);
+  facts.name = basic.deviceName;
+  facts.type = basic.deviceType;
+  facts.apiVersion = basic.apiVersion;
+
+  VkPhysicalDeviceMemoryProperties memory{};
+  vkGetPhysicalDeviceMemoryProperties(device, &memory);
+  for (uint32_t h = 0; h < memory.memoryHeapCount; ++h) {
+    if (memory.memoryHeaps[h].flags & VK_MEMORY_HEAP_DEVICE_LOCAL_BIT) facts.deviceLocalBytes += memory.memoryHeaps[h].size;
+  }
+
+  uint32_t familyCount = 0;
+  vkGetPhysicalDeviceQueueFamilyProperties(device, &familyCount, nullptr);
+  std::vector<VkQueueFamilyProperties> families(familyCount);
+  vkGetPhysicalDeviceQueueFamilyProperties(device, &familyCount, families.data());
+  // Prefer a family that also draws: the raster pass shares the queue with compute.
+  for (uint32_t f = 0; f < familyCount; ++f) {
+    VkQueueFlags flags = families[f].queueFlags;
+    if (!(flags & VK_QUEUE_COMPUTE_BIT)) continue;
+    bool graphics = flags & VK_QUEUE_GRAPHICS_BIT;
+    if (facts.computeQueueFamily == UINT32_MAX || graphics) facts.computeQueueFamily = f;
+    if (graphics) break;
+  }
+  if (facts.computeQueueFamily == UINT32_MAX) facts.unmet.push_back("no queue family supports compute");
+
+  if (basic.apiVersion < VK_API_VERSION_1_3) {
+    facts.unmet.push_back("Vulkan " + versionString(basic.apiVersion) + " is below the required 1.3");
+    return facts;  // the 1.2/1.3 property structs below may not be chained on it
+  }
+
+  VkPhysicalDeviceVulkan13Properties props13{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_3_PROPERTIES};
+  VkPhysicalDeviceVulkan12Properties props12{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_PROPERTIES, &props13};
+  VkPhysicalDeviceVulkan11Properties props11{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_1_PROPERTIES, &props12};
+  VkPhysicalDeviceProperties2 props{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2, &props11};
+  vkGetPhysicalDeviceProperties2(device, &props);
+  facts.driverId = props12.driverID;
+  facts.driverName = props12.driverName;
+  facts.driverInfo = props12.driverInfo;
+  facts.subgroupSize = props11.subgroupSize;
+  facts.minSubgroupSize = props13.minSubgroupSize;
+  facts.maxSubgroupSize = props13.maxSubgroupSize;
+
+  VkPhysicalDeviceVulkan13Features features13{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_3_FEATURES};
+  VkPhysicalDeviceFeatures2 features{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2, &features13};
+  vkGetPhysicalDeviceFeatures2(device, &features);
+
+  if (!(props11.subgroupSupportedStages & VK_SHADER_STAGE_COMPUTE_BIT)) {
+    facts.unmet.push_back("subgroup operations are not supported in compute shaders");
+  }
+  const VkSubgroupFeatureFlags needed =
+      VK_SUBGROUP_FEATURE_BASIC_BIT | VK_SUBGROUP_FEATURE_BALLOT_BIT | VK_SUBGROUP_FEATURE_ARITHMETIC_BIT;
+  if ((props11.subgroupSupportedOperations & needed) != needed) {
+    facts.unmet.push_back("subgroup basic, ballot and arithmetic operations are not all supported");
+  }
+  if (!features13.subgroupSizeControl) facts.unmet.push_back("feature subgroupSizeControl is missing");
+  if (!features13.computeFullSubgroups) facts.unmet.push_back("feature computeFullSubgroups is missing");
+  // glslang writes a specialised workgroup size as LocalSizeId, which needs maintenance4.
+  if (!features13.maintenance4) facts.unmet.push_back("feature maintenance4 is missing");
+  if (props13.maxSubgroupSize > 128) {
+    facts.unmet.push_back("subgroups of " + std::to_string(props13.maxSubgroupSize) + " lanes exceed the 128 snell's ballots hold");
+  }
+  return facts;
+}
+
+DeviceChoice chooseDevice(std::span<const DeviceFacts> devices, const std::string& override) {
+  DeviceChoice choice;
+  uint32_t overrideIndex = 0;
+  bool byIndex = isIndex(override, overrideIndex);
+  std::string needle = lower(override);
+
+  auto named = [&](const DeviceFacts& d) {
+    if (override.empty()) return true;
+    if (byIndex) return d.index == overrideIndex;
+    return lower(d.name).find(needle) != std::string::npos;
+  };
+  // Lower is better: device type first, then more device-local memory.
+  auto rank = [](const DeviceFacts& d) { return std::make_pair(typeRank(d.type), ~d.deviceLocalBytes); };
+
+  for (uint32_t i = 0; i < devices.size(); ++i) {
+    const DeviceFacts& d = devices[i];
+    if (!named(d) || !d.unmet.empty()) continue;
+    if (!choice.chosen || rank(d) < rank(devices[*choice.chosen])) choice.chosen = i;
+  }
+
+  for (uint32_t i = 0; i < devices.size(); ++i) {
+    const DeviceFacts& d = devices[i];
+    std::string verdict;
+    if (choice.chosen && i == *choice.chosen) {
+      verdict = override.empty() ? "chosen: the highest-ranked device that meets every requirement"
+                                 : "chosen: named by SNELL_DEVICE=" + override;
+    } else if (!d.unmet.empty()) {
+      verdict = "rejected: ";
+      for (size_t u = 0; u < d.unmet.size(); ++u) verdict += (u ? "; " : "") + d.unmet[u];
+    } else if (!named(d)) {
+      verdict = "not chosen: SNELL_DEVICE=" + override + " names another device";
+    } else {
+      const DeviceFacts& best = devices[*choice.chosen];
+      verdict = "not chosen: ranks below " + best.name + " (a " + deviceTypeName(best.type) +
+                "; the order is discrete, integrated, virtual, CPU, then more device memory)";
+    }
+    choice.verdicts.push_back(verdict);
+  }
+  return choice;
+}
+
+}  // namespace snell::vk

@@ -1,0 +1,27 @@
+// The fixture every GPU test uses: one Vulkan context per test process on the
+// device snell would pick (lavapipe in CI), with the Khronos validation layer
+// and synchronization validation on. Any validation message fails the test.
+#pragma once
+
+#include "vk/context.h"
+
+#include <gtest/gtest.h>
+
+#include <cstdint>
+
+namespace snell::test {
+
+/// The shared context; created on first use, with validation required.
+vk::Context& gpuContext();
+
+class GpuTest : public ::testing::Test {
+ protected:
+  void SetUp() override;
+  void TearDown() override;
+  vk::Context& context() { return gpuContext(); }
+
+ private:
+  uint64_t messagesBefore_ = 0;
+};
+
+}  // namespace snell::test
