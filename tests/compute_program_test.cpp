@@ -54,7 +54,13 @@ TEST_F(ComputeProgramTest, DispatchThreadsCoversExactlyTheCountGiven) {
 
 TEST_F(ComputeProgramTest, DispatchBeyondTheXLimitIsSplitOverY) {
   vk::ComputeProgram program(context(), fillDesc(8));
-  uint64_t groups = uint64_t(context().caps().maxComputeWorkgroupCount[0]) + 100;
+  uint64_t limit = context().caps().maxComputeWorkgroupCount[0];
+  if (limit > (1u << 20)) {
+    // NVIDIA allows 2^31 - 1 groups along x: exceeding that would need 64 GiB.
+    // CI's lavapipe allows 65535, so CI always runs this test.
+    GTEST_SKIP() << "this device's x limit (" << limit << " groups) is too large to exceed in a test";
+  }
+  uint64_t groups = limit + 100;
   uint64_t count = groups * 8;
   vk::Buffer out(context(), {count * 4, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT,
                              vk::MemoryDomain::Device, "wide fill"});

@@ -3,6 +3,7 @@
 // histogram gives every (digit, block) its first output position.
 #version 460
 #extension GL_GOOGLE_include_directive : require
+#extension GL_EXT_control_flow_attributes : require
 #include "../shared/radix_sort.h"
 
 layout(local_size_x_id = kSortSpecWorkgroupSize) in;
@@ -24,9 +25,9 @@ void main() {
   for (uint d = r; d < kSortRadix; d += gl_WorkGroupSize.x) sCount[d] = 0;
   barrier();
   uint tile = gl_WorkGroupSize.x * KEYS_PER_THREAD;
-  uint word = pc.shift >> 5;
+  uint word = KEY_WORDS == 1u ? 0u : (pc.shift >> 5);
   uint bit = pc.shift & 31u;
-  for (uint i = 0; i < KEYS_PER_THREAD; ++i) {
+  [[unroll]] for (uint i = 0; i < KEYS_PER_THREAD; ++i) {
     uint index = block * tile + i * gl_WorkGroupSize.x + r;
     // Past the end every key reads as all ones: padding sorts last in every pass,
     // which lands it beyond `count` where the scatter drops it.

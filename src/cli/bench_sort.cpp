@@ -12,6 +12,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
+#include <map>
 #include <numeric>
 #include <random>
 #include <stdexcept>
@@ -26,25 +27,30 @@ struct Options {
   unsigned minLog = 16;
   unsigned maxLog = 24;
   unsigned runs = 20;
-  unsigned warmup = 3;
+  unsigned warmup = 10;
   std::vector<unsigned> keyBits = {32, 64};
   std::string json;
+  bool breakdown = false;
+  bool pipelineStats = false;
   render::RadixSortTuning tuning;
 };
 
 constexpr const char* kHelp = R"(usage: snell bench sort [options]
 
 Sorts random key-value pairs (32-bit values) on the GPU and prints pairs per
-second from GPU timestamps: the median over --runs runs after --warmup runs.
+second from GPU timestamps: the median over --runs back-to-back runs, after a
+submission of --warmup runs.
 Each size is checked against std::sort before it is reported.
 
 options:
   --min-log N          smallest size, 2^N pairs (default 16)
   --max-log N          largest size, 2^N pairs (default 24)
-  --runs N             timed runs per size, at least 10 (default 20)
-  --warmup N           untimed runs first (default 3)
+  --runs N             timed runs per size, 10 to 100 (default 20)
+  --warmup N           untimed runs first, in their own submission (default 10)
   --keys 32|64|both    key width (default both)
   --json FILE          also write the results as JSON
+  --breakdown          also time each step (histogram, scan, scatter) separately
+  --pipeline-stats     print the driver's statistics of each program (registers, spills)
   --workgroup N        override the workgroup size (tuning)
   --keys-per-thread N  override keys per invocation (tuning)
 )";
@@ -56,6 +62,14 @@ Options parse(const Args& args) {
     if (a == "--help" || a == "-h") {
       std::fputs(kHelp, stdout);
       std::exit(0);
+    }
+    if (a == "--breakdown") {
+      o.breakdown = true;
+      continue;
+    }
+    if (a == "--pipeline-stats") {
+      o.pipelineStats = true;
+      continue;
     }
     if (i + 1 >= args.size()) throw UsageError{"bench sort: " + a + " needs a value (or is unknown)"};
     const std::string& v = args[++i];
@@ -76,7 +90,7 @@ Options parse(const Args& args) {
     }
   }
   if (o.minLog > o.maxLog || o.maxLog > 30) throw UsageError{"bench sort: need --min-log <= --max-log <= 30"};
-  if (o.runs < 10) throw UsageError{"bench sort: --runs must be at least 10 for a meaningful median"};
+  if (o.runs < 10 || o.runs > 100) throw UsageError{"bench sort: --runs must be 10 to 100"};
   return o;
 }
 
@@ -85,10 +99,12 @@ struct Row {
   unsigned keyBits;
   double medianMs, minMs, maxMs;
   bool correct;
+  uint32_t workgroup = 0, keysPerThread = 0;
+  const char* ranking = "";
 };
 
 template <typename Key>
-Row measure(vk::Context& context, const render::RadixSort& sort, uint64_t count, const Options& o) {
+Row measure(vk::Context& context, render::RadixSort& sort, uint64_t count, const Options& o) {
   std::mt19937_64 random(count * 131 + sizeof(Key));
   std::vector<Key> keys(count);
   for (Key& k : keys) k = static_cast<Key>(random());
@@ -106,20 +122,60 @@ Row measure(vk::Context& context, const render::RadixSort& sort, uint64_t count,
   render::RadixSort::Scratch scratch = sort.makeScratch(count);
 
   vk::Commands commands(context, "bench sort");
-  std::vector<double> times;
-  for (unsigned run = 0; run < o.warmup + o.runs; ++run) {
+  // Every run sorts the same unsorted input (sorted input would flatter the
+  // scatter). Runs go back to back in one submission, so the GPU never idles
+  // between them and its clocks settle during the warm-up submission.
+  auto recordRuns = [&](unsigned runs, bool timed) {
     commands.begin();
-    // Every run sorts the same unsorted input: sorted input would flatter the scatter.
-    commands.copyBuffer(pristineKeys, workKeys, count * sizeof(Key));
-    commands.copyBuffer(pristineValues, workValues, count * 4);
-    commands.transferToCompute();
-    commands.beginPass("sort");
-    sort.record(commands, workKeys, workValues, count, scratch);
-    commands.endPass();
+    for (unsigned run = 0; run < runs; ++run) {
+      commands.copyBuffer(pristineKeys, workKeys, count * sizeof(Key));
+      commands.copyBuffer(pristineValues, workValues, count * 4);
+      commands.transferToCompute();
+      if (timed) commands.beginPass("sort");
+      sort.record(commands, workKeys, workValues, count, scratch);
+      if (timed) commands.endPass();
+      commands.computeToTransfer();
+    }
     commands.submitAndWait();
-    if (run >= o.warmup && !commands.passTimes().empty()) times.push_back(commands.passTimes()[0].milliseconds);
+  };
+  recordRuns(o.warmup, false);
+  recordRuns(o.runs, true);
+  std::vector<double> times;
+  for (const vk::PassTime& t : commands.passTimes()) times.push_back(t.milliseconds);
+  if (times.size() != o.runs) throw std::runtime_error("this device's queue has no timestamps; cannot time the sort");
+
+  if (o.breakdown) {
+    // Separate runs: per-step timestamps add gaps the headline figure must not
+    // carry. Each sort stamps 3 steps per pass; a submission holds 128 stamps.
+    std::map<std::string, std::vector<double>> steps;
+    sort.setStepTiming(true);
+    unsigned stepsPerSort = 3 * ((static_cast<unsigned>(sizeof(Key)) * 8 + 7) / 8);
+    unsigned batch = std::max(1u, 128 / stepsPerSort);
+    for (unsigned done = 0; done < o.runs; done += batch) {
+      commands.begin();
+      for (unsigned run = 0; run < batch; ++run) {
+        commands.copyBuffer(pristineKeys, workKeys, count * sizeof(Key));
+        commands.copyBuffer(pristineValues, workValues, count * 4);
+        commands.transferToCompute();
+        sort.record(commands, workKeys, workValues, count, scratch);
+        commands.computeToTransfer();
+      }
+      commands.submitAndWait();
+      const std::vector<vk::PassTime>& stamps = commands.passTimes();
+      for (size_t first = 0; first + stepsPerSort <= stamps.size(); first += stepsPerSort) {
+        std::map<std::string, double> sums;
+        for (size_t i = first; i < first + stepsPerSort; ++i) sums[stamps[i].name] += stamps[i].milliseconds;
+        for (auto& [name, ms] : sums) steps[name].push_back(ms);
+      }
+    }
+    sort.setStepTiming(false);
+    std::printf("%12s", "  steps:");
+    for (auto& [name, ms] : steps) {
+      std::sort(ms.begin(), ms.end());
+      std::printf("  %s %.4f ms", name.c_str(), ms[ms.size() / 2]);
+    }
+    std::printf("  (medians, all passes)\n");
   }
-  if (times.empty()) throw std::runtime_error("this device's queue has no timestamps; cannot time the sort");
 
   std::vector<Key> gotKeys(count);
   std::vector<uint32_t> gotValues(count);
@@ -144,6 +200,7 @@ int runBenchSort(const Args& args) {
   Options o = parse(args);
   vk::ContextDesc desc;
   desc.validation = std::getenv("SNELL_VALIDATION") && std::string(std::getenv("SNELL_VALIDATION")) == "1";
+  desc.pipelineStatistics = o.pipelineStats;
   auto context = vk::Context::create(desc);
   const vk::DeviceFacts& device = context->facts();
   std::printf("device: %s (%s %s), Vulkan %s\n", device.name.c_str(), device.driverName.c_str(),
@@ -151,12 +208,13 @@ int runBenchSort(const Args& args) {
 
   std::vector<Row> rows;
   bool allCorrect = true;
-  uint32_t workgroup = 0, keysPerThread = 0;
   std::printf("%12s %5s %11s %11s %11s %13s %8s\n", "pairs", "bits", "median ms", "min ms", "max ms", "Gpairs/s", "correct");
   for (unsigned bits : o.keyBits) {
     render::RadixSort sort(*context, bits == 64 ? render::KeyWidth::Bits64 : render::KeyWidth::Bits32, o.tuning);
-    workgroup = sort.workgroupSize();
-    keysPerThread = sort.keysPerThread();
+    std::printf("%u-bit keys: workgroup %u x %u keys\n", bits, sort.workgroupSize(), sort.keysPerThread());
+    if (o.pipelineStats) {
+      for (const std::string& line : sort.statistics()) std::printf("  %s\n", line.c_str());
+    }
     for (unsigned log = o.minLog; log <= o.maxLog; ++log) {
       uint64_t count = uint64_t(1) << log;
       if (count > sort.maxCount()) {
@@ -166,6 +224,9 @@ int runBenchSort(const Args& args) {
       }
       Row row = bits == 64 ? measure<uint64_t>(*context, sort, count, o) : measure<uint32_t>(*context, sort, count, o);
       allCorrect = allCorrect && row.correct;
+      row.workgroup = sort.workgroupSize();
+      row.keysPerThread = sort.keysPerThread();
+      row.ranking = "ballots";
       std::printf("%12llu %5u %11.4f %11.4f %11.4f %13.3f %8s\n", (unsigned long long)row.pairs, row.keyBits, row.medianMs,
                   row.minMs, row.maxMs, static_cast<double>(row.pairs) / (row.medianMs * 1e6), row.correct ? "yes" : "NO");
       std::fflush(stdout);
@@ -180,13 +241,14 @@ int runBenchSort(const Args& args) {
       if (!out) throw std::runtime_error("cannot write " + temporary);
       out << "{\n  \"benchmark\": \"sort\",\n  \"device\": \"" << device.name << "\",\n  \"driver\": \"" << device.driverName
           << " " << device.driverInfo << "\",\n  \"vulkan\": \"" << vk::versionString(device.apiVersion)
-          << "\",\n  \"workgroup_size\": " << workgroup << ",\n  \"keys_per_thread\": " << keysPerThread
-          << ",\n  \"runs\": " << o.runs << ",\n  \"warmup\": " << o.warmup << ",\n  \"results\": [\n";
+          << "\",\n  \"runs\": " << o.runs << ",\n  \"warmup\": " << o.warmup << ",\n  \"results\": [\n";
       for (size_t i = 0; i < rows.size(); ++i) {
         const Row& r = rows[i];
         out << "    {\"pairs\": " << r.pairs << ", \"key_bits\": " << r.keyBits << ", \"median_ms\": " << r.medianMs
             << ", \"min_ms\": " << r.minMs << ", \"max_ms\": " << r.maxMs
             << ", \"gpairs_per_s\": " << static_cast<double>(r.pairs) / (r.medianMs * 1e6) << ", \"correct\": " << (r.correct ? "true" : "false")
+            << ", \"workgroup_size\": " << r.workgroup << ", \"keys_per_thread\": " << r.keysPerThread
+            << ", \"ranking\": \"" << r.ranking << "\""
             << "}" << (i + 1 < rows.size() ? "," : "") << "\n";
       }
       out << "  ]\n}\n";

@@ -13,12 +13,14 @@ namespace snell::render {
 
 namespace {
 
-uint32_t sharedBytes(uint32_t workgroup, uint32_t keysPerThread, uint32_t minSubgroup) {
+uint32_t sharedBytes(uint32_t workgroup, uint32_t keysPerThread, uint32_t minSubgroup, KeyWidth width) {
   uint32_t subgroups = workgroup / minSubgroup;
-  return 4 * (subgroups * gpu::kSortRadix   // per-subgroup digit counters
-              + 2 * gpu::kSortRadix         // digit starts and outputs
-              + workgroup * keysPerThread   // the exchange tile
-              + subgroups + 1);             // the workgroup scan's partial sums
+  uint32_t keyWords = static_cast<uint32_t>(width);
+  uint32_t tile = workgroup * keysPerThread;
+  return 4 * (subgroups * gpu::kSortRadix       // per-subgroup digit counters
+              + 2 * gpu::kSortRadix             // digit starts and shifts
+              + tile * (keyWords + 1) + 1       // staged keys and values
+              + subgroups + 1);                 // the workgroup scan's partial sums
 }
 
 }  // namespace
@@ -34,7 +36,7 @@ RadixSort::RadixSort(vk::Context& context, KeyWidth width, RadixSortTuning tunin
     for (uint32_t preferred : {256u, 128u, 64u}) {
       uint32_t w = fullSubgroupWorkgroupSize(caps, preferred);
       uint32_t k = keysPerThread_ ? keysPerThread_ : 8u;
-      if (sharedBytes(w, k, caps.minSubgroupSize) <= caps.maxComputeSharedMemoryBytes) {
+      if (sharedBytes(w, k, caps.minSubgroupSize, width) <= caps.maxComputeSharedMemoryBytes) {
         workgroupSize_ = w;
         break;
       }
@@ -43,15 +45,19 @@ RadixSort::RadixSort(vk::Context& context, KeyWidth width, RadixSortTuning tunin
   if (!keysPerThread_) {
     keysPerThread_ = 1;
     for (uint32_t k : {16u, 12u, 8u, 4u, 2u}) {
-      if (workgroupSize_ && sharedBytes(workgroupSize_, k, caps.minSubgroupSize) <= caps.maxComputeSharedMemoryBytes) {
+      if (workgroupSize_ && sharedBytes(workgroupSize_, k, caps.minSubgroupSize, width) <= caps.maxComputeSharedMemoryBytes) {
         keysPerThread_ = k;
         break;
       }
     }
   }
-  if (!workgroupSize_ || sharedBytes(workgroupSize_, keysPerThread_, caps.minSubgroupSize) > caps.maxComputeSharedMemoryBytes) {
+  if (!workgroupSize_ || sharedBytes(workgroupSize_, keysPerThread_, caps.minSubgroupSize, width) > caps.maxComputeSharedMemoryBytes) {
     throw vk::VulkanError("the radix sort does not fit in " + std::to_string(caps.maxComputeSharedMemoryBytes) +
                           " bytes of shared memory");
+  }
+  if (uint64_t(workgroupSize_) * keysPerThread_ > 65536) {
+    throw vk::VulkanError("radix sort tiles hold at most 65536 keys (ranks are 16-bit); asked for " +
+                          std::to_string(workgroupSize_) + " x " + std::to_string(keysPerThread_));
   }
   std::vector<vk::SpecConstant> spec = {
       {gpu::kSortSpecWorkgroupSize, workgroupSize_},
@@ -61,6 +67,14 @@ RadixSort::RadixSort(vk::Context& context, KeyWidth width, RadixSortTuning tunin
   };
   histogram_ = std::make_unique<vk::ComputeProgram>(context, vk::ComputeProgramDesc{"sort_histogram", kSpvSortHistogram, spec, true});
   scatter_ = std::make_unique<vk::ComputeProgram>(context, vk::ComputeProgramDesc{"sort_scatter", kSpvSortScatter, spec, true});
+}
+
+std::vector<std::string> RadixSort::statistics() const {
+  std::vector<std::string> lines;
+  for (const vk::ComputeProgram* program : {histogram_.get(), scatter_.get()}) {
+    for (const std::string& line : program->statistics()) lines.push_back(program->name() + ": " + line);
+  }
+  return lines;
 }
 
 uint64_t RadixSort::maxCount() const {
@@ -114,12 +128,15 @@ void RadixSort::record(vk::Commands& commands, const vk::Buffer& keys, const vk:
   const vk::Buffer* valuesOut = &scratch.values;
   for (uint32_t pass = 0; pass < passes; ++pass) {
     gpu::SortPush push{static_cast<uint32_t>(count), blocks, pass * gpu::kSortRadixBits, 0};
+    if (stepTiming_) commands.beginPass("histogram");
     histogram_->dispatchGroups(commands,
                                {{gpu::kSortBindingKeysIn, keysIn}, {gpu::kSortBindingHistogram, &scratch.histogram}},
                                push, blocks);
     commands.computeToCompute();
+    if (stepTiming_) commands.beginPass("scan");
     scan_.record(commands, scratch.histogram, uint64_t(blocks) * gpu::kSortRadix, scratch.scan);
     commands.computeToCompute();
+    if (stepTiming_) commands.beginPass("scatter");
     scatter_->dispatchGroups(commands,
                              {{gpu::kSortBindingKeysIn, keysIn},
                               {gpu::kSortBindingKeysOut, keysOut},
@@ -128,6 +145,7 @@ void RadixSort::record(vk::Commands& commands, const vk::Buffer& keys, const vk:
                               {gpu::kSortBindingHistogram, &scratch.histogram}},
                              push, blocks);
     commands.computeToCompute();
+    if (stepTiming_) commands.endPass();
     std::swap(keysIn, keysOut);
     std::swap(valuesIn, valuesOut);
   }

@@ -13,6 +13,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <string>
 #include <vector>
 
 namespace snell::render {
@@ -50,10 +51,16 @@ class RadixSort {
     record(commands, keys, values, count, scratch, 32u * static_cast<uint32_t>(width_));
   }
 
+  /// Times each step (histogram, scan, scatter) as its own pass; the caller
+  /// must then not wrap record() in a pass of its own. For benchmarks.
+  void setStepTiming(bool on) { stepTiming_ = on; }
+
   KeyWidth width() const { return width_; }
   uint32_t tileSize() const { return workgroupSize_ * keysPerThread_; }
   uint32_t workgroupSize() const { return workgroupSize_; }
   uint32_t keysPerThread() const { return keysPerThread_; }
+  /// The driver's statistics of each program, where the context captures them.
+  std::vector<std::string> statistics() const;
   /// The most pairs this device can sort (its storage-buffer range bounds it).
   uint64_t maxCount() const;
 
@@ -62,6 +69,7 @@ class RadixSort {
   KeyWidth width_;
   uint32_t workgroupSize_ = 0;
   uint32_t keysPerThread_ = 0;
+  bool stepTiming_ = false;
   PrefixSum scan_;
   std::unique_ptr<vk::ComputeProgram> histogram_;
   std::unique_ptr<vk::ComputeProgram> scatter_;

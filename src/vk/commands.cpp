@@ -171,7 +171,9 @@ void Commands::fillBuffer(const Buffer& buffer, uint32_t word) {
 void Commands::beginPass(const std::string& name) {
   if (passOpen_) endPass();
   if (!queries_ || queryCount_ + 2 > kMaxTimestamps) return;
-  vkCmdWriteTimestamp(buffer_, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, queries_, queryCount_++);
+  // BOTTOM_OF_PIPE waits for every earlier command: a TOP_OF_PIPE stamp would
+  // start the clock while earlier copies still run and charge them to this pass.
+  vkCmdWriteTimestamp(buffer_, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, queries_, queryCount_++);
   passNames_.push_back(name);
   passOpen_ = true;
 }

@@ -57,7 +57,8 @@ class Commands {
                   VkDeviceSize toOffset = 0);
   void fillBuffer(const Buffer& buffer, uint32_t word);
 
-  /// Starts timing a pass; passes do not nest. No-op where the queue has no timestamps.
+  /// Starts timing a pass once every earlier command has finished; passes do
+  /// not nest; at most 128 per submission. No-op where the queue has no timestamps.
   void beginPass(const std::string& name);
   void endPass();
   /// The timings of the last completed submission, in recording order.

@@ -70,6 +70,7 @@ ComputeProgram::ComputeProgram(Context& context, const ComputeProgramDesc& desc)
   stage.pName = "main";
   stage.pSpecializationInfo = entries.empty() ? nullptr : &specInfo;
   VkComputePipelineCreateInfo pipelineInfo{VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO};
+  if (caps.pipelineStatistics) pipelineInfo.flags = VK_PIPELINE_CREATE_CAPTURE_STATISTICS_BIT_KHR;
   pipelineInfo.stage = stage;
   pipelineInfo.layout = pipelineLayout_;
   VK_CHECK(vkCreateComputePipelines(device, VK_NULL_HANDLE, 1, &pipelineInfo, nullptr, &pipeline_));
@@ -88,6 +89,42 @@ ComputeProgram::~ComputeProgram() {
     vkDestroyDescriptorSetLayout(device, setLayout, nullptr);
     vkDestroyShaderModule(device, module, nullptr);
   });
+}
+
+std::vector<std::string> ComputeProgram::statistics() const {
+  std::vector<std::string> lines;
+  if (!context_->caps().pipelineStatistics) return lines;
+  VkDevice device = context_->device();
+  auto getProperties = reinterpret_cast<PFN_vkGetPipelineExecutablePropertiesKHR>(
+      vkGetDeviceProcAddr(device, "vkGetPipelineExecutablePropertiesKHR"));
+  auto getStatistics = reinterpret_cast<PFN_vkGetPipelineExecutableStatisticsKHR>(
+      vkGetDeviceProcAddr(device, "vkGetPipelineExecutableStatisticsKHR"));
+  if (!getProperties || !getStatistics) return lines;
+  VkPipelineInfoKHR pipelineInfo{VK_STRUCTURE_TYPE_PIPELINE_INFO_KHR};
+  pipelineInfo.pipeline = pipeline_;
+  uint32_t executables = 0;
+  VK_CHECK(getProperties(device, &pipelineInfo, &executables, nullptr));
+  for (uint32_t e = 0; e < executables; ++e) {
+    VkPipelineExecutableInfoKHR executable{VK_STRUCTURE_TYPE_PIPELINE_EXECUTABLE_INFO_KHR};
+    executable.pipeline = pipeline_;
+    executable.executableIndex = e;
+    uint32_t count = 0;
+    VK_CHECK(getStatistics(device, &executable, &count, nullptr));
+    std::vector<VkPipelineExecutableStatisticKHR> stats(count, {VK_STRUCTURE_TYPE_PIPELINE_EXECUTABLE_STATISTIC_KHR});
+    VK_CHECK(getStatistics(device, &executable, &count, stats.data()));
+    for (const VkPipelineExecutableStatisticKHR& s : stats) {
+      std::string value;
+      switch (s.format) {
+        case VK_PIPELINE_EXECUTABLE_STATISTIC_FORMAT_BOOL32_KHR: value = s.value.b32 ? "true" : "false"; break;
+        case VK_PIPELINE_EXECUTABLE_STATISTIC_FORMAT_INT64_KHR: value = std::to_string(s.value.i64); break;
+        case VK_PIPELINE_EXECUTABLE_STATISTIC_FORMAT_UINT64_KHR: value = std::to_string(s.value.u64); break;
+        case VK_PIPELINE_EXECUTABLE_STATISTIC_FORMAT_FLOAT64_KHR: value = std::to_string(s.value.f64); break;
+        default: value = "?";
+      }
+      lines.push_back(std::string(s.name) + " = " + value);
+    }
+  }
+  return lines;
 }
 
 void ComputeProgram::record(Commands& commands, std::initializer_list<BufferBinding> buffers, const void* push,

@@ -44,6 +44,9 @@ class ComputeProgram {
   const std::string& name() const { return name_; }
   std::array<uint32_t, 3> localSize() const { return reflection_.localSize; }
   const ShaderReflection& reflection() const { return reflection_; }
+  /// "name = value" lines the driver reports for this pipeline (registers,
+  /// spills, ...); empty unless the context captures pipeline statistics.
+  std::vector<std::string> statistics() const;
 
   /// Dispatches enough workgroups to cover `threads` invocations along x.
   template <typename Push>

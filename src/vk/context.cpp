@@ -148,6 +148,7 @@ std::unique_ptr<Context> Context::create(const ContextDesc& desc) {
   bool debugUtils = false;
   c.instance_ = createInstance({desc.applicationName, desc.validation, desc.synchronizationValidation}, debugUtils);
   c.validation_ = desc.validation;
+  c.pipelineStatisticsRequested_ = desc.pipelineStatistics;
 
   if (debugUtils) {
     auto createMessenger = reinterpret_cast<PFN_vkCreateDebugUtilsMessengerEXT>(
@@ -186,10 +187,21 @@ std::unique_ptr<Context> Context::create(const ContextDesc& desc) {
   features13.maintenance4 = VK_TRUE;
   VkPhysicalDeviceFeatures2 features{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2, &features13};
 
+  std::vector<const char*> extensions;
+  VkPhysicalDevicePipelineExecutablePropertiesFeaturesKHR executableInfo{
+      VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PIPELINE_EXECUTABLE_PROPERTIES_FEATURES_KHR};
+  if (desc.pipelineStatistics && chosen.pipelineStatistics) {
+    extensions.push_back(VK_KHR_PIPELINE_EXECUTABLE_PROPERTIES_EXTENSION_NAME);
+    executableInfo.pipelineExecutableInfo = VK_TRUE;
+    features13.pNext = &executableInfo;
+  }
+
   VkDeviceCreateInfo info{VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO};
   info.pNext = &features;
   info.queueCreateInfoCount = 1;
   info.pQueueCreateInfos = &queueInfo;
+  info.enabledExtensionCount = static_cast<uint32_t>(extensions.size());
+  info.ppEnabledExtensionNames = extensions.data();
   VK_CHECK(vkCreateDevice(physical, &info, nullptr, &c.device_));
   c.queueFamily_ = chosen.computeQueueFamily;
   vkGetDeviceQueue(c.device_, c.queueFamily_, 0, &c.queue_);
@@ -229,6 +241,7 @@ std::unique_ptr<Context> Context::adopt(const AdoptedDevice& host) {
   c.queue_ = host.queue;
   c.queueFamily_ = host.queueFamily;
   facts.computeQueueFamily = host.queueFamily;
+  facts.pipelineStatistics = false;  // we cannot know whether the host enabled the extension
   // Present only if the host enabled VK_EXT_debug_utils; otherwise names are skipped.
   c.setObjectName_ = reinterpret_cast<PFN_vkSetDebugUtilsObjectNameEXT>(
       vkGetInstanceProcAddr(host.instance, "vkSetDebugUtilsObjectNameEXT"));
@@ -254,6 +267,7 @@ void Context::initialise(VkPhysicalDevice physicalDevice, const DeviceFacts& fac
   caps_.maxMemoryAllocationSize = maintenance3.maxMemoryAllocationSize;
   caps_.maxPushConstantsSize = limits.maxPushConstantsSize;
   caps_.timestampPeriodNs = limits.timestampPeriod;
+  caps_.pipelineStatistics = owned_ && facts.pipelineStatistics && pipelineStatisticsRequested_;
 
   uint32_t familyCount = 0;
   vkGetPhysicalDeviceQueueFamilyProperties(physicalDevice, &familyCount, nullptr);

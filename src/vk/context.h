@@ -25,6 +25,8 @@ struct ContextDesc {
   bool synchronizationValidation = false;
   /// An index or a name substring; empty means use the SNELL_DEVICE variable.
   std::string deviceOverride;
+  /// Ask the driver for per-pipeline statistics where it offers them.
+  bool pipelineStatistics = false;
 };
 
 /// Handles a host application created; snell uses them and never destroys them.
@@ -52,6 +54,8 @@ struct DeviceCaps {
   uint32_t maxPushConstantsSize = 0;
   float timestampPeriodNs = 0;  ///< nanoseconds per timestamp tick
   uint32_t timestampValidBits = 0;  ///< 0: the queue cannot time passes
+  /// Pipelines capture the driver's statistics (ComputeProgram::statistics).
+  bool pipelineStatistics = false;
 };
 
 /// Every devices' facts and the verdict on each, without creating a device.
@@ -129,6 +133,7 @@ class Context {
   uint32_t queueFamily_ = 0;
   bool owned_ = false;
   bool validation_ = false;
+  bool pipelineStatisticsRequested_ = false;
   DeviceFacts facts_;
   DeviceCaps caps_;
   VkPhysicalDeviceMemoryProperties memory_{};

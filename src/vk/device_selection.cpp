@@ -4,6 +4,9 @@
 #include <algorithm>
 #include <cctype>
 #include <charconv>
+#include <cstring>
+
+#include "vk/error.h"
 #include <sstream>
 
 namespace snell::vk {
@@ -112,6 +115,13 @@ DeviceFacts readDeviceFacts(VkPhysicalDevice device, uint32_t index) {
   if (!features13.computeFullSubgroups) facts.unmet.push_back("feature computeFullSubgroups is missing");
   // glslang writes a specialised workgroup size as LocalSizeId, which needs maintenance4.
   if (!features13.maintenance4) facts.unmet.push_back("feature maintenance4 is missing");
+  uint32_t extensionCount = 0;
+  VK_CHECK(vkEnumerateDeviceExtensionProperties(device, nullptr, &extensionCount, nullptr));
+  std::vector<VkExtensionProperties> extensions(extensionCount);
+  VK_CHECK(vkEnumerateDeviceExtensionProperties(device, nullptr, &extensionCount, extensions.data()));
+  facts.pipelineStatistics = std::any_of(extensions.begin(), extensions.end(), [](const VkExtensionProperties& e) {
+    return std::strcmp(e.extensionName, VK_KHR_PIPELINE_EXECUTABLE_PROPERTIES_EXTENSION_NAME) == 0;
+  });
   if (props13.maxSubgroupSize > 128) {
     facts.unmet.push_back("subgroups of " + std::to_string(props13.maxSubgroupSize) + " lanes exceed the 128 snell's ballots hold");
   }

@@ -27,6 +27,9 @@ struct DeviceFacts {
   uint32_t maxSubgroupSize = 0;
   uint64_t deviceLocalBytes = 0;  ///< sum of the DEVICE_LOCAL heaps
   uint32_t computeQueueFamily = UINT32_MAX;
+  /// VK_KHR_pipeline_executable_properties: the driver reports per-pipeline
+  /// statistics (registers, spills), which benchmarks print.
+  bool pipelineStatistics = false;
   /// Requirements this device does not meet, in words; empty when it qualifies.
   std::vector<std::string> unmet;
 };

@@ -10,6 +10,7 @@
 #extension GL_KHR_shader_subgroup_basic : require
 #extension GL_KHR_shader_subgroup_arithmetic : require
 #extension GL_KHR_shader_subgroup_ballot : require
+#extension GL_KHR_memory_scope_semantics : require
 
 shared uint sSubgroupSums[MAX_SUBGROUPS];
 shared uint sWorkgroupTotal;
@@ -23,6 +24,13 @@ uint scanOrderIndex() {
 // many devices; this flattens them back into one block number.
 uint blockIndex() {
   return gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x;
+}
+
+// Execution barrier for the subgroup that orders its shared-memory accesses
+// only. GLSL's subgroupBarrier() also orders global memory, which NVIDIA's
+// compiler turns into a fence that waits for every outstanding load and store.
+void subgroupSharedBarrier() {
+  controlBarrier(gl_ScopeSubgroup, gl_ScopeSubgroup, gl_StorageSemanticsShared, gl_SemanticsAcquireRelease);
 }
 
 // Exclusive prefix sum of one value per invocation, in scanOrderIndex() order.
