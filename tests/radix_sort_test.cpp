@@ -53,8 +53,9 @@ std::vector<Key> makeKeys(size_t n, Pattern pattern, uint64_t seed) {
 
 /// Sorts on the GPU by the low `keyBits` bits; returns keys and values.
 template <typename Key>
-void gpuSort(vk::Context& context, std::vector<Key>& keys, std::vector<uint32_t>& values, uint32_t keyBits) {
-  render::RadixSort sort(context, sizeof(Key) == 8 ? render::KeyWidth::Bits64 : render::KeyWidth::Bits32);
+void gpuSort(vk::Context& context, std::vector<Key>& keys, std::vector<uint32_t>& values, uint32_t keyBits,
+             render::RadixSortTuning tuning = {}) {
+  render::RadixSort sort(context, sizeof(Key) == 8 ? render::KeyWidth::Bits64 : render::KeyWidth::Bits32, tuning);
   const VkBufferUsageFlags usage =
       VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT;
   vk::Buffer keyBuffer(context, {keys.size() * sizeof(Key), usage, vk::MemoryDomain::Device, "test keys"});
@@ -72,7 +73,8 @@ void gpuSort(vk::Context& context, std::vector<Key>& keys, std::vector<uint32_t>
 }
 
 template <typename Key>
-void expectMatchesStableSort(vk::Context& context, std::vector<Key> keys, uint32_t keyBits) {
+void expectMatchesStableSort(vk::Context& context, std::vector<Key> keys, uint32_t keyBits,
+                             render::RadixSortTuning tuning = {}) {
   std::vector<uint32_t> values(keys.size());
   std::iota(values.begin(), values.end(), 0u);
   const Key mask = keyBits >= sizeof(Key) * 8 ? Key(~Key(0)) : Key((Key(1) << keyBits) - 1);
@@ -80,7 +82,7 @@ void expectMatchesStableSort(vk::Context& context, std::vector<Key> keys, uint32
   for (size_t i = 0; i < keys.size(); ++i) expected[i] = {keys[i], values[i]};
   std::stable_sort(expected.begin(), expected.end(),
                    [&](const auto& a, const auto& b) { return (a.first & mask) < (b.first & mask); });
-  gpuSort(context, keys, values, keyBits);
+  gpuSort(context, keys, values, keyBits, tuning);
   for (size_t i = 0; i < keys.size(); ++i) {
     ASSERT_EQ(keys[i], expected[i].first) << "first key mismatch at " << i << " of " << keys.size();
     ASSERT_EQ(values[i], expected[i].second) << "first value mismatch (stability) at " << i << " of " << keys.size();
@@ -132,6 +134,17 @@ TEST_F(RadixSortTest, SameInputGivesTheSameOutputBitForBit) {
   gpuSort(context(), keysB, valuesB, 32);
   EXPECT_EQ(keysA, keysB);
   EXPECT_EQ(valuesA, valuesB);
+}
+
+TEST_F(RadixSortTest, EveryWorkgroupShapeSortsTheSame) {
+  // The defaults differ per device (512 x 12 on an H200, 128 x 12 here); other
+  // shapes exercise several digits per invocation and ragged last tiles.
+  for (auto [workgroup, keysPerThread] : {std::pair{64u, 4u}, {64u, 7u}, {128u, 3u}, {128u, 13u}}) {
+    SCOPED_TRACE("workgroup " + std::to_string(workgroup) + " x " + std::to_string(keysPerThread));
+    render::RadixSortTuning tuning{workgroup, keysPerThread};
+    expectMatchesStableSort(context(), makeKeys<uint32_t>(30011, Pattern::FewDistinct, workgroup), 32, tuning);
+    expectMatchesStableSort(context(), makeKeys<uint64_t>(30011, Pattern::Random, keysPerThread), 64, tuning);
+  }
 }
 
 TEST_F(RadixSortTest, ZeroKeyBitsIsRefused) {

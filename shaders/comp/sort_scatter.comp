@@ -20,23 +20,37 @@ layout(constant_id = kSortSpecKeyWords) const uint KEY_WORDS = 1;
 #include "common/workgroup.glsl"
 
 layout(push_constant) uniform Push { SortPush pc; };
+// 64-bit keys are also read and written as uvec2 through a second view of the
+// same binding: one 8-byte access instead of two 4-byte ones.
 layout(std430, binding = kSortBindingKeysIn) readonly buffer KeysIn { uint keysIn[]; };
+layout(std430, binding = kSortBindingKeysIn) readonly buffer KeysIn64 { uvec2 keysIn64[]; };
 layout(std430, binding = kSortBindingKeysOut) writeonly buffer KeysOut { uint keysOut[]; };
+layout(std430, binding = kSortBindingKeysOut) writeonly buffer KeysOut64 { uvec2 keysOut64[]; };
 layout(std430, binding = kSortBindingValuesIn) readonly buffer ValuesIn { uint valuesIn[]; };
 layout(std430, binding = kSortBindingValuesOut) writeonly buffer ValuesOut { uint valuesOut[]; };
 layout(std430, binding = kSortBindingHistogram) readonly buffer Histogram { uint histogram[]; };
 
 const uint kTile = gl_WorkGroupSize.x * KEYS_PER_THREAD;
+const uint kDigitsPerInvocation = (kSortRadix + gl_WorkGroupSize.x - 1u) / gl_WorkGroupSize.x;
 shared uint sSubgroupDigits[MAX_SUBGROUPS * kSortRadix];  // [subgroup][digit] counts, then offsets
 shared uint sDigitStart[kSortRadix];  // first tile-local position of each digit
 shared uint sDigitShift[kSortRadix];  // output position minus tile-local position, per digit (wraps)
-// Keys and values staged in digit order. The high words exist only for 64-bit keys.
-shared uint sKeysLo[kTile];
-shared uint sKeysHi[(KEY_WORDS - 1u) * kTile + 1u];
-shared uint sValues[kTile];
+// Keys, then values, staged in digit order through one buffer; the high words
+// of 64-bit keys have their own.
+shared uint sStaged[kTile];
+shared uint sStagedHi[(KEY_WORDS - 1u) * kTile + 1u];
 
 uint popcount4(uvec4 m) {
   return bitCount(m.x) + bitCount(m.y) + bitCount(m.z) + bitCount(m.w);
+}
+
+uint digitOf(uvec2 key, uint word, uint bit) {
+  return (((word == 0u) ? key.x : key.y) >> bit) & (kSortRadix - 1u);
+}
+
+uvec2 loadKey(uint index) {
+  if (index >= pc.count) return uvec2(0xFFFFFFFFu);  // padding sorts last in every pass
+  return KEY_WORDS == 2u ? keysIn64[index] : uvec2(keysIn[index], 0xFFFFFFFFu);
 }
 
 void main() {
@@ -46,6 +60,14 @@ void main() {
   // A constant 0 for 32-bit keys lets the compiler drop every high-word path.
   uint word = KEY_WORDS == 1u ? 0u : (pc.shift >> 5);
   uint bit = pc.shift & 31u;
+
+  // Where this tile's keys of each digit go: loaded now, used after ranking,
+  // so the scattered reads overlap the work in between.
+  uint digitOutput[kDigitsPerInvocation];
+  [[unroll]] for (uint j = 0; j < kDigitsPerInvocation; ++j) {
+    uint d = r * kDigitsPerInvocation + j;
+    digitOutput[j] = d < kSortRadix ? histogram[d * pc.blockCount + block] : 0u;
+  }
 
   for (uint i = r; i < gl_NumSubgroups * kSortRadix; i += gl_WorkGroupSize.x) sSubgroupDigits[i] = 0;
   barrier();
@@ -96,48 +118,64 @@ void main() {
   }
   barrier();
   // kSortRadix digits over the workgroup: a few per invocation, then one scan.
-  uint perInvocation = (kSortRadix + gl_WorkGroupSize.x - 1u) / gl_WorkGroupSize.x;
-  uint first = r * perInvocation;
+  uint first = r * kDigitsPerInvocation;
   uint runSum = 0;
-  for (uint j = 0; j < perInvocation; ++j) {
+  [[unroll]] for (uint j = 0; j < kDigitsPerInvocation; ++j) {
     if (first + j < kSortRadix) runSum += sDigitStart[first + j];
   }
   uint total;
   uint running = workgroupExclusiveAdd(runSum, total);
-  for (uint j = 0; j < perInvocation; ++j) {
+  [[unroll]] for (uint j = 0; j < kDigitsPerInvocation; ++j) {
     uint d = first + j;
     if (d < kSortRadix) {
       uint count = sDigitStart[d];
       sDigitStart[d] = running;
-      sDigitShift[d] = histogram[d * pc.blockCount + block] - running;
+      sDigitShift[d] = digitOutput[j] - running;
       running += count;
     }
   }
   barrier();
 
-  // Stage keys and values in digit order, then write them out striped: within a
-  // digit, neighbouring invocations write neighbouring addresses.
+  // Stage in digit order, then write out striped: within a digit, neighbouring
+  // invocations write neighbouring addresses. Keys first, then values.
+  uint slotDigits[(KEYS_PER_THREAD + 3u) / 4u];
+  [[unroll]] for (uint i = 0; i < KEYS_PER_THREAD; ++i) {
+    uint d = (digits[i / 4u] >> (8u * (i % 4u))) & (kSortRadix - 1u);
+    uint rank = (ranks[i / 2u] >> (16u * (i % 2u))) & 0xFFFFu;
+    uint local = sDigitStart[d] + sSubgroupDigits[gl_SubgroupID * kSortRadix + d] + rank;
+    uvec2 key = loadKey(subgroupBase + i * gl_SubgroupSize + gl_SubgroupInvocationID);
+    sStaged[local] = key.x;
+    if (KEY_WORDS == 2u) sStagedHi[local] = key.y;
+  }
+  barrier();
+  [[unroll]] for (uint i = 0; i < KEYS_PER_THREAD; i += 4u) slotDigits[i / 4u] = 0u;
+  [[unroll]] for (uint i = 0; i < KEYS_PER_THREAD; ++i) {
+    uint local = i * gl_WorkGroupSize.x + r;
+    uvec2 key = uvec2(sStaged[local], KEY_WORDS == 2u ? sStagedHi[local] : 0u);
+    uint d = digitOf(key, word, bit);
+    slotDigits[i / 4u] |= d << (8u * (i % 4u));
+    uint destination = local + sDigitShift[d];
+    if (destination < pc.count) {
+      if (KEY_WORDS == 2u) {
+        keysOut64[destination] = key;
+      } else {
+        keysOut[destination] = key.x;
+      }
+    }
+  }
+  barrier();
   [[unroll]] for (uint i = 0; i < KEYS_PER_THREAD; ++i) {
     uint d = (digits[i / 4u] >> (8u * (i % 4u))) & (kSortRadix - 1u);
     uint rank = (ranks[i / 2u] >> (16u * (i % 2u))) & 0xFFFFu;
     uint local = sDigitStart[d] + sSubgroupDigits[gl_SubgroupID * kSortRadix + d] + rank;
     uint index = subgroupBase + i * gl_SubgroupSize + gl_SubgroupInvocationID;
-    bool inside = index < pc.count;
-    sKeysLo[local] = inside ? keysIn[index * KEY_WORDS] : 0xFFFFFFFFu;
-    if (KEY_WORDS == 2u) sKeysHi[local] = inside ? keysIn[index * KEY_WORDS + 1u] : 0xFFFFFFFFu;
-    sValues[local] = inside ? valuesIn[index] : 0u;
+    sStaged[local] = index < pc.count ? valuesIn[index] : 0u;
   }
   barrier();
   [[unroll]] for (uint i = 0; i < KEYS_PER_THREAD; ++i) {
     uint local = i * gl_WorkGroupSize.x + r;
-    uint lo = sKeysLo[local];
-    uint hi = KEY_WORDS == 2u ? sKeysHi[local] : 0u;
-    uint d = (((word == 0u) ? lo : hi) >> bit) & (kSortRadix - 1u);
+    uint d = (slotDigits[i / 4u] >> (8u * (i % 4u))) & (kSortRadix - 1u);
     uint destination = local + sDigitShift[d];
-    if (destination < pc.count) {
-      keysOut[destination * KEY_WORDS] = lo;
-      if (KEY_WORDS == 2u) keysOut[destination * KEY_WORDS + 1u] = hi;
-      valuesOut[destination] = sValues[local];
-    }
+    if (destination < pc.count) valuesOut[destination] = sStaged[local];
   }
 }

@@ -9,6 +9,7 @@
 #include "vk/context.h"
 
 #include <algorithm>
+#include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
@@ -38,15 +39,16 @@ struct Options {
 constexpr const char* kHelp = R"(usage: snell bench sort [options]
 
 Sorts random key-value pairs (32-bit values) on the GPU and prints pairs per
-second from GPU timestamps: the median over --runs back-to-back runs, after a
-submission of --warmup runs.
+second from GPU timestamps: the median over --runs back-to-back runs, after
+at least 250 ms of warm-up runs.
 Each size is checked against std::sort before it is reported.
 
 options:
   --min-log N          smallest size, 2^N pairs (default 16)
   --max-log N          largest size, 2^N pairs (default 24)
   --runs N             timed runs per size, 10 to 100 (default 20)
-  --warmup N           untimed runs first, in their own submission (default 10)
+  --warmup N           untimed runs per warm-up submission, repeated for at
+                       least 250 ms (default 10)
   --keys 32|64|both    key width (default both)
   --json FILE          also write the results as JSON
   --breakdown          also time each step (histogram, scan, scatter) separately
@@ -138,7 +140,13 @@ Row measure(vk::Context& context, render::RadixSort& sort, uint64_t count, const
     }
     commands.submitAndWait();
   };
-  recordRuns(o.warmup, false);
+  // Warm up for a fixed time, not a count: after the host-side check of the
+  // previous size the GPU has idled and lowered its clocks, and a few small
+  // sorts take milliseconds, far too little for them to come back.
+  auto warmStart = std::chrono::steady_clock::now();
+  do {
+    recordRuns(o.warmup, false);
+  } while (std::chrono::steady_clock::now() - warmStart < std::chrono::milliseconds(250));
   recordRuns(o.runs, true);
   std::vector<double> times;
   for (const vk::PassTime& t : commands.passTimes()) times.push_back(t.milliseconds);

@@ -19,7 +19,7 @@ uint32_t sharedBytes(uint32_t workgroup, uint32_t keysPerThread, uint32_t minSub
   uint32_t tile = workgroup * keysPerThread;
   return 4 * (subgroups * gpu::kSortRadix       // per-subgroup digit counters
               + 2 * gpu::kSortRadix             // digit starts and shifts
-              + tile * (keyWords + 1) + 1       // staged keys and values
+              + tile * keyWords + 1             // staged keys, then values
               + subgroups + 1);                 // the workgroup scan's partial sums
 }
 
@@ -28,28 +28,22 @@ uint32_t sharedBytes(uint32_t workgroup, uint32_t keysPerThread, uint32_t minSub
 RadixSort::RadixSort(vk::Context& context, KeyWidth width, RadixSortTuning tuning)
     : context_(context), width_(width), scan_(context) {
   const vk::DeviceCaps& caps = context.caps();
-  // The widest workgroup and the most keys per invocation that fit in shared
-  // memory: larger tiles mean fewer blocks, so a smaller histogram to scan.
+  // Keys per invocation trade registers (occupancy) against tile size (fewer
+  // blocks, longer runs per digit when scattering); then the widest workgroup
+  // whose shared memory fits. Measured on an H200 at 2^24 pairs: 512 x 12 for
+  // 32-bit keys and 384 x 10 for 64-bit keys were the fastest shapes
+  // (bench/results/sort-nvidia-h200.md); lavapipe's 32 KiB gives 128 x 12 / 10.
+  keysPerThread_ = tuning.keysPerThread ? tuning.keysPerThread : (width == KeyWidth::Bits32 ? 12u : 10u);
   workgroupSize_ = tuning.workgroupSize;
-  keysPerThread_ = tuning.keysPerThread;
-  if (!workgroupSize_) {
-    for (uint32_t preferred : {256u, 128u, 64u}) {
-      uint32_t w = fullSubgroupWorkgroupSize(caps, preferred);
-      uint32_t k = keysPerThread_ ? keysPerThread_ : 8u;
-      if (sharedBytes(w, k, caps.minSubgroupSize, width) <= caps.maxComputeSharedMemoryBytes) {
-        workgroupSize_ = w;
+  while (!workgroupSize_ && keysPerThread_ > 1) {
+    for (uint32_t preferred : {512u, 384u, 256u, 128u, 64u}) {
+      if (preferred > caps.maxComputeWorkgroupInvocations || preferred % caps.maxSubgroupSize != 0) continue;
+      if (sharedBytes(preferred, keysPerThread_, caps.minSubgroupSize, width) <= caps.maxComputeSharedMemoryBytes) {
+        workgroupSize_ = preferred;
         break;
       }
     }
-  }
-  if (!keysPerThread_) {
-    keysPerThread_ = 1;
-    for (uint32_t k : {16u, 12u, 8u, 4u, 2u}) {
-      if (workgroupSize_ && sharedBytes(workgroupSize_, k, caps.minSubgroupSize, width) <= caps.maxComputeSharedMemoryBytes) {
-        keysPerThread_ = k;
-        break;
-      }
-    }
+    if (!workgroupSize_) keysPerThread_ = tuning.keysPerThread ? 1 : keysPerThread_ - 1;
   }
   if (!workgroupSize_ || sharedBytes(workgroupSize_, keysPerThread_, caps.minSubgroupSize, width) > caps.maxComputeSharedMemoryBytes) {
     throw vk::VulkanError("the radix sort does not fit in " + std::to_string(caps.maxComputeSharedMemoryBytes) +

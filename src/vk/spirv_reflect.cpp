@@ -234,6 +234,14 @@ ShaderReflection reflectCompute(std::span<const uint32_t> spirv, std::span<const
   }
   std::sort(out.bindings.begin(), out.bindings.end(),
             [](const ReflectedBinding& a, const ReflectedBinding& b) { return std::tie(a.set, a.binding) < std::tie(b.set, b.binding); });
+  // Several views of one buffer (uint[] and uvec2[], say) share a binding: keep one.
+  auto same = [](const ReflectedBinding& a, const ReflectedBinding& b) { return a.set == b.set && a.binding == b.binding; };
+  for (size_t i = 1; i < out.bindings.size(); ++i) {
+    if (same(out.bindings[i - 1], out.bindings[i]) && out.bindings[i - 1].type != out.bindings[i].type) {
+      r.fail("binding " + std::to_string(out.bindings[i].binding) + " is declared with two descriptor types");
+    }
+  }
+  out.bindings.erase(std::unique(out.bindings.begin(), out.bindings.end(), same), out.bindings.end());
   return out;
 }
 
