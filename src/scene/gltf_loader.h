@@ -1,0 +1,34 @@
+// glTF 2.0 (.gltf with external or embedded buffers, .glb) into a Scene,
+// through tinygltf. Every reference and range is checked: a malformed file is
+// a SceneError that names the file and the problem, never a crash.
+#pragma once
+
+#include "scene/scene.h"
+
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace snell::scene {
+
+/// A file that cannot become a scene; the message starts with the file's path.
+class SceneError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+struct LoadOptions {
+  /// The glTF scene to use: an index or a name; empty means the file's default
+  /// scene (or its first).
+  std::string scene;
+  /// Required extensions to drop knowingly instead of refusing the file.
+  std::vector<std::string> ignoredExtensions;
+};
+
+/// Loads a .gltf or .glb file (told apart by content, not by name).
+Scene loadGltf(const std::string& path, const LoadOptions& options = {});
+
+/// The glTF extensions snell implements.
+const std::vector<std::string>& supportedExtensions();
+
+}  // namespace snell::scene

@@ -1,0 +1,181 @@
+// The scene the renderer consumes: shapes (one per glTF triangle primitive),
+// the node graph that places them, materials, textures, lights, cameras, skins
+// and animation clips. Loaded from glTF (gltf_loader.h) or built in code
+// (the procedural eye); evaluated at a time by evaluate.h.
+#pragma once
+
+#include <glm/glm.hpp>
+#include <glm/gtc/quaternion.hpp>
+
+#include <cstdint>
+#include <limits>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace snell::scene {
+
+/// A decoded texture, always RGBA8 (sRGB or linear is the material's business).
+struct Texture {
+  std::string name;
+  uint32_t width = 0;
+  uint32_t height = 0;
+  std::vector<uint8_t> rgba;  ///< width * height * 4 bytes
+  bool repeatS = true, repeatT = true, mirrorS = false, mirrorT = false;
+  bool linearFilter = true;
+};
+
+/// A material's use of a texture: which one, which UV set, and the
+/// KHR_texture_transform applied to the UVs.
+struct TextureRef {
+  int texture = -1;  ///< index into Scene::textures; -1: none
+  int texCoord = 0;  ///< TEXCOORD_n
+  glm::mat3 transform{1.0f};
+  bool present() const { return texture >= 0; }
+};
+
+enum class AlphaMode { Opaque, Mask, Blend };
+
+struct Material {
+  std::string name;
+  glm::vec4 baseColorFactor{1.0f};
+  TextureRef baseColorTexture;
+  glm::vec3 emissiveFactor{0.0f};
+  TextureRef emissiveTexture;
+  bool doubleSided = false;
+  AlphaMode alphaMode = AlphaMode::Opaque;
+  float alphaCutoff = 0.5f;
+  // KHR_materials_transmission
+  float transmission = 0.0f;
+  TextureRef transmissionTexture;
+  // KHR_materials_ior
+  float ior = 1.5f;
+  // KHR_materials_volume
+  float thickness = 0.0f;  ///< 0: thin-walled
+  TextureRef thicknessTexture;
+  glm::vec3 attenuationColor{1.0f};
+  float attenuationDistance = std::numeric_limits<float>::infinity();
+
+  /// Faces with this material refract (the talk's cornea tip).
+  bool refractive() const { return transmission > 0.0f; }
+};
+
+/// One morph target's per-vertex deltas; a missing attribute is empty.
+struct MorphTarget {
+  std::vector<glm::vec3> positions;
+  std::vector<glm::vec3> normals;
+};
+
+/// One glTF triangle primitive: topology and rest pose. Normals are generated
+/// (area-weighted) when the file has none.
+struct Shape {
+  std::string name;
+  int mesh = -1;  ///< the glTF mesh it belongs to (morph weights are per mesh)
+  int material = -1;  ///< -1: the default material
+  std::vector<glm::vec3> positions;
+  std::vector<glm::vec3> normals;
+  std::vector<glm::vec2> texcoords0, texcoords1;
+  std::vector<uint32_t> indices;  ///< triangle list, 3 per triangle
+  std::vector<MorphTarget> targets;
+  std::vector<glm::uvec4> joints;  ///< indices into the skin's joint list
+  std::vector<glm::vec4> weights;  ///< the 4 strongest influences, summing to 1
+  uint32_t maxJoint = 0;           ///< the largest joint index used, checked against the skin
+
+  size_t vertexCount() const { return positions.size(); }
+  size_t triangleCount() const { return indices.size() / 3; }
+  bool morphed() const { return !targets.empty(); }
+  bool skinned() const { return !joints.empty(); }
+};
+
+/// A glTF mesh: the shapes of its primitives and their shared default weights.
+struct Mesh {
+  std::string name;
+  std::vector<int> shapes;
+  std::vector<float> weights;  ///< one per morph target
+};
+
+struct Camera {
+  std::string name;
+  bool orthographic = false;
+  float yfov = 0.8f;         ///< radians, perspective
+  float aspectRatio = 0.0f;  ///< 0: use the image's
+  float xmag = 1.0f, ymag = 1.0f;  ///< orthographic half extents
+  float znear = 0.01f;
+  float zfar = std::numeric_limits<float>::infinity();
+};
+
+enum class LightType { Directional, Point, Spot };
+
+/// KHR_lights_punctual: intensity in candela (point, spot) or lux (directional).
+struct Light {
+  std::string name;
+  LightType type = LightType::Point;
+  glm::vec3 color{1.0f};
+  float intensity = 1.0f;
+  float range = std::numeric_limits<float>::infinity();
+  float innerConeAngle = 0.0f;
+  float outerConeAngle = 0.7853982f;
+};
+
+struct Skin {
+  std::string name;
+  std::vector<int> joints;  ///< node indices
+  std::vector<glm::mat4> inverseBindMatrices;
+  int skeleton = -1;
+};
+
+struct Node {
+  std::string name;
+  int parent = -1;
+  std::vector<int> children;
+  glm::vec3 translation{0.0f};
+  glm::quat rotation{1.0f, 0.0f, 0.0f, 0.0f};
+  glm::vec3 scale{1.0f};
+  std::optional<glm::mat4> matrix;  ///< when the file gives a matrix (not animatable)
+  int mesh = -1;
+  int skin = -1;
+  int camera = -1;
+  int light = -1;
+  std::vector<float> weights;  ///< overrides the mesh's default morph weights
+  std::vector<glm::mat4> instances;  ///< EXT_mesh_gpu_instancing, local to the node
+};
+
+enum class AnimationPath { Translation, Rotation, Scale, Weights };
+enum class Interpolation { Step, Linear, CubicSpline };
+
+struct AnimationSampler {
+  Interpolation interpolation = Interpolation::Linear;
+  std::vector<float> times;   ///< seconds, increasing
+  std::vector<float> values;  ///< flat: per key `components` floats (x3 for cubic: in, value, out)
+  int components = 0;         ///< 3, 4 (rotation) or the number of morph targets
+};
+
+struct AnimationChannel {
+  int node = -1;
+  AnimationPath path = AnimationPath::Translation;
+  int sampler = -1;
+};
+
+struct Animation {
+  std::string name;
+  std::vector<AnimationSampler> samplers;
+  std::vector<AnimationChannel> channels;
+  float duration = 0.0f;  ///< the last key time of any sampler
+};
+
+struct Scene {
+  std::string source;  ///< the file it came from, for messages
+  std::vector<Shape> shapes;
+  std::vector<Mesh> meshes;
+  std::vector<Material> materials;
+  std::vector<Texture> textures;
+  std::vector<Camera> cameras;
+  std::vector<Light> lights;
+  std::vector<Skin> skins;
+  std::vector<Node> nodes;
+  std::vector<int> roots;  ///< root nodes of the chosen glTF scene
+  std::vector<Animation> animations;
+  std::vector<std::string> warnings;  ///< things that loaded but were dropped or repaired
+};
+
+}  // namespace snell::scene

@@ -1,0 +1,111 @@
+// Scene counts and the per-frame GPU memory estimate behind `snell info`.
+#include "scene/scene_summary.h"
+
+#include <cstdio>
+#include <functional>
+#include <sstream>
+
+namespace snell::scene {
+
+namespace {
+
+// Budgets per element on the GPU (see DESIGN.md, the frame's passes).
+constexpr uint64_t kRestBytesPerVertex = 24 + 8;     // position + normal, one UV set
+constexpr uint64_t kIndexBytesPerTriangle = 12;
+constexpr uint64_t kMorphBytesPerVertexTarget = 24;  // position + normal delta
+constexpr uint64_t kSkinBytesPerVertex = 32;         // 4 joints (u32) + 4 weights
+constexpr uint64_t kDeformedBytesPerVertex = 24;     // deformed position + normal
+constexpr uint64_t kBvhBytesPerTriangle = 64;        // LBVH: 2n - 1 nodes of 32 bytes
+constexpr uint64_t kTraceBytesPerPixel = 8 + 4 + 4;  // rgba16f trace, rgba8 viewport, depth
+
+/// Calls `visit(node, instanceCount)` for every node under the scene's roots.
+void forEachNode(const Scene& scene, const std::function<void(const Node&, size_t)>& visit) {
+  std::vector<int> stack(scene.roots.rbegin(), scene.roots.rend());
+  while (!stack.empty()) {
+    const Node& node = scene.nodes[size_t(stack.back())];
+    stack.pop_back();
+    visit(node, node.instances.empty() ? 1 : node.instances.size());
+    stack.insert(stack.end(), node.children.rbegin(), node.children.rend());
+  }
+}
+
+std::string mebibytes(uint64_t bytes) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.1f MiB", static_cast<double>(bytes) / (1024.0 * 1024.0));
+  return text;
+}
+
+}  // namespace
+
+SceneSummary summarize(const Scene& scene, uint32_t width, uint32_t height) {
+  SceneSummary s;
+  s.shapes = scene.shapes.size();
+  for (const Shape& shape : scene.shapes) {
+    s.geometryBytes += shape.vertexCount() * kRestBytesPerVertex + shape.triangleCount() * kIndexBytesPerTriangle;
+    s.deformBytes += shape.vertexCount() * shape.targets.size() * kMorphBytesPerVertexTarget;
+    if (shape.skinned()) s.deformBytes += shape.vertexCount() * kSkinBytesPerVertex;
+    s.morphedShapes += shape.morphed();
+    s.skinnedShapes += shape.skinned();
+  }
+  forEachNode(scene, [&](const Node& node, size_t copies) {
+    ++s.nodes;
+    if (node.mesh < 0) return;
+    for (int index : scene.meshes[size_t(node.mesh)].shapes) {
+      const Shape& shape = scene.shapes[size_t(index)];
+      s.instances += copies;
+      s.triangles += shape.triangleCount() * copies;
+      s.vertices += shape.vertexCount() * copies;
+      // One BVH per shape; deformed shapes get their own deformed copy and tree per instance.
+      bool deforms = shape.morphed() || (shape.skinned() && node.skin >= 0);
+      s.bvhBytes += shape.triangleCount() * kBvhBytesPerTriangle * (deforms ? copies : 1);
+      if (deforms) s.deformBytes += shape.vertexCount() * kDeformedBytesPerVertex * copies;
+    }
+  });
+  for (const Material& m : scene.materials) s.refractiveMaterials += m.refractive();
+  for (const Texture& t : scene.textures) s.textureBytes += t.rgba.size() * 4 / 3;  // with mip levels
+  s.imageBytes = uint64_t(width) * height * kTraceBytesPerPixel;
+  return s;
+}
+
+std::string describe(const Scene& scene, uint32_t width, uint32_t height) {
+  SceneSummary s = summarize(scene, width, height);
+  std::ostringstream out;
+  out << scene.source << "\n";
+  out << "  nodes " << s.nodes << " (of " << scene.nodes.size() << "), shapes " << s.shapes << ", instances " << s.instances
+      << "\n  triangles " << s.triangles << ", vertices " << s.vertices << " (drawn, all instances)\n";
+  out << "  morphed shapes " << s.morphedShapes << ", skinned shapes " << s.skinnedShapes << ", skins " << scene.skins.size()
+      << ", textures " << scene.textures.size() << "\n";
+  out << "  materials " << scene.materials.size() << ", refractive " << s.refractiveMaterials << "\n";
+  for (size_t m = 0; m < scene.materials.size(); ++m) {
+    const Material& material = scene.materials[m];
+    if (!material.refractive()) continue;
+    out << "    [" << m << "] " << (material.name.empty() ? "(unnamed)" : material.name) << ": transmission "
+        << material.transmission << ", ior " << material.ior;
+    if (material.thickness > 0.0f) out << ", thickness " << material.thickness;
+    out << "\n";
+  }
+  out << "  lights " << scene.lights.size() << (scene.lights.empty() ? " (a headlight will be used)" : "") << "\n";
+  const char* types[] = {"directional", "point", "spot"};
+  for (const Light& light : scene.lights) {
+    out << "    " << types[int(light.type)] << (light.name.empty() ? "" : " '" + light.name + "'") << ", intensity "
+        << light.intensity << "\n";
+  }
+  out << "  cameras " << scene.cameras.size() << "\n";
+  for (const Camera& camera : scene.cameras) {
+    out << "    " << (camera.orthographic ? "orthographic" : "perspective") << (camera.name.empty() ? "" : " '" + camera.name + "'");
+    if (!camera.orthographic) out << ", yfov " << camera.yfov;
+    out << "\n";
+  }
+  out << "  animations " << scene.animations.size() << "\n";
+  for (const Animation& a : scene.animations) {
+    out << "    '" << a.name << "': " << a.duration << " s, " << a.channels.size() << " channels\n";
+  }
+  out << "  GPU memory per frame at " << width << "x" << height << " (estimate): " << mebibytes(s.totalBytes())
+      << " = geometry " << mebibytes(s.geometryBytes) << " + deformation " << mebibytes(s.deformBytes) << " + BVH "
+      << mebibytes(s.bvhBytes) << " + textures " << mebibytes(s.textureBytes) << " + images " << mebibytes(s.imageBytes)
+      << "\n";
+  for (const std::string& w : scene.warnings) out << "  note: " << w << "\n";
+  return out.str();
+}
+
+}  // namespace snell::scene

@@ -1,0 +1,32 @@
+// Where the third-party glTF models are: ../shared/assets beside the checkout
+// (CI always has it). A missing folder fails the test that asks, loudly.
+#pragma once
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <string>
+
+namespace snell::test {
+
+inline std::filesystem::path assetsDir() {
+  std::filesystem::path dir = SNELL_ASSETS_DIR;
+  if (!std::filesystem::is_directory(dir)) {
+    ADD_FAILURE() << "the shared glTF assets are missing: expected " << dir
+                  << " (the project's shared/ folder beside the checkout)";
+  }
+  return dir;
+}
+
+/// A model under ../shared/assets/gltf, e.g. model("Cameras/glTF/Cameras.gltf").
+inline std::string model(const std::string& relative) { return (assetsDir() / "gltf" / relative).string(); }
+
+/// A fresh empty folder for one test's files.
+inline std::filesystem::path scratchDir(const std::string& name) {
+  std::filesystem::path dir = std::filesystem::temp_directory_path() / ("snell-test-" + name);
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  return dir;
+}
+
+}  // namespace snell::test

@@ -1,0 +1,67 @@
+// `snell info SCENE` as a user runs it: exit codes and what it prints.
+#include "assets.h"
+
+#include <gtest/gtest.h>
+
+#include <array>
+#include <cstdio>
+#include <memory>
+#include <string>
+
+namespace snell::test {
+namespace {
+
+struct CommandRun {
+  int exitCode;
+  std::string output;  // stdout and stderr together
+};
+
+CommandRun snell(const std::string& arguments) {
+  std::string command = std::string(SNELL_BINARY) + " " + arguments + " 2>&1";
+  std::unique_ptr<FILE, int (*)(FILE*)> pipe(popen(command.c_str(), "r"), pclose);
+  std::string output;
+  std::array<char, 4096> buffer;
+  while (size_t n = fread(buffer.data(), 1, buffer.size(), pipe.get())) output.append(buffer.data(), n);
+  int status = pclose(pipe.release());
+  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, output};
+}
+
+std::string shellQuoted(const std::string& path) { return "'" + path + "'"; }
+
+TEST(SceneInfoCommand, DescribesAModelAndExitsZero) {
+  CommandRun run = snell("info " + shellQuoted(model("TransmissionRoughnessTest/glTF-Binary/TransmissionRoughnessTest.glb")));
+  EXPECT_EQ(run.exitCode, 0) << run.output;
+  EXPECT_NE(run.output.find("refractive"), std::string::npos) << run.output;
+  EXPECT_NE(run.output.find("ior 2.42"), std::string::npos) << run.output;
+  EXPECT_NE(run.output.find("GPU memory per frame"), std::string::npos) << run.output;
+}
+
+TEST(SceneInfoCommand, MalformedFileExitsNonZeroNamingTheFileAndTheProblem) {
+  std::string path = (assetsDir() / "gltf-invalid/node/node_loop.gltf").string();
+  CommandRun run = snell("info " + shellQuoted(path));
+  EXPECT_EQ(run.exitCode, 1) << run.output;
+  EXPECT_NE(run.output.find(path), std::string::npos) << run.output;
+  EXPECT_NE(run.output.find("cycle"), std::string::npos) << run.output;
+}
+
+TEST(SceneInfoCommand, MissingFileExitsNonZero) {
+  CommandRun run = snell("info /nonexistent/scene.glb");
+  EXPECT_EQ(run.exitCode, 1) << run.output;
+  EXPECT_NE(run.output.find("/nonexistent/scene.glb"), std::string::npos) << run.output;
+}
+
+TEST(SceneInfoCommand, RequiredExtensionCanBeIgnoredOnRequest) {
+  std::string path = shellQuoted(model("IridescenceSuzanne/glTF-Binary/IridescenceSuzanne.glb"));
+  EXPECT_EQ(snell("info " + path).exitCode, 1);
+  CommandRun run = snell("info " + path + " --ignore-extension KHR_materials_iridescence");
+  EXPECT_EQ(run.exitCode, 0) << run.output;
+}
+
+TEST(SceneInfoCommand, BadArgumentsExitTwoWithUsageHint) {
+  CommandRun run = snell("info --frobnicate");
+  EXPECT_EQ(run.exitCode, 2) << run.output;
+  EXPECT_NE(run.output.find("snell help"), std::string::npos) << run.output;
+}
+
+}  // namespace
+}  // namespace snell::test
