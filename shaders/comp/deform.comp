@@ -1,0 +1,61 @@
+// The deform pass: morph targets, then linear blend skinning, per vertex.
+// Writes the deformed positions and normals that the BVH and raster passes read.
+#version 460
+#extension GL_GOOGLE_include_directive : require
+#include "../shared/deform.h"
+
+layout(local_size_x_id = kDeformSpecWorkgroupSize) in;
+
+layout(push_constant) uniform Push { DeformPush pc; };
+layout(std430, binding = kDeformBindingRestPositions) readonly buffer RestPositions { float restPositions[]; };
+layout(std430, binding = kDeformBindingRestNormals) readonly buffer RestNormals { float restNormals[]; };
+layout(std430, binding = kDeformBindingMorphDeltas) readonly buffer MorphDeltas { float morphDeltas[]; };
+layout(std430, binding = kDeformBindingMorphWeights) readonly buffer MorphWeights { float morphWeights[]; };
+layout(std430, binding = kDeformBindingJoints) readonly buffer Joints { uvec4 joints[]; };
+layout(std430, binding = kDeformBindingSkinWeights) readonly buffer SkinWeights { vec4 skinWeights[]; };
+layout(std430, binding = kDeformBindingJointMatrices) readonly buffer JointMatrices { mat4 jointMatrices[]; };
+layout(std430, binding = kDeformBindingPositions) writeonly buffer Positions { float positions[]; };
+layout(std430, binding = kDeformBindingNormals) writeonly buffer Normals { float normals[]; };
+
+vec3 load3(uint v, bool normal) {
+  uint i = 3u * v;
+  return normal ? vec3(restNormals[i], restNormals[i + 1u], restNormals[i + 2u])
+                : vec3(restPositions[i], restPositions[i + 1u], restPositions[i + 2u]);
+}
+
+void main() {
+  uint block = gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x;
+  uint v = block * gl_WorkGroupSize.x + gl_LocalInvocationID.x;
+  if (v >= pc.vertexCount) return;
+
+  vec3 p = load3(v, false);
+  vec3 n = load3(v, true);
+  for (uint t = 0u; t < pc.targetCount; ++t) {  // bounded by the push constant
+    float w = morphWeights[t];
+    if (w == 0.0) continue;
+    uint i = 6u * (t * pc.vertexCount + v);
+    p += w * vec3(morphDeltas[i], morphDeltas[i + 1u], morphDeltas[i + 2u]);
+    n += w * vec3(morphDeltas[i + 3u], morphDeltas[i + 4u], morphDeltas[i + 5u]);
+  }
+  if (pc.jointCount > 0u) {
+    // The loader checked joint indices against the skin; the clamp keeps a
+    // corrupted buffer from reading outside the matrices anyway.
+    uvec4 j = min(joints[v], uvec4(pc.jointCount - 1u));
+    vec4 w = skinWeights[v];
+    mat4 m = w.x * jointMatrices[j.x] + w.y * jointMatrices[j.y] + w.z * jointMatrices[j.z] + w.w * jointMatrices[j.w];
+    p = (m * vec4(p, 1.0)).xyz;
+    // Cofactor (det * inverse-transpose), sign-corrected as in src/scene/evaluate.cpp.
+    mat3 a = mat3(m);
+    mat3 cofactor = mat3(cross(a[1], a[2]), cross(a[2], a[0]), cross(a[0], a[1]));
+    n = cofactor * n * (determinant(a) < 0.0 ? -1.0 : 1.0);
+  }
+  float len = length(n);
+  n = len > 0.0 ? n / len : n;
+  uint o = 3u * v;
+  positions[o] = p.x;
+  positions[o + 1u] = p.y;
+  positions[o + 2u] = p.z;
+  normals[o] = n.x;
+  normals[o + 1u] = n.y;
+  normals[o + 2u] = n.z;
+}

@@ -1,0 +1,59 @@
+// The deform pass, first of every frame: for each drawn shape that is morphed
+// or skinned, morph targets then linear blend skinning on the GPU, into
+// storage buffers the BVH and raster passes read. Static shapes skip it.
+#pragma once
+
+#include "scene/evaluate.h"
+#include "scene/scene.h"
+#include "vk/buffer.h"
+#include "vk/commands.h"
+#include "vk/compute_program.h"
+#include "vk/context.h"
+
+#include <memory>
+#include <vector>
+
+namespace snell::render {
+
+/// A shape's rest pose on the GPU: uploaded once, shared by its instances.
+struct DeformInputs {
+  uint32_t vertexCount = 0;
+  uint32_t targetCount = 0;
+  vk::Buffer positions, normals, morphDeltas, joints, skinWeights;
+};
+
+/// One deforming draw item: its per-frame weights and joint matrices (host
+/// visible, written by setPose) and its deformed geometry (device local).
+struct DeformOutput {
+  int item = -1;   ///< index into Pose::items
+  int shape = -1;
+  uint32_t jointCount = 0;
+  vk::Buffer morphWeights, jointMatrices;
+  vk::Buffer positions, normals;
+};
+
+class DeformPass {
+ public:
+  /// Uploads every shape that some item deforms and allocates an output per
+  /// deforming item of `layout` (a pose of `scene` at any time: which items
+  /// exist does not depend on time).
+  DeformPass(vk::Context& context, const scene::Scene& scene, const scene::Pose& layout);
+
+  /// Writes the pose's weights and joint matrices and records one dispatch
+  /// per deforming item, then a barrier that makes the outputs visible to
+  /// compute and transfer. The host writes shared buffers: the previous
+  /// frame's deform must have finished.
+  void record(vk::Commands& commands, const scene::Pose& pose);
+
+  const std::vector<DeformOutput>& outputs() const { return outputs_; }
+
+ private:
+  vk::Context& context_;
+  const scene::Scene& scene_;
+  std::unique_ptr<vk::ComputeProgram> program_;
+  std::vector<std::unique_ptr<DeformInputs>> inputs_;  ///< per shape; null when it never deforms
+  std::vector<DeformOutput> outputs_;
+  vk::Buffer empty_;  ///< bound where a shape has no morph targets or no skin
+};
+
+}  // namespace snell::render
