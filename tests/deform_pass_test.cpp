@@ -6,6 +6,7 @@
 #include "render/deform_pass.h"
 #include "scene/evaluate.h"
 #include "scene/gltf_loader.h"
+#include "scene/procedural_eye.h"
 #include "vk/error.h"
 
 #include <gtest/gtest.h>
@@ -106,6 +107,19 @@ INSTANTIATE_TEST_SUITE_P(Assets, DeformingModel, ::testing::ValuesIn(kDeformingM
 });
 
 using DeformPassTest = GpuTest;
+
+TEST_F(DeformPassTest, ProceduralEyeAndCrowdMatchCpu) {
+  scene::EyeOptions options;
+  Errors eye = deformAndCompare(context(), scene::makeEye(options), 8);
+  options.crowd = 3;
+  options.resolution = 16;
+  Errors crowd = deformAndCompare(context(), scene::makeEye(options), 8);
+  std::printf("    procedural eye: max position error %.2e, crowd of 3: %.2e (of extent)\n", eye.position, crowd.position);
+  EXPECT_EQ(eye.itemsChecked, 8u * 5u);
+  EXPECT_LE(eye.position, 1e-5);
+  EXPECT_LE(crowd.position, 1e-5);
+  EXPECT_LE(eye.normal, 1e-5);
+}
 
 TEST_F(DeformPassTest, StaticShapesDoNotRunIt) {
   scene::Scene scene = scene::loadGltf(model("SimpleSparseAccessor/glTF/SimpleSparseAccessor.gltf"));

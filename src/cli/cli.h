@@ -16,6 +16,7 @@ struct UsageError {
 
 int runInfo(const Args& args);
 int runBenchSort(const Args& args);
+int runEye(const Args& args);
 
 /// Parses an unsigned integer option value or throws UsageError naming the option.
 unsigned long long parseCount(const std::string& option, const std::string& value);

@@ -17,6 +17,8 @@ usage: snell <command> [options]
 
 commands:
   info --devices        list every Vulkan device, which one snell picks and why
+  info SCENE.glb        what a glTF file holds and the GPU memory a frame needs
+  eye -o EYE.glb        write the procedural eye (see 'snell eye --help')
   bench sort [options]  time the GPU radix sort (see 'snell bench sort --help')
   help                  show this text
 
@@ -60,6 +62,7 @@ int main(int argc, char** argv) {
     Args rest(args.begin() + 1, args.end());
     if (args[0] == "info") return runInfo(rest);
     if (args[0] == "bench") return runBench(rest);
+    if (args[0] == "eye") return runEye(rest);
     throw UsageError{"unknown command '" + args[0] + "'"};
   } catch (const UsageError& e) {
     std::fprintf(stderr, "snell: %s\nRun 'snell help' for usage.\n", e.message.c_str());
