@@ -4,13 +4,16 @@
 
 #include <gtest/gtest.h>
 
+#include <cstdlib>
 #include <filesystem>
 #include <string>
 
 namespace snell::test {
 
 inline std::filesystem::path assetsDir() {
-  std::filesystem::path dir = SNELL_ASSETS_DIR;
+  // SNELL_ASSETS_DIR in the environment wins: the GPU machine gets a copy elsewhere.
+  const char* override = std::getenv("SNELL_ASSETS_DIR");
+  std::filesystem::path dir = override ? override : SNELL_ASSETS_DIR;
   if (!std::filesystem::is_directory(dir)) {
     ADD_FAILURE() << "the shared glTF assets are missing: expected " << dir
                   << " (the project's shared/ folder beside the checkout)";
