@@ -102,7 +102,6 @@ struct Row {
   double medianMs, minMs, maxMs;
   bool correct;
   uint32_t workgroup = 0, keysPerThread = 0;
-  const char* ranking = "";
 };
 
 template <typename Key>
@@ -160,15 +159,7 @@ Row measure(vk::Context& context, render::RadixSort& sort, uint64_t count, const
     unsigned stepsPerSort = 3 * ((static_cast<unsigned>(sizeof(Key)) * 8 + 7) / 8);
     unsigned batch = std::max(1u, 128 / stepsPerSort);
     for (unsigned done = 0; done < o.runs; done += batch) {
-      commands.begin();
-      for (unsigned run = 0; run < batch; ++run) {
-        commands.copyBuffer(pristineKeys, workKeys, count * sizeof(Key));
-        commands.copyBuffer(pristineValues, workValues, count * 4);
-        commands.transferToCompute();
-        sort.record(commands, workKeys, workValues, count, scratch);
-        commands.computeToTransfer();
-      }
-      commands.submitAndWait();
+      recordRuns(batch, false);  // the sort stamps its own steps
       const std::vector<vk::PassTime>& stamps = commands.passTimes();
       for (size_t first = 0; first + stepsPerSort <= stamps.size(); first += stepsPerSort) {
         std::map<std::string, double> sums;
@@ -234,7 +225,6 @@ int runBenchSort(const Args& args) {
       allCorrect = allCorrect && row.correct;
       row.workgroup = sort.workgroupSize();
       row.keysPerThread = sort.keysPerThread();
-      row.ranking = "ballots";
       std::printf("%12llu %5u %11.4f %11.4f %11.4f %13.3f %8s\n", (unsigned long long)row.pairs, row.keyBits, row.medianMs,
                   row.minMs, row.maxMs, static_cast<double>(row.pairs) / (row.medianMs * 1e6), row.correct ? "yes" : "NO");
       std::fflush(stdout);
@@ -256,7 +246,6 @@ int runBenchSort(const Args& args) {
             << ", \"min_ms\": " << r.minMs << ", \"max_ms\": " << r.maxMs
             << ", \"gpairs_per_s\": " << static_cast<double>(r.pairs) / (r.medianMs * 1e6) << ", \"correct\": " << (r.correct ? "true" : "false")
             << ", \"workgroup_size\": " << r.workgroup << ", \"keys_per_thread\": " << r.keysPerThread
-            << ", \"ranking\": \"" << r.ranking << "\""
             << "}" << (i + 1 < rows.size() ? "," : "") << "\n";
       }
       out << "  ]\n}\n";

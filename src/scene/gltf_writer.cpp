@@ -295,7 +295,6 @@ void saveGlb(const Scene& scene, const std::string& path) {
     out.name = a.name;
     for (const AnimationSampler& s : a.samplers) {
       tinygltf::AnimationSampler sampler;
-      tinygltf::Accessor times;
       sampler.input = b.accessor(s.times, TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_SCALAR, 1, 0, true);
       // Rotations are VEC4, translations and scales VEC3; weights are scalars.
       int type = s.components == 4 ? TINYGLTF_TYPE_VEC4 : s.components == 3 ? TINYGLTF_TYPE_VEC3 : TINYGLTF_TYPE_SCALAR;
