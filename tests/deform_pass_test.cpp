@@ -46,8 +46,8 @@ Errors deformAndCompare(vk::Context& context, const scene::Scene& scene, int sam
       std::vector<glm::dvec3> cpuPositions, cpuNormals;
       scene::deformOnCpu(item, cpuPositions, cpuNormals);
       std::vector<float> gpuPositions(cpuPositions.size() * 3), gpuNormals(cpuNormals.size() * 3);
-      vk::download(context, out.positions, gpuPositions.data(), gpuPositions.size() * 4);
-      vk::download(context, out.normals, gpuNormals.data(), gpuNormals.size() * 4);
+      vk::download(context, *out.slot.positions, gpuPositions.data(), gpuPositions.size() * 4);
+      vk::download(context, *out.slot.normals, gpuNormals.data(), gpuNormals.size() * 4);
       glm::dvec3 lo(INFINITY), hi(-INFINITY);
       for (const glm::dvec3& p : cpuPositions) lo = glm::min(lo, p), hi = glm::max(hi, p);
       double extent = std::max(glm::length(hi - lo), 1e-30);

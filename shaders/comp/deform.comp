@@ -51,7 +51,7 @@ void main() {
   }
   float len = length(n);
   n = len > 0.0 ? n / len : n;
-  uint o = 3u * v;
+  uint o = 3u * (pc.outputFirst + v);
   positions[o] = p.x;
   positions[o + 1u] = p.y;
   positions[o + 2u] = p.z;

@@ -24,7 +24,7 @@ struct DeformPush {
   uint vertexCount;  // 4
   uint targetCount;  // 4: morph targets; 0 skips morphing
   uint jointCount;   // 4: 0 skips skinning
-  uint pad0;         // 4
+  uint outputFirst;  // 4: first output vertex (outputs are slices of shared buffers)
 };
 
 SNELL_GPU_END

@@ -197,8 +197,7 @@ Row measure(vk::Context& context, render::RadixSort& sort, uint64_t count, const
 
 int runBenchSort(const Args& args) {
   Options o = parse(args);
-  vk::ContextDesc desc;
-  desc.validation = std::getenv("SNELL_VALIDATION") && std::string(std::getenv("SNELL_VALIDATION")) == "1";
+  vk::ContextDesc desc = contextDescFromEnvironment();
   desc.pipelineStatistics = o.pipelineStats;
   auto context = vk::Context::create(desc);
   const vk::DeviceFacts& device = context->facts();

@@ -1,6 +1,8 @@
 // The `snell` command's subcommands; main.cpp routes to them.
 #pragma once
 
+#include "vk/context.h"
+
 #include <string>
 #include <vector>
 
@@ -17,6 +19,12 @@ struct UsageError {
 int runInfo(const Args& args);
 int runBenchSort(const Args& args);
 int runEye(const Args& args);
+int runRender(const Args& args);
+int runBenchBvh(const Args& args);
+int runBenchFrame(const Args& args);
+
+/// A context on the device snell picks; SNELL_VALIDATION=1 turns on the validation layer.
+vk::ContextDesc contextDescFromEnvironment();
 
 /// Parses an unsigned integer option value or throws UsageError naming the option.
 unsigned long long parseCount(const std::string& option, const std::string& value);

@@ -5,6 +5,7 @@
 
 #include <charconv>
 #include <cstdio>
+#include <cstdlib>
 #include <exception>
 
 namespace snell::cli {
@@ -19,7 +20,10 @@ commands:
   info --devices        list every Vulkan device, which one snell picks and why
   info SCENE.glb        what a glTF file holds and the GPU memory a frame needs
   eye -o EYE.glb        write the procedural eye (see 'snell eye --help')
+  render SCENE -o IMG   ray trace a frame (or frames) to PNG/EXR (see 'snell render --help')
   bench sort [options]  time the GPU radix sort (see 'snell bench sort --help')
+  bench bvh [scenes]    GPU BVH quality (SAH cost) against a CPU binned-SAH build
+  bench frame [options] per-pass GPU time of a frame of the eye
   help                  show this text
 
 environment:
@@ -30,15 +34,26 @@ environment:
 
 int runBench(const Args& args) {
   if (args.empty() || args[0] == "--help" || args[0] == "-h") {
-    std::printf("usage: snell bench sort [options]\n\nbenchmarks:\n  sort   GPU radix sort, pairs per second\n");
+    std::printf("usage: snell bench sort|bvh|frame [options]\n\nbenchmarks:\n  sort   GPU radix sort, pairs per second\n"
+                "  bvh    SAH cost of the GPU trees against a CPU binned-SAH build\n"
+                "  frame  per-pass GPU time of the eye's frame\n");
     return args.empty() ? 2 : 0;
   }
   Args rest(args.begin() + 1, args.end());
   if (args[0] == "sort") return runBenchSort(rest);
-  throw UsageError{"unknown benchmark '" + args[0] + "' (try: sort)"};
+  if (args[0] == "bvh") return runBenchBvh(rest);
+  if (args[0] == "frame") return runBenchFrame(rest);
+  throw UsageError{"unknown benchmark '" + args[0] + "' (try: sort, bvh, frame)"};
 }
 
 }  // namespace
+
+vk::ContextDesc contextDescFromEnvironment() {
+  vk::ContextDesc desc;
+  const char* validation = std::getenv("SNELL_VALIDATION");
+  desc.validation = validation && std::string(validation) == "1";
+  return desc;
+}
 
 unsigned long long parseCount(const std::string& option, const std::string& value) {
   unsigned long long result = 0;
@@ -63,6 +78,7 @@ int main(int argc, char** argv) {
     if (args[0] == "info") return runInfo(rest);
     if (args[0] == "bench") return runBench(rest);
     if (args[0] == "eye") return runEye(rest);
+    if (args[0] == "render") return runRender(rest);
     throw UsageError{"unknown command '" + args[0] + "'"};
   } catch (const UsageError& e) {
     std::fprintf(stderr, "snell: %s\nRun 'snell help' for usage.\n", e.message.c_str());

@@ -56,7 +56,8 @@ std::unique_ptr<DeformInputs> uploadShape(vk::Context& context, const scene::Sha
 
 }  // namespace
 
-DeformPass::DeformPass(vk::Context& context, const scene::Scene& scene, const scene::Pose& layout)
+DeformPass::DeformPass(vk::Context& context, const scene::Scene& scene, const scene::Pose& layout,
+                       const std::function<DeformSlot(int item)>& slots)
     : context_(context), scene_(scene) {
   program_ = std::make_unique<vk::ComputeProgram>(
       context, vk::ComputeProgramDesc{"deform", kSpvDeform, {{gpu::kDeformSpecWorkgroupSize, kWorkgroupSize}}, false});
@@ -78,9 +79,17 @@ DeformPass::DeformPass(vk::Context& context, const scene::Scene& scene, const sc
     out.jointMatrices = vk::Buffer(context, {std::max<size_t>(out.jointCount, 1) * sizeof(glm::mat4),
                                              VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, vk::MemoryDomain::Upload,
                                              name + " joint matrices"});
-    out.positions = vk::Buffer(context, {floats3, kStorage, vk::MemoryDomain::Device, name + " deformed positions"});
-    out.normals = vk::Buffer(context, {floats3, kStorage, vk::MemoryDomain::Device, name + " deformed normals"});
+    if (slots) {
+      out.slot = slots(static_cast<int>(i));
+    } else {
+      out.ownPositions = vk::Buffer(context, {floats3, kStorage, vk::MemoryDomain::Device, name + " deformed positions"});
+      out.ownNormals = vk::Buffer(context, {floats3, kStorage, vk::MemoryDomain::Device, name + " deformed normals"});
+    }
     outputs_.push_back(std::move(out));
+  }
+  // Pointers into outputs_ are taken once it no longer grows.
+  for (DeformOutput& out : outputs_) {
+    if (!out.slot.positions) out.slot = {&out.ownPositions, &out.ownNormals, 0};
   }
 }
 
@@ -97,7 +106,7 @@ void DeformPass::record(vk::Commands& commands, const scene::Pose& pose) {
     if (out.jointCount) {
       std::memcpy(out.jointMatrices.mapped().data(), item.jointMatrices.data(), out.jointCount * sizeof(glm::mat4));
     }
-    gpu::DeformPush push{in.vertexCount, targets, item.skinned ? out.jointCount : 0u, 0};
+    gpu::DeformPush push{in.vertexCount, targets, item.skinned ? out.jointCount : 0u, out.slot.firstVertex};
     auto orEmpty = [&](const vk::Buffer& b) { return b.handle() ? &b : &empty_; };
     program_->dispatchThreads(commands,
                               {{gpu::kDeformBindingRestPositions, &in.positions},
@@ -107,8 +116,8 @@ void DeformPass::record(vk::Commands& commands, const scene::Pose& pose) {
                                {gpu::kDeformBindingJoints, orEmpty(in.joints)},
                                {gpu::kDeformBindingSkinWeights, orEmpty(in.skinWeights)},
                                {gpu::kDeformBindingJointMatrices, &out.jointMatrices},
-                               {gpu::kDeformBindingPositions, &out.positions},
-                               {gpu::kDeformBindingNormals, &out.normals}},
+                               {gpu::kDeformBindingPositions, out.slot.positions},
+                               {gpu::kDeformBindingNormals, out.slot.normals}},
                               push, in.vertexCount);
   }
   if (!outputs_.empty()) {

@@ -10,6 +10,7 @@
 #include "vk/compute_program.h"
 #include "vk/context.h"
 
+#include <functional>
 #include <memory>
 #include <vector>
 
@@ -22,14 +23,23 @@ struct DeformInputs {
   vk::Buffer positions, normals, morphDeltas, joints, skinWeights;
 };
 
+/// Where a deforming item's vertices go: a slice of vertex buffers shared
+/// with the BVH and raster passes (packed float triples).
+struct DeformSlot {
+  const vk::Buffer* positions = nullptr;
+  const vk::Buffer* normals = nullptr;
+  uint32_t firstVertex = 0;
+};
+
 /// One deforming draw item: its per-frame weights and joint matrices (host
-/// visible, written by setPose) and its deformed geometry (device local).
+/// visible, written by record) and where its deformed geometry goes.
 struct DeformOutput {
   int item = -1;   ///< index into Pose::items
   int shape = -1;
   uint32_t jointCount = 0;
   vk::Buffer morphWeights, jointMatrices;
-  vk::Buffer positions, normals;
+  DeformSlot slot;  ///< the caller's buffers, or ownPositions/ownNormals
+  vk::Buffer ownPositions, ownNormals;
 };
 
 class DeformPass {
@@ -37,7 +47,10 @@ class DeformPass {
   /// Uploads every shape that some item deforms and allocates an output per
   /// deforming item of `layout` (a pose of `scene` at any time: which items
   /// exist does not depend on time).
-  DeformPass(vk::Context& context, const scene::Scene& scene, const scene::Pose& layout);
+  /// `slots` gives the output slice of each deforming item (by pose item
+  /// index); without it each item gets buffers of its own.
+  DeformPass(vk::Context& context, const scene::Scene& scene, const scene::Pose& layout,
+             const std::function<DeformSlot(int item)>& slots = {});
 
   /// Writes the pose's weights and joint matrices and records one dispatch
   /// per deforming item, then a barrier that makes the outputs visible to

@@ -1,9 +1,11 @@
 // Every struct in shaders/shared/ is read by GLSL with std430 rules; these
 // checks fail the build if the C++ view of a layout drifts from the budget its
 // header states.
+#include "shared/bvh.h"
 #include "shared/deform.h"
 #include "shared/prefix_sum.h"
 #include "shared/radix_sort.h"
+#include "shared/trace.h"
 
 #include <cstddef>
 
@@ -26,5 +28,19 @@ static_assert(offsetof(DeformPush, targetCount) == 4);
 static_assert(offsetof(DeformPush, jointCount) == 8);
 // deform.comp reads these as std430 uvec4[], vec4[] and mat4[].
 static_assert(sizeof(glm::uvec4) == 16 && sizeof(glm::vec4) == 16 && sizeof(glm::mat4) == 64);
+static_assert(offsetof(DeformPush, outputFirst) == 12);
+
+static_assert(sizeof(BvhNode) == 64 && offsetof(BvhNode, child) == 48 && offsetof(BvhNode, parent) == 56);
+static_assert(sizeof(BvhGroup) == 64 && offsetof(BvhGroup, root) == 24 && offsetof(BvhGroup, first) == 28);
+static_assert(offsetof(BvhGroup, boxLo) == 32 && offsetof(BvhGroup, boxHi) == 44 && offsetof(BvhGroup, count) == 56);
+static_assert(sizeof(BvhPush) == 16 && offsetof(BvhPush, total) == 12);
+static_assert(sizeof(GpuInstance) == 112 && offsetof(GpuInstance, worldToObject) == 48 &&
+              offsetof(GpuInstance, geometry) == 96 && offsetof(GpuInstance, material) == 100);
+
+static_assert(sizeof(GpuMaterial) == 112 && offsetof(GpuMaterial, textures) == 96);
+static_assert(sizeof(GpuTexture) == 16 && offsetof(GpuTexture, flags) == 12);
+static_assert(sizeof(GpuLight) == 64 && offsetof(GpuLight, cone) == 48);
+static_assert(sizeof(TraceAov) == 32 && offsetof(TraceAov, nodeVisits) == 20);
+static_assert(sizeof(TracePush) == 96 && offsetof(TracePush, width) == 64 && offsetof(TracePush, tilesX) == 84);
 
 }  // namespace snell::gpu

@@ -140,8 +140,10 @@ void ComputeProgram::record(Commands& commands, std::initializer_list<BufferBind
   if (groups == 0) return;
 
   std::vector<VkDescriptorBufferInfo> infos;
+  std::vector<VkDescriptorImageInfo> imageInfos;
   std::vector<VkWriteDescriptorSet> writes;
-  infos.reserve(buffers.size());
+  infos.reserve(buffers.size());  // writes point into these: no reallocation
+  imageInfos.reserve(buffers.size());
   VkDescriptorSet set = commands.allocateSet(setLayout_);
   for (const BufferBinding& b : buffers) {
     auto reflected = std::find_if(reflection_.bindings.begin(), reflection_.bindings.end(),
@@ -149,16 +151,24 @@ void ComputeProgram::record(Commands& commands, std::initializer_list<BufferBind
     if (reflected == reflection_.bindings.end()) {
       throw VulkanError("program '" + name_ + "' has no binding " + std::to_string(b.slot));
     }
-    if (!b.buffer || !b.buffer->handle()) {
-      throw VulkanError("program '" + name_ + "': binding " + std::to_string(b.slot) + " has no buffer");
-    }
-    infos.push_back({b.buffer->handle(), 0, VK_WHOLE_SIZE});
     VkWriteDescriptorSet write{VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
     write.dstSet = set;
     write.dstBinding = b.slot;
     write.descriptorCount = 1;
     write.descriptorType = reflected->type;
-    write.pBufferInfo = &infos.back();
+    if (reflected->type == VK_DESCRIPTOR_TYPE_STORAGE_IMAGE) {
+      if (!b.image || !b.image->view()) {
+        throw VulkanError("program '" + name_ + "': binding " + std::to_string(b.slot) + " needs a storage image");
+      }
+      imageInfos.push_back({VK_NULL_HANDLE, b.image->view(), VK_IMAGE_LAYOUT_GENERAL});
+      write.pImageInfo = &imageInfos.back();
+    } else {
+      if (!b.buffer || !b.buffer->handle()) {
+        throw VulkanError("program '" + name_ + "': binding " + std::to_string(b.slot) + " has no buffer");
+      }
+      infos.push_back({b.buffer->handle(), 0, VK_WHOLE_SIZE});
+      write.pBufferInfo = &infos.back();
+    }
     writes.push_back(write);
   }
   vkUpdateDescriptorSets(context_->device(), static_cast<uint32_t>(writes.size()), writes.data(), 0, nullptr);

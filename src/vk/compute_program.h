@@ -28,10 +28,11 @@ struct ComputeProgramDesc {
   bool requireFullSubgroups = false;
 };
 
-/// One buffer bound to a binding slot of set 0.
+/// One buffer, or one storage image in GENERAL layout, bound to a slot of set 0.
 struct BufferBinding {
   uint32_t slot;
-  const Buffer* buffer;
+  const Buffer* buffer = nullptr;
+  const Image* image = nullptr;
 };
 
 class ComputeProgram {

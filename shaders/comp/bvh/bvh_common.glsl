@@ -1,0 +1,32 @@
+// Helpers every BVH pass shares: boxes as six floats, and float keys whose
+// unsigned order is the float order (so atomicMin can reduce floats).
+#include "../../shared/bvh.h"
+
+layout(local_size_x_id = kBvhSpecWorkgroupSize) in;
+layout(push_constant) uniform Push { BvhPush pc; };
+
+const float kInf = 1.0 / 0.0;  // folded to +infinity at compile time
+
+uint threadIndex() {
+  // Large dispatches are split over y (ComputeProgram::dispatchThreads).
+  return (gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x) * gl_WorkGroupSize.x + gl_LocalInvocationID.x;
+}
+
+uint orderedKey(float f) {
+  uint u = floatBitsToUint(f);
+  return (u & 0x80000000u) != 0u ? ~u : (u | 0x80000000u);
+}
+
+float orderedFloat(uint k) {
+  return uintBitsToFloat((k & 0x80000000u) != 0u ? (k & 0x7fffffffu) : ~k);
+}
+
+bool finite3(vec3 v) {
+  return !any(isnan(v)) && !any(isinf(v));
+}
+
+// An empty box: no ray enters it and it grows no union.
+void emptyBox(out vec3 lo, out vec3 hi) {
+  lo = vec3(kInf);
+  hi = vec3(-kInf);
+}

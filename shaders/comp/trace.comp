@@ -1,0 +1,375 @@
+// The trace pass: one ray per pixel from the camera (at the origin: the scene
+// is camera-relative), through the top-level tree into each instance's
+// bottom-level tree; refracted at transmissive faces, reflected when Snell's
+// law has no solution, Phong-shaded where it lands. The contract it follows
+// is written out in shaders/shared/trace.h; src/ref is its double twin.
+#version 460
+#extension GL_GOOGLE_include_directive : require
+#include "../shared/bvh.h"
+#include "../shared/trace.h"
+
+layout(local_size_x = 64) in;  // one kTraceTile x kTraceTile tile of pixels
+layout(push_constant) uniform Push { TracePush pc; };
+
+layout(std430, binding = kTraceBindingTlasNodes) readonly buffer TlasNodes { BvhNode tlasNodes[]; };
+layout(std430, binding = kTraceBindingTlasGroups) readonly buffer TlasGroups { BvhGroup tlasGroups[]; };
+layout(std430, binding = kTraceBindingInstances) readonly buffer Instances { GpuInstance instances[]; };
+layout(std430, binding = kTraceBindingBlasNodes) readonly buffer BlasNodes { BvhNode blasNodes[]; };
+layout(std430, binding = kTraceBindingBlasGroups) readonly buffer BlasGroups { BvhGroup blasGroups[]; };
+layout(std430, binding = kTraceBindingPositions) readonly buffer Positions { float positions[]; };
+layout(std430, binding = kTraceBindingNormals) readonly buffer Normals { float normals[]; };
+layout(std430, binding = kTraceBindingTexcoords) readonly buffer Texcoords { vec4 texcoords[]; };
+layout(std430, binding = kTraceBindingIndices) readonly buffer Indices { uint indices[]; };
+layout(std430, binding = kTraceBindingMaterials) readonly buffer Materials { GpuMaterial materials[]; };
+layout(std430, binding = kTraceBindingTextures) readonly buffer Textures { GpuTexture textures[]; };
+layout(std430, binding = kTraceBindingTexels) readonly buffer Texels { uint texels[]; };
+layout(std430, binding = kTraceBindingLights) readonly buffer Lights { GpuLight lights[]; };
+layout(binding = kTraceBindingImage, rgba16f) uniform writeonly image2D outImage;
+layout(std430, binding = kTraceBindingAov) writeonly buffer Aovs { TraceAov aovs[]; };
+
+const float kInf = 1.0 / 0.0;  // folded to +infinity at compile time
+const float kPi = 3.14159265358979;
+const uint kStackSize = 64u;
+
+// ---------------------------------------------------------------- traversal
+
+uint stack[kStackSize];
+uint visits;  // nodes visited by this pixel's whole path
+
+struct Hit {
+  float t;
+  uint instance;
+  uint primitive;  // global triangle index
+  vec3 bary;       // weights of v0, v1, v2
+};
+
+// Woop, Benthin & Wald 2013: the ray's shear, computed once per space.
+struct ShearedRay {
+  vec3 origin;
+  ivec3 k;    // kx, ky, kz: kz is the dominant axis of the direction
+  vec3 shear; // Sx, Sy, Sz
+  vec3 invDir;
+};
+
+ShearedRay shearRay(vec3 origin, vec3 dir) {
+  ShearedRay r;
+  r.origin = origin;
+  vec3 a = abs(dir);
+  int kz = a.x > a.y ? (a.x > a.z ? 0 : 2) : (a.y > a.z ? 1 : 2);
+  int kx = (kz + 1) % 3, ky = (kx + 1) % 3;
+  if (dir[kz] < 0.0) { int tmp = kx; kx = ky; ky = tmp; }  // keeps the winding
+  r.k = ivec3(kx, ky, kz);
+  r.shear = vec3(dir[kx] / dir[kz], dir[ky] / dir[kz], 1.0 / dir[kz]);
+  // Zero components would make 0 * inf = NaN in the slab test; a tiny
+  // stand-in keeps the box test conservative.
+  for (int i = 0; i < 3; ++i) r.invDir[i] = 1.0 / (abs(dir[i]) < 1e-30 ? (dir[i] < 0.0 ? -1e-30 : 1e-30) : dir[i]);
+  return r;
+}
+
+// Slab test against [lo, hi], grown by the rounding bound of the test itself
+// (3 ulps, Ize 2013) so a ray through a shared edge cannot slip past both boxes.
+float enterBox(ShearedRay r, vec3 lo, vec3 hi, float tMax) {
+  vec3 t0 = (lo - r.origin) * r.invDir, t1 = (hi - r.origin) * r.invDir;
+  vec3 tNear = min(t0, t1), tFar = max(t0, t1);
+  float enter = max(max(tNear.x, tNear.y), max(tNear.z, 0.0));
+  float leave = min(min(tFar.x, tFar.y), min(tFar.z, tMax)) * 1.0000004;
+  return enter <= leave ? enter : kInf;  // false for NaN boxes too
+}
+
+vec3 vertexAt(uint v) {
+  return vec3(positions[3u * v], positions[3u * v + 1u], positions[3u * v + 2u]);
+}
+
+// Watertight ray/triangle test; returns t (or kInf) and the barycentrics.
+float intersectTriangle(ShearedRay r, uint tri, float tMax, out vec3 bary) {
+  vec3 A = vertexAt(indices[3u * tri]) - r.origin;
+  vec3 B = vertexAt(indices[3u * tri + 1u]) - r.origin;
+  vec3 C = vertexAt(indices[3u * tri + 2u]) - r.origin;
+  int kx = r.k.x, ky = r.k.y, kz = r.k.z;
+  float Ax = A[kx] - r.shear.x * A[kz], Ay = A[ky] - r.shear.y * A[kz];
+  float Bx = B[kx] - r.shear.x * B[kz], By = B[ky] - r.shear.y * B[kz];
+  float Cx = C[kx] - r.shear.x * C[kz], Cy = C[ky] - r.shear.y * C[kz];
+  float U = Cx * By - Cy * Bx;
+  float V = Ax * Cy - Ay * Cx;
+  float W = Bx * Ay - By * Ax;
+  if ((U < 0.0 || V < 0.0 || W < 0.0) && (U > 0.0 || V > 0.0 || W > 0.0)) return kInf;
+  float det = U + V + W;
+  if (det == 0.0) return kInf;
+  float T = U * r.shear.z * A[kz] + V * r.shear.z * B[kz] + W * r.shear.z * C[kz];
+  if (det < 0.0 ? (T >= 0.0 || T < tMax * det) : (T <= 0.0 || T > tMax * det)) return kInf;
+  float inv = 1.0 / det;
+  bary = vec3(U, V, W) * inv;
+  return T * inv;
+}
+
+// One instance's tree, with the ray in its object space (t is shared: the
+// direction is not renormalised). Uses the stack above `base`.
+void traverseBlas(uint instance, vec3 origin, vec3 dir, uint skipPrim, uint base, inout Hit hit) {
+  GpuInstance inst = instances[instance];
+  uint root = blasGroups[inst.geometry].root;
+  if (root == kBvhNone) return;
+  vec3 o = vec3(dot(inst.worldToObject[0], vec4(origin, 1.0)), dot(inst.worldToObject[1], vec4(origin, 1.0)),
+                dot(inst.worldToObject[2], vec4(origin, 1.0)));
+  vec3 d = vec3(dot(inst.worldToObject[0].xyz, dir), dot(inst.worldToObject[1].xyz, dir),
+                dot(inst.worldToObject[2].xyz, dir));
+  ShearedRay r = shearRay(o, d);
+  uint sp = base;
+  stack[sp++] = root;
+  uint budget = kTraceMaxVisits;
+  while (sp > base && budget-- > 0u) {
+    uint ref = stack[--sp];
+    ++visits;
+    if ((ref & kBvhLeafBit) != 0u) {
+      uint tri = ref & ~kBvhLeafBit;
+      if (tri == skipPrim) continue;  // the face this ray leaves
+      vec3 bary;
+      float t = intersectTriangle(r, tri, hit.t, bary);
+      if (t < hit.t) hit = Hit(t, instance, tri, bary);
+      continue;
+    }
+    BvhNode node = blasNodes[ref];
+    float t0 = enterBox(r, vec3(node.box[0], node.box[1], node.box[2]), vec3(node.box[3], node.box[4], node.box[5]), hit.t);
+    float t1 = enterBox(r, vec3(node.box[6], node.box[7], node.box[8]), vec3(node.box[9], node.box[10], node.box[11]), hit.t);
+    // Near child on top; a full stack drops the far one (only a corrupted tree is that deep).
+    bool swapOrder = t1 < t0;
+    uint nearRef = swapOrder ? node.child[1] : node.child[0], farRef = swapOrder ? node.child[0] : node.child[1];
+    float nearT = min(t0, t1), farT = max(t0, t1);
+    if (farT < kInf && sp < kStackSize) stack[sp++] = farRef;
+    if (nearT < kInf && sp < kStackSize) stack[sp++] = nearRef;
+  }
+}
+
+Hit traceClosest(vec3 origin, vec3 dir, uint skipInstance, uint skipPrim) {
+  Hit hit = Hit(kInf, kNoHit, kNoHit, vec3(0.0));
+  uint root = tlasGroups[0].root;
+  if (root == kBvhNone) return hit;
+  ShearedRay r = shearRay(origin, dir);
+  uint sp = 0u;
+  stack[sp++] = root;
+  uint budget = kTraceMaxVisits;
+  while (sp > 0u && budget-- > 0u) {
+    uint ref = stack[--sp];
+    ++visits;
+    if ((ref & kBvhLeafBit) != 0u) {
+      uint instance = ref & ~kBvhLeafBit;
+      traverseBlas(instance, origin, dir, instance == skipInstance ? skipPrim : kNoHit, sp, hit);
+      continue;
+    }
+    BvhNode node = tlasNodes[ref];
+    float t0 = enterBox(r, vec3(node.box[0], node.box[1], node.box[2]), vec3(node.box[3], node.box[4], node.box[5]), hit.t);
+    float t1 = enterBox(r, vec3(node.box[6], node.box[7], node.box[8]), vec3(node.box[9], node.box[10], node.box[11]), hit.t);
+    bool swapOrder = t1 < t0;
+    uint nearRef = swapOrder ? node.child[1] : node.child[0], farRef = swapOrder ? node.child[0] : node.child[1];
+    float nearT = min(t0, t1), farT = max(t0, t1);
+    if (farT < kInf && sp < kStackSize) stack[sp++] = farRef;
+    if (nearT < kInf && sp < kStackSize) stack[sp++] = nearRef;
+  }
+  return hit;
+}
+
+// ----------------------------------------------------------------- textures
+
+vec3 srgbToLinear(vec3 c) {
+  return mix(c / 12.92, pow((c + 0.055) / 1.055, vec3(2.4)), greaterThan(c, vec3(0.04045)));
+}
+
+int wrapIndex(int i, int size, uint mode) {
+  if (mode == kWrapClamp) return clamp(i, 0, size - 1);
+  if (mode == kWrapMirror) {
+    int period = 2 * size;
+    int m = ((i % period) + period) % period;
+    return m < size ? m : period - 1 - m;
+  }
+  return ((i % size) + size) % size;
+}
+
+vec3 texel(GpuTexture tex, int x, int y) {
+  x = wrapIndex(x, int(tex.width), tex.flags & 3u);
+  y = wrapIndex(y, int(tex.height), (tex.flags >> 2) & 3u);
+  uint rgba = texels[tex.firstTexel + uint(y) * tex.width + uint(x)];
+  return srgbToLinear(unpackUnorm4x8(rgba).rgb);
+}
+
+vec3 sampleTexture(uint index, vec2 uv) {
+  GpuTexture tex = textures[index];
+  if ((tex.flags & 16u) != 0u) return texel(tex, int(floor(uv.x * float(tex.width))), int(floor(uv.y * float(tex.height))));
+  vec2 p = uv * vec2(tex.width, tex.height) - 0.5;
+  vec2 base = floor(p);
+  vec2 f = p - base;
+  int x = int(base.x), y = int(base.y);
+  vec3 top = mix(texel(tex, x, y), texel(tex, x + 1, y), f.x);
+  vec3 bottom = mix(texel(tex, x, y + 1), texel(tex, x + 1, y + 1), f.x);
+  return mix(top, bottom, f.y);
+}
+
+vec3 textured(uint texture, vec4 uvs, uint texCoord, vec4 row0, vec4 row1) {
+  if (texture == kNoTexture) return vec3(1.0);
+  vec3 uv = vec3(texCoord == 1u ? uvs.zw : uvs.xy, 1.0);
+  return sampleTexture(texture, vec2(dot(row0.xyz, uv), dot(row1.xyz, uv)));
+}
+
+// ------------------------------------------------------------------ shading
+
+struct Surface {
+  vec3 position;  // camera-relative world space
+  vec3 ng;        // geometric normal, unit
+  vec3 ns;        // shading normal, unit, on ng's side
+  vec4 uvs;
+  uint material;
+};
+
+Surface surfaceAt(Hit hit) {
+  GpuInstance inst = instances[hit.instance];
+  uint i0 = indices[3u * hit.primitive], i1 = indices[3u * hit.primitive + 1u], i2 = indices[3u * hit.primitive + 2u];
+  vec3 p0 = vertexAt(i0), p1 = vertexAt(i1), p2 = vertexAt(i2);
+  vec3 p = hit.bary.x * p0 + hit.bary.y * p1 + hit.bary.z * p2;
+  vec3 n0 = vec3(normals[3u * i0], normals[3u * i0 + 1u], normals[3u * i0 + 2u]);
+  vec3 n1 = vec3(normals[3u * i1], normals[3u * i1 + 1u], normals[3u * i1 + 2u]);
+  vec3 n2 = vec3(normals[3u * i2], normals[3u * i2 + 1u], normals[3u * i2 + 2u]);
+  vec3 ns = hit.bary.x * n0 + hit.bary.y * n1 + hit.bary.z * n2;
+  vec3 ng = cross(p1 - p0, p2 - p0);
+  // Object to world; normals by the inverse transpose, i.e. worldToObject's columns.
+  mat3 toWorldNormal = transpose(mat3(inst.worldToObject[0].xyz, inst.worldToObject[1].xyz, inst.worldToObject[2].xyz));
+  Surface s;
+  s.position = vec3(dot(inst.objectToWorld[0], vec4(p, 1.0)), dot(inst.objectToWorld[1], vec4(p, 1.0)),
+                    dot(inst.objectToWorld[2], vec4(p, 1.0)));
+  s.ng = normalize(toWorldNormal * ng);
+  ns = toWorldNormal * ns;
+  s.ns = dot(ns, ns) > 0.0 ? normalize(ns) : s.ng;
+  if (dot(s.ns, s.ng) < 0.0) s.ns = -s.ns;
+  s.uvs = hit.bary.x * texcoords[i0] + hit.bary.y * texcoords[i1] + hit.bary.z * texcoords[i2];
+  s.material = inst.material;
+  return s;
+}
+
+vec3 baseColour(GpuMaterial m, vec4 uvs) {
+  return m.baseColorFactor.rgb * textured(m.textures.x, uvs, m.textures.y, m.baseUvRow0, m.baseUvRow1);
+}
+
+vec3 phong(Surface s, GpuMaterial m, vec3 dir) {
+  vec3 base = baseColour(m, s.uvs);
+  vec3 n = dot(s.ns, dir) > 0.0 ? -s.ns : s.ns;  // towards the viewer
+  vec3 v = -dir;
+  vec3 colour = m.emissiveFactor.rgb * textured(m.textures.z, s.uvs, m.textures.w, m.emissiveUvRow0, m.emissiveUvRow1) +
+                kAmbient * base;
+  uint count = max(pc.lightCount, 1u);
+  for (uint i = 0u; i < count; ++i) {
+    vec3 l, e;
+    if (pc.lightCount == 0u) {
+      l = -pc.forward.xyz;
+      e = vec3(kHeadlight);
+    } else {
+      GpuLight light = lights[i];
+      uint type = uint(light.positionType.w);
+      if (type == kLightDirectional) {
+        l = -light.direction.xyz;
+        e = light.radiance.rgb;
+      } else {
+        vec3 toLight = light.positionType.xyz - s.position;
+        float distance2 = dot(toLight, toLight);
+        float distance = sqrt(distance2);
+        l = toLight / distance;
+        e = light.radiance.rgb / distance2;
+        float range = light.direction.w;
+        if (range > 0.0) {
+          float ratio = distance / range;
+          float window = clamp(1.0 - ratio * ratio * ratio * ratio, 0.0, 1.0);
+          e *= window * window;
+        }
+        if (type == kLightSpot) {
+          float cd = dot(light.direction.xyz, -l);
+          float s2 = clamp((cd - light.cone.y) / max(1e-4, light.cone.x - light.cone.y), 0.0, 1.0);
+          e *= s2 * s2;
+        }
+      }
+    }
+    float nl = dot(n, l);
+    if (nl <= 0.0) continue;
+    vec3 h = normalize(l + v);
+    colour += e * nl * (base / kPi + kSpecular * pow(max(dot(n, h), 0.0), kShininess));
+  }
+  return colour;
+}
+
+// Wächter & Binder (Ray Tracing Gems, ch. 6): move the point off the surface
+// by a few ulps of its own magnitude (a fixed step near the origin, where ulps vanish).
+vec3 offsetRay(vec3 p, vec3 n) {
+  const float kOrigin = 1.0 / 32.0, kFloatScale = 1.0 / 65536.0, kIntScale = 256.0;
+  ivec3 of = ivec3(kIntScale * n);
+  vec3 pi = intBitsToFloat(floatBitsToInt(p) + mix(of, -of, lessThan(p, vec3(0.0))));
+  return mix(pi, p + kFloatScale * n, lessThan(abs(p), vec3(kOrigin)));
+}
+
+void main() {
+  uint tile = gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x;
+  uvec2 pixel = uvec2(tile % pc.tilesX, tile / pc.tilesX) * kTraceTile +
+                uvec2(gl_LocalInvocationID.x % kTraceTile, gl_LocalInvocationID.x / kTraceTile);
+  if (pixel.x >= pc.width || pixel.y >= pc.height) return;
+
+  float sx = (2.0 * (float(pixel.x) + 0.5) / float(pc.width) - 1.0) * pc.right.w;
+  float sy = (1.0 - 2.0 * (float(pixel.y) + 0.5) / float(pc.height)) * pc.up.w;
+  vec3 origin = vec3(0.0), dir;
+  if ((pc.flags & kTraceFlagOrthographic) != 0u) {
+    origin = sx * pc.right.xyz + sy * pc.up.xyz;
+    dir = pc.forward.xyz;
+  } else {
+    dir = normalize(pc.forward.xyz + sx * pc.right.xyz + sy * pc.up.xyz);
+  }
+
+  visits = 0u;
+  vec3 throughput = vec3(1.0);
+  vec3 colour = vec3(0.0);
+  uint interfaces = 0u;
+  uint outcome = kOutcomeMiss;
+  float firstDistance = -1.0;
+  uint firstInstance = kNoHit, firstPrimitive = kNoHit;
+  uint skipInstance = kNoHit, skipPrim = kNoHit;
+  // Each pass of the loop is one segment; maxInterfaces + 1 segments at most.
+  for (uint segment = 0u; segment <= pc.maxInterfaces; ++segment) {
+    Hit hit = traceClosest(origin, dir, skipInstance, skipPrim);
+    if (hit.instance == kNoHit) {
+      colour = throughput * pc.background.rgb;
+      outcome = kOutcomeMiss;
+      break;
+    }
+    if (segment == 0u) {
+      firstDistance = hit.t;
+      firstInstance = hit.instance;
+      firstPrimitive = hit.primitive - blasGroups[instances[hit.instance].geometry].first;
+    }
+    Surface s = surfaceAt(hit);
+    GpuMaterial m = materials[s.material];
+    if (m.emissiveFactor.w <= 0.0) {
+      colour = throughput * phong(s, m, dir);
+      outcome = kOutcomeOpaque;
+      break;
+    }
+    if (interfaces == pc.maxInterfaces) {
+      colour = throughput * pc.background.rgb;
+      outcome = kOutcomeInterfaceLimit;
+      break;
+    }
+    bool entering = dot(dir, s.ng) < 0.0;
+    vec3 n = entering ? s.ns : -s.ns;
+    float ior = m.baseUvRow0.w;
+    float eta = entering ? 1.0 / ior : ior;
+    float c = -dot(dir, n);
+    if (c <= 0.0) {
+      n = entering ? s.ng : -s.ng;
+      c = -dot(dir, n);
+    }
+    float k = 1.0 - eta * eta * (1.0 - c * c);
+    dir = normalize(k < 0.0 ? dir + 2.0 * c * n : eta * dir + (eta * c - sqrt(k)) * n);
+    throughput *= baseColour(m, s.uvs);
+    ++interfaces;
+    origin = offsetRay(s.position, dot(dir, s.ng) > 0.0 ? s.ng : -s.ng);
+    skipInstance = hit.instance;
+    skipPrim = hit.primitive;
+  }
+
+  imageStore(outImage, ivec2(pixel), vec4(colour, 1.0));
+  if ((pc.flags & kTraceFlagAov) != 0u) {
+    aovs[pixel.y * pc.width + pixel.x] =
+        TraceAov(firstDistance, firstInstance, firstPrimitive, interfaces, outcome, visits, 0u, 0u);
+  }
+}

@@ -1,0 +1,163 @@
+// The tracing contract, shared by shaders/comp/trace.comp (float, GPU) and
+// src/ref (double, CPU). Both implement the rules below independently; only
+// the constants and the GPU record layouts live here.
+//
+// Rays. One per pixel through its centre: for pixel (x, y), y = 0 the top row,
+//   sx = (2 (x + 0.5) / W - 1) * tanHalfFovY * W / H,  sy = (1 - 2 (y + 0.5) / H) * tanHalfFovY,
+//   perspective:  origin = eye, direction = normalize(forward + sx right + sy up);
+//   orthographic: origin = eye + right sx' + up sy' with tanHalfFovY replaced by
+//                 the half height, direction = forward.
+// (scene/view.h resolves eye, right, up, forward and the fov; both tracers use it.)
+//
+// Hits. The closest triangle with t > 0 along the ray; a secondary ray never
+// hits the triangle it leaves at its origin. Barycentrics (b0, b1, b2) of
+// p = b0 v0 + b1 v1 + b2 v2. In world space:
+//   Ng = normalize(cross(v1 - v0, v2 - v0)), the geometric normal;
+//   Ns = normalize(b0 n0 + b1 n1 + b2 n2), the shading normal (Ng where that is zero),
+//        flipped to Ng's side when dot(Ns, Ng) < 0.
+// Object-space normals go to world by the inverse transpose of the instance matrix.
+//
+// Refractive faces (material transmission > 0):
+//   entering = dot(d, Ng) < 0; n = entering ? Ns : -Ns; eta = entering ? 1 / ior : ior;
+//   c = -dot(d, n); if c <= 0 the shading normal faces away: n = entering ? Ng : -Ng, c = -dot(d, n);
+//   k = 1 - eta^2 (1 - c^2);
+//   k < 0: total internal reflection, d' = d + 2 c n;  else d' = eta d + (eta c - sqrt(k)) n;
+//   d' = normalize(d'); throughput *= base colour (factor times texture, linear);
+//   one interface crossed (refraction and internal reflection alike). A ray
+//   crosses at most maxInterfaces faces (default kDefaultMaxInterfaces): the
+//   refractive face after that ends it as a miss (outcome kOutcomeInterfaceLimit).
+// Opaque faces: colour = throughput * (emissive + kAmbient * base
+//                 + sum over lights E * max(dot(N, L), 0) * (base / pi + kSpecular * max(dot(N, H), 0)^kShininess))
+//   with N = Ns turned towards the viewer (flipped when dot(Ns, -d) < 0), V = -d,
+//   H = normalize(L + V), base = baseColorFactor.rgb * texture.rgb, emissive the same way.
+//   Lights (glTF KHR_lights_punctual; a light shines down its node's -Z):
+//     directional: L = -direction, E = colour * intensity;
+//     point: L towards the light, E = colour * intensity / distance^2 * window,
+//            window = clamp(1 - (distance / range)^4, 0, 1)^2 with a finite range, else 1;
+//     spot: as point times s^2, s = clamp((dot(direction, -L) - cos outer) / max(1e-4, cos inner - cos outer), 0, 1).
+//   No lights in the scene: one directional headlight along the camera's forward
+//   axis with E = (kHeadlight, kHeadlight, kHeadlight). No shadows.
+// Misses: colour = throughput * background. Alpha is 1 everywhere.
+//
+// Textures. uv' = (T * vec3(uv, 1)).xy with T the KHR_texture_transform matrix;
+// x = u' W - 0.5, y = v' H - 0.5 (row 0 is the image's first row); texels are
+// decoded from sRGB to linear, then filtered bilinearly (or the nearest texel,
+// floor(u' W), when the sampler says nearest). Wrap per axis: repeat, mirrored
+// repeat or clamp to edge, applied to the integer texel index.
+#ifndef SNELL_TRACE_H
+#define SNELL_TRACE_H
+#include "shared_types.h"
+
+SNELL_GPU_BEGIN
+
+#ifdef __cplusplus
+inline constexpr float kAmbient = 0.03f;
+inline constexpr float kSpecular = 0.04f;
+inline constexpr float kShininess = 64.0f;
+inline constexpr float kHeadlight = 3.14159265f;
+#else
+const float kAmbient = 0.03;
+const float kSpecular = 0.04;
+const float kShininess = 64.0;
+const float kHeadlight = 3.14159265;
+#endif
+SNELL_CONST kDefaultMaxInterfaces = 8;
+
+SNELL_CONST kLightDirectional = 0;
+SNELL_CONST kLightPoint = 1;
+SNELL_CONST kLightSpot = 2;
+
+SNELL_CONST kWrapRepeat = 0;
+SNELL_CONST kWrapMirror = 1;
+SNELL_CONST kWrapClamp = 2;
+
+SNELL_CONST kNoTexture = 0xffffffffu;
+
+// What a traced pixel ended on (TraceAov::outcome).
+SNELL_CONST kOutcomeMiss = 0;
+SNELL_CONST kOutcomeOpaque = 1;
+SNELL_CONST kOutcomeInterfaceLimit = 2;  // more refractive faces than maxInterfaces
+
+// 112 bytes, total: 112 bytes
+struct GpuMaterial {
+  vec4 baseColorFactor;  // 16
+  vec4 emissiveFactor;   // 16: rgb, w: transmission factor (> 0: the face refracts)
+  vec4 baseUvRow0;       // 16: KHR_texture_transform, first row (xyz); w: index of refraction
+  vec4 baseUvRow1;       // 16: second row (xyz)
+  vec4 emissiveUvRow0;   // 16
+  vec4 emissiveUvRow1;   // 16
+  uvec4 textures;        // 16: base texture, its texCoord, emissive texture, its texCoord
+};
+
+// 16 bytes, total: 16 bytes
+struct GpuTexture {
+  uint firstTexel;  // 4: into the texel buffer, RGBA8 sRGB
+  uint width;       // 4
+  uint height;      // 4
+  uint flags;       // 4: bits 0-1 wrap S, 2-3 wrap T, 4 nearest
+};
+
+// 64 bytes, total: 64 bytes
+struct GpuLight {
+  vec4 positionType;  // 16: camera-relative position, w: kLight* as float
+  vec4 direction;     // 16: the way the light shines (unit), w: range (0: infinite)
+  vec4 radiance;      // 16: colour * intensity, w unused
+  vec4 cone;          // 16: cos inner, cos outer, unused, unused
+};
+
+// Per-pixel outputs for tests and tools, written when TracePush::flags has kTraceFlagAov.
+// 32 bytes, total: 32 bytes
+struct TraceAov {
+  float distance;   // 4: to the first hit along the unit primary ray; -1 on a miss
+  uint instance;    // 4: draw item of the first hit, kNoHit on a miss
+  uint primitive;   // 4: triangle within that item's shape, kNoHit on a miss
+  uint interfaces;  // 4: refractive faces crossed
+  uint outcome;     // 4: kOutcome*
+  uint nodeVisits;  // 4: BVH nodes visited over the whole path (the cost heat map)
+  uint pad0;        // 4
+  uint pad1;        // 4
+};
+
+SNELL_CONST kNoHit = 0xffffffffu;
+SNELL_CONST kTraceFlagAov = 1u;
+SNELL_CONST kTraceFlagOrthographic = 2u;
+SNELL_CONST kTraceTile = 8;  // pixels per side of one workgroup's tile
+// Nodes one ray segment may visit before it gives up: a corrupted tree ends here.
+SNELL_CONST kTraceMaxVisits = 1u << 20;
+
+// Binding slots of set 0.
+SNELL_CONST kTraceBindingTlasNodes = 0;
+SNELL_CONST kTraceBindingTlasGroups = 1;
+SNELL_CONST kTraceBindingInstances = 2;
+SNELL_CONST kTraceBindingBlasNodes = 3;
+SNELL_CONST kTraceBindingBlasGroups = 4;
+SNELL_CONST kTraceBindingPositions = 5;   // float[3 * vertexCount]
+SNELL_CONST kTraceBindingNormals = 6;     // float[3 * vertexCount]
+SNELL_CONST kTraceBindingTexcoords = 7;   // vec4[vertexCount]: uv0, uv1
+SNELL_CONST kTraceBindingIndices = 8;     // uint[3 * triangleCount], absolute
+SNELL_CONST kTraceBindingMaterials = 9;   // GpuMaterial[]
+SNELL_CONST kTraceBindingTextures = 10;   // GpuTexture[]
+SNELL_CONST kTraceBindingTexels = 11;     // uint[]: RGBA8
+SNELL_CONST kTraceBindingLights = 12;     // GpuLight[]
+SNELL_CONST kTraceBindingImage = 13;      // rgba16f storage image
+SNELL_CONST kTraceBindingAov = 14;        // TraceAov[width * height]
+
+// Rays start at the camera: the scene is rebased to camera-relative coordinates.
+// 96 bytes, total: 96 bytes
+struct TracePush {
+  vec4 right;       // 16: xyz; w: half width of the view at unit distance (or of the ortho view)
+  vec4 up;          // 16: xyz; w: half height
+  vec4 forward;     // 16: xyz; w unused
+  vec4 background;  // 16: rgb; w unused
+  uint width;       // 4
+  uint height;      // 4
+  uint maxInterfaces;  // 4
+  uint lightCount;  // 4: 0: the headlight
+  uint flags;       // 4: kTraceFlag*
+  uint tilesX;      // 4: tiles per row
+  uint pad0;        // 4
+  uint pad1;        // 4
+};
+
+SNELL_GPU_END
+#endif

@@ -1,0 +1,155 @@
+// `snell bench bvh`: how good the GPU's LBVH trees are, as SAH cost against a
+// CPU binned-SAH build of the very same triangles (src/ref), per mesh.
+#include "cli/cli.h"
+
+#include "ref/sah_bvh.h"
+#include "render/renderer.h"
+#include "scene/evaluate.h"
+#include "scene/gltf_loader.h"
+#include "scene/procedural_eye.h"
+#include "scene/view.h"
+#include "vk/commands.h"
+
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+
+namespace snell::cli {
+
+namespace {
+
+constexpr const char* kHelp = R"(usage: snell bench bvh [SCENE.glb ...] [--json FILE] [--eye-resolution N]
+
+Builds every bottom-level tree of each scene on the GPU (the procedural eye
+first, then the files given) and prices it with the surface area heuristic
+(Ct = 1 per internal node, Ci = 1 per triangle, one triangle per leaf), next to
+a CPU binned-SAH tree (32 bins) over the same triangles. ratio = GPU / CPU:
+1.0 is as good as binned SAH, higher is worse.
+)";
+
+struct Row {
+  std::string scene, mesh;
+  uint32_t triangles = 0;
+  double gpuCost = 0, cpuCost = 0;
+  double ratio() const { return cpuCost > 0 ? gpuCost / cpuCost : 1.0; }
+};
+
+ref::Aabb box(const float* lo, const float* hi) {
+  ref::Aabb b;
+  b.lo = {lo[0], lo[1], lo[2]};
+  b.hi = {hi[0], hi[1], hi[2]};
+  return b;
+}
+
+void measure(vk::Context& context, const scene::Scene& scene, const std::string& label, std::vector<Row>& rows) {
+  scene::Pose pose = scene::evaluate(scene, 0.0);
+  render::Renderer renderer(context, scene, pose);
+  // One small frame builds the trees from the deformed positions.
+  render::FrameSettings settings{8, 8, scene::resolveView(scene, pose, {}), {}, gpu::kDefaultMaxInterfaces};
+  render::renderFrame(context, renderer, pose, settings);
+  render::BvhSnapshot snapshot = renderer.builder().download(renderer.blas());
+  const render::SceneGpu& gpuScene = renderer.sceneGpu();
+  std::vector<float> positions(size_t(gpuScene.vertexCount) * 3);
+  std::vector<uint32_t> indices(size_t(gpuScene.triangleCount) * 3);
+  vk::download(context, gpuScene.positions, positions.data(), positions.size() * 4);
+  vk::download(context, gpuScene.indices, indices.data(), indices.size() * 4);
+
+  for (size_t g = 0; g < gpuScene.geometries.size(); ++g) {
+    const render::GeometryRange& range = gpuScene.geometries[g];
+    if (range.triangleCount < 2) continue;
+    std::vector<ref::Aabb> triangles;
+    for (uint32_t t = range.firstTriangle; t < range.firstTriangle + range.triangleCount; ++t) {
+      ref::Aabb b;
+      for (int k = 0; k < 3; ++k) {
+        const float* p = &positions[3 * size_t(indices[3 * size_t(t) + size_t(k)])];
+        b.extend(glm::dvec3(p[0], p[1], p[2]));
+      }
+      triangles.push_back(b);
+    }
+    // The GPU tree's boxes: every internal node's child slots, split into internal and leaf boxes.
+    const gpu::BvhGroup& group = snapshot.groups[g];
+    std::vector<ref::Aabb> internalBoxes{box(group.boxLo, group.boxHi)}, leafBoxes;
+    std::vector<uint32_t> stack;
+    if (!(group.root & gpu::kBvhLeafBit) && group.root != gpu::kBvhNone) stack.push_back(group.root);
+    while (!stack.empty() && internalBoxes.size() <= snapshot.nodes.size()) {
+      const gpu::BvhNode& node = snapshot.nodes.at(stack.back());
+      stack.pop_back();
+      for (int c = 0; c < 2; ++c) {
+        ref::Aabb b = box(&node.box[6 * c], &node.box[6 * c + 3]);
+        if (node.child[c] & gpu::kBvhLeafBit) {
+          leafBoxes.push_back(b);
+        } else {
+          internalBoxes.push_back(b);
+          stack.push_back(node.child[c]);
+        }
+      }
+    }
+    Row row;
+    row.scene = label;
+    row.mesh = scene.shapes[size_t(range.shape)].name;
+    row.triangles = range.triangleCount;
+    row.gpuCost = ref::sahCost(internalBoxes, leafBoxes, internalBoxes.front());
+    row.cpuCost = ref::binnedSahCost(triangles);
+    rows.push_back(row);
+  }
+}
+
+}  // namespace
+
+int runBenchBvh(const Args& args) {
+  std::vector<std::string> files;
+  std::string json;
+  uint32_t eyeResolution = 64;
+  for (size_t i = 0; i < args.size(); ++i) {
+    const std::string& a = args[i];
+    if (a == "--help" || a == "-h") {
+      std::fputs(kHelp, stdout);
+      return 0;
+    }
+    if (a == "--json" || a == "--eye-resolution") {
+      if (i + 1 >= args.size()) throw UsageError{"bench bvh: " + a + " needs a value"};
+      if (a == "--json") json = args[++i];
+      else eyeResolution = uint32_t(parseCount(a, args[++i]));
+    } else if (!a.empty() && a[0] == '-') {
+      throw UsageError{"bench bvh: unknown option " + a};
+    } else {
+      files.push_back(a);
+    }
+  }
+  auto context = vk::Context::create(contextDescFromEnvironment());
+  std::printf("device: %s\n", context->facts().name.c_str());
+  std::vector<Row> rows;
+  scene::EyeOptions eye;
+  eye.resolution = eyeResolution;
+  measure(*context, scene::makeEye(eye), "eye (resolution " + std::to_string(eyeResolution) + ")", rows);
+  for (const std::string& f : files) {
+    scene::LoadOptions load;
+    load.ignoredExtensions = {"KHR_materials_iridescence"};
+    measure(*context, scene::loadGltf(f, load), std::filesystem::path(f).stem().string(), rows);
+  }
+
+  std::printf("%-28s %-28s %9s %10s %10s %7s\n", "scene", "mesh", "triangles", "GPU SAH", "CPU SAH", "ratio");
+  double worst = 0;
+  for (const Row& r : rows) {
+    std::printf("%-28.28s %-28.28s %9u %10.2f %10.2f %7.3f\n", r.scene.c_str(), r.mesh.c_str(), r.triangles, r.gpuCost,
+                r.cpuCost, r.ratio());
+    worst = std::max(worst, r.ratio());
+  }
+  std::printf("worst ratio %.3f\n", worst);
+  if (!json.empty()) {
+    std::ofstream out(json);
+    out << "{\n  \"device\": \"" << context->facts().name << "\",\n  \"meshes\": [\n";
+    for (size_t i = 0; i < rows.size(); ++i) {
+      const Row& r = rows[i];
+      out << "    {\"scene\": \"" << r.scene << "\", \"mesh\": \"" << r.mesh << "\", \"triangles\": " << r.triangles
+          << ", \"gpu_sah\": " << r.gpuCost << ", \"cpu_binned_sah\": " << r.cpuCost << ", \"ratio\": " << r.ratio()
+          << "}" << (i + 1 < rows.size() ? "," : "") << "\n";
+    }
+    out << "  ],\n  \"worst_ratio\": " << worst << "\n}\n";
+    if (!out) throw std::runtime_error(json + ": could not write");
+  }
+  return 0;
+}
+
+}  // namespace snell::cli

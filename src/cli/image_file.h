@@ -1,0 +1,36 @@
+// Image files through OpenImageIO: PNG (8-bit sRGB) and EXR (half, linear),
+// written atomically so a failed or interrupted write leaves nothing behind.
+#pragma once
+
+#include <glm/glm.hpp>
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace snell::cli {
+
+struct LinearImage {
+  uint32_t width = 0, height = 0;
+  std::vector<glm::vec4> rgba;  ///< linear, row 0 at the top
+};
+
+/// Encodes linear [0, 1] to 8-bit sRGB, rounding to nearest.
+uint8_t linearToSrgb8(float linear);
+
+/// Writes `image` to `path` (format from the extension: .png or .exr): into a
+/// temporary file beside it, renamed into place once complete. Throws
+/// std::runtime_error naming the file and the problem; leaves no file then.
+void writeImage(const std::string& path, const LinearImage& image);
+
+/// Reads an 8-bit-per-channel image (a golden PNG) as RGB bytes.
+struct Rgb8Image {
+  uint32_t width = 0, height = 0;
+  std::vector<uint8_t> rgb;
+};
+Rgb8Image readRgb8(const std::string& path);
+void writeRgb8(const std::string& path, const Rgb8Image& image);
+/// The image as 8-bit sRGB, as writeImage would put it in a PNG.
+Rgb8Image toSrgb8(const LinearImage& image);
+
+}  // namespace snell::cli

@@ -1,0 +1,250 @@
+// `snell render SCENE -o OUT.png|OUT.exr`: headless frames of a glTF scene,
+// traced on the GPU (or by the CPU reference with --reference).
+#include "cli/cli.h"
+
+#include "cli/image_file.h"
+#include "ref/reference_tracer.h"
+#include "render/renderer.h"
+#include "scene/evaluate.h"
+#include "scene/gltf_loader.h"
+#include "scene/procedural_eye.h"
+#include "scene/view.h"
+#include "vk/context.h"
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <sstream>
+
+namespace snell::cli {
+
+namespace {
+
+constexpr const char* kHelp = R"(usage: snell render SCENE.glb|SCENE.gltf|--eye -o OUT.png|OUT.exr [options]
+
+Ray traces the scene on the GPU: one ray per pixel, refracted through every
+transmissive face (KHR_materials_transmission, KHR_materials_ior), Phong-shaded
+where it lands. PNG is written as 8-bit sRGB, EXR as linear half floats. The
+file appears only once it is complete.
+
+options:
+  -o, --output FILE      the image to write (required); with --frames, '#'s in
+                         the name become the frame number, else it is added
+                         before the extension (out.0012.png)
+  --eye                  render the procedural eye instead of a file
+  --size WxH             image size in pixels (default 640x480)
+  --camera N             the scene's glTF camera N (default: camera 0, or a view
+                         framing the whole scene when it has none)
+  --look-at EX,EY,EZ,TX,TY,TZ   camera at E looking at T, +Y up (overrides --camera)
+  --fov DEGREES          vertical field of view for --look-at and framed views (40)
+  --time T               seconds into the animation (default 0)
+  --frames A:B           frames A to B inclusive at --fps (default 24), with progress
+  --fps N                frames per second for --frames
+  --max-interfaces N     refractive faces a ray may cross (default 8)
+  --background R,G,B     linear colour of misses (default 0.02,0.02,0.025)
+  --scene NAME|INDEX     which glTF scene of the file
+  --ignore-extension E   load a file that requires extension E anyway
+  --reference            render with the CPU double-precision reference instead
+                         of the GPU (slow; golden images are made this way)
+)";
+
+struct Options {
+  std::string input;
+  bool eye = false;
+  std::string output;
+  uint32_t width = 640, height = 480;
+  scene::ViewRequest view;
+  double time = 0.0;
+  bool frames = false;
+  long firstFrame = 0, lastFrame = 0;
+  double fps = 24.0;
+  uint32_t maxInterfaces = gpu::kDefaultMaxInterfaces;
+  glm::vec3 background{0.02f, 0.02f, 0.025f};
+  scene::LoadOptions load;
+  bool reference = false;
+};
+
+std::vector<double> parseNumbers(const std::string& option, const std::string& value, size_t count) {
+  std::vector<double> numbers;
+  std::stringstream in(value);
+  std::string part;
+  while (std::getline(in, part, ',')) {
+    char* end = nullptr;
+    double v = std::strtod(part.c_str(), &end);
+    if (part.empty() || *end != '\0' || !std::isfinite(v)) break;
+    numbers.push_back(v);
+  }
+  if (numbers.size() != count || std::count(value.begin(), value.end(), ',') != long(count - 1)) {
+    throw UsageError{option + " expects " + std::to_string(count) + " comma-separated numbers, got '" + value + "'"};
+  }
+  return numbers;
+}
+
+Options parse(const Args& args) {
+  Options o;
+  for (size_t i = 0; i < args.size(); ++i) {
+    const std::string& a = args[i];
+    if (a == "--eye") { o.eye = true; continue; }
+    if (a == "--reference") { o.reference = true; continue; }
+    if (!a.empty() && a[0] != '-') {
+      if (!o.input.empty()) throw UsageError{"render: more than one scene given ('" + o.input + "', '" + a + "')"};
+      o.input = a;
+      continue;
+    }
+    if (i + 1 >= args.size()) throw UsageError{"render: " + a + " needs a value (or is unknown)"};
+    const std::string& v = args[++i];
+    if (a == "-o" || a == "--output") {
+      o.output = v;
+    } else if (a == "--size") {
+      size_t x = v.find('x');
+      if (x == std::string::npos) throw UsageError{"--size expects WxH, e.g. 640x480, got '" + v + "'"};
+      unsigned long long w = parseCount("--size", v.substr(0, x)), h = parseCount("--size", v.substr(x + 1));
+      if (w == 0 || h == 0 || w > 65536 || h > 65536) throw UsageError{"--size " + v + " is out of range (1x1 to 65536x65536)"};
+      o.width = uint32_t(w);
+      o.height = uint32_t(h);
+    } else if (a == "--camera") {
+      o.view.camera = int(parseCount(a, v));
+    } else if (a == "--look-at") {
+      std::vector<double> n = parseNumbers(a, v, 6);
+      o.view.lookAt = scene::LookAt{{n[0], n[1], n[2]}, {n[3], n[4], n[5]}, {0.0, 1.0, 0.0}};
+    } else if (a == "--fov") {
+      double deg = parseNumbers(a, v, 1)[0];
+      if (!(deg > 0.0 && deg < 180.0)) throw UsageError{"--fov must be between 0 and 180 degrees, got " + v};
+      o.view.yfov = deg * 3.14159265358979 / 180.0;
+    } else if (a == "--time") {
+      o.time = parseNumbers(a, v, 1)[0];
+    } else if (a == "--frames") {
+      size_t colon = v.find(':');
+      if (colon == std::string::npos) throw UsageError{"--frames expects A:B, e.g. 1:48, got '" + v + "'"};
+      o.firstFrame = long(parseCount("--frames", v.substr(0, colon)));
+      o.lastFrame = long(parseCount("--frames", v.substr(colon + 1)));
+      if (o.lastFrame < o.firstFrame) throw UsageError{"--frames " + v + ": the last frame comes before the first"};
+      o.frames = true;
+    } else if (a == "--fps") {
+      o.fps = parseNumbers(a, v, 1)[0];
+      if (!(o.fps > 0.0)) throw UsageError{"--fps must be positive, got " + v};
+    } else if (a == "--max-interfaces") {
+      o.maxInterfaces = uint32_t(std::min<unsigned long long>(parseCount(a, v), 1024));
+    } else if (a == "--background") {
+      std::vector<double> n = parseNumbers(a, v, 3);
+      o.background = glm::vec3(glm::dvec3(n[0], n[1], n[2]));
+    } else if (a == "--scene") {
+      o.load.scene = v;
+    } else if (a == "--ignore-extension") {
+      o.load.ignoredExtensions.push_back(v);
+    } else {
+      throw UsageError{"render: unknown option " + a};
+    }
+  }
+  if (o.input.empty() && !o.eye) throw UsageError{"render: give a scene file (or --eye)"};
+  if (!o.input.empty() && o.eye) throw UsageError{"render: give a scene file or --eye, not both"};
+  if (o.output.empty()) throw UsageError{"render: give the output image with -o FILE.png or FILE.exr"};
+  std::string ext = std::filesystem::path(o.output).extension().string();
+  if (ext != ".png" && ext != ".exr" && ext != ".PNG" && ext != ".EXR") {
+    throw UsageError{"render: the output must end in .png or .exr, got '" + o.output + "'"};
+  }
+  return o;
+}
+
+std::string framePath(const std::string& pattern, long frame) {
+  size_t first = pattern.find('#');
+  if (first != std::string::npos) {
+    size_t last = pattern.find_first_not_of('#', first);
+    size_t width = (last == std::string::npos ? pattern.size() : last) - first;
+    std::string number = std::to_string(frame);
+    if (number.size() < width) number.insert(0, width - number.size(), '0');
+    return pattern.substr(0, first) + number + pattern.substr(first + width);
+  }
+  std::filesystem::path p(pattern);
+  char number[32];
+  std::snprintf(number, sizeof number, ".%04ld", frame);
+  return (p.parent_path() / (p.stem().string() + number + p.extension().string())).string();
+}
+
+void progress(long done, long total, double seconds) {
+  const int width = 30;
+  int filled = int(width * done / std::max(total, 1L));
+  std::fprintf(stderr, "\r[%.*s%.*s] %ld/%ld frames, %.1f s", filled, "##############################", width - filled,
+               "..............................", done, total, seconds);
+  if (done == total) std::fputc('\n', stderr);
+  std::fflush(stderr);
+}
+
+}  // namespace
+
+int runRender(const Args& args) {
+  for (const std::string& a : args) {
+    if (a == "--help" || a == "-h") {
+      std::fputs(kHelp, stdout);
+      return 0;
+    }
+  }
+  Options o = parse(args);
+  scene::Scene scene = o.eye ? scene::makeEye() : scene::loadGltf(o.input, o.load);
+  if (o.eye) scene.source = "procedural eye";
+  for (const std::string& w : scene.warnings) std::fprintf(stderr, "snell: note: %s\n", w.c_str());
+
+  std::vector<std::pair<long, double>> frames;  // (frame number, time)
+  if (o.frames) {
+    for (long f = o.firstFrame; f <= o.lastFrame; ++f) frames.emplace_back(f, double(f) / o.fps);
+  } else {
+    frames.emplace_back(0, o.time);
+  }
+
+  scene::Pose layout = scene::evaluate(scene, frames.front().second);
+  std::unique_ptr<vk::Context> context;
+  std::unique_ptr<render::Renderer> renderer;
+  if (!o.reference) {
+    context = vk::Context::create(contextDescFromEnvironment());
+    try {
+      render::checkImageSize(*context, o.width, o.height);
+    } catch (const std::invalid_argument& e) {
+      throw UsageError{std::string("render: ") + e.what()};
+    }
+    renderer = std::make_unique<render::Renderer>(*context, scene, layout);
+  }
+
+  auto start = std::chrono::steady_clock::now();
+  for (size_t i = 0; i < frames.size(); ++i) {
+    scene::Pose pose = i == 0 ? layout : scene::evaluate(scene, frames[i].second);
+    scene::View view;
+    try {
+      view = scene::resolveView(scene, pose, o.view);
+    } catch (const std::invalid_argument& e) {
+      throw UsageError{std::string("render: ") + e.what()};
+    }
+    LinearImage image{o.width, o.height, {}};
+    if (o.reference) {
+      ref::ReferenceSettings settings;
+      settings.width = o.width;
+      settings.height = o.height;
+      settings.view = view;
+      settings.background = glm::dvec3(o.background);
+      settings.maxInterfaces = o.maxInterfaces;
+      ref::ReferenceImage r = ref::renderReference(scene, pose, settings);
+      image.rgba.reserve(r.color.size());
+      for (const glm::dvec3& c : r.color) image.rgba.emplace_back(glm::vec3(c), 1.0f);
+    } else {
+      render::FrameSettings settings{o.width, o.height, view, o.background, o.maxInterfaces};
+      image.rgba = render::renderFrame(*context, *renderer, pose, settings).rgba;
+    }
+    std::string path = o.frames ? framePath(o.output, frames[i].first) : o.output;
+    writeImage(path, image);
+    double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    if (frames.size() > 1) {
+      progress(long(i + 1), long(frames.size()), seconds);
+    } else {
+      std::printf("wrote %s: %ux%u, %s, %s, %.2f s\n", path.c_str(), o.width, o.height, view.description.c_str(),
+                  o.reference ? "CPU reference" : context->facts().name.c_str(), seconds);
+    }
+  }
+  if (context && context->validationMessageCount() > 0) {
+    std::fprintf(stderr, "snell: the validation layer reported %llu message(s)\n",
+                 static_cast<unsigned long long>(context->validationMessageCount()));
+    return 1;
+  }
+  return 0;
+}
+
+}  // namespace snell::cli

@@ -1,0 +1,624 @@
+// The reference tracer: world-space triangles in double, a median-split BVH,
+// and the refraction and shading rules of shaders/shared/trace.h, one
+// std::thread per share of the rows.
+#include "ref/reference_tracer.h"
+
+#include "ref/sah_bvh.h"
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <limits>
+#include <thread>
+
+namespace snell::ref {
+
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+constexpr double kInfinity = std::numeric_limits<double>::infinity();
+// A secondary ray starts on the face it leaves; besides that face (excluded
+// by id), it ignores hits closer than this fraction of the larger of its
+// origin's magnitude and the scene's size, which is far above double
+// rounding of the hit point (~1e-16 relative) and far below any feature.
+constexpr double kSecondaryEpsilon = 1e-9;
+constexpr uint32_t kLeafSize = 4;
+
+// The contract's constants are floats; the reference uses exactly those values.
+constexpr double kAmbient = double(gpu::kAmbient);
+constexpr double kSpecular = double(gpu::kSpecular);
+constexpr double kShininess = double(gpu::kShininess);
+constexpr double kHeadlight = double(gpu::kHeadlight);
+
+double maxAbs(const glm::dvec3& v) { return std::max({std::abs(v.x), std::abs(v.y), std::abs(v.z)}); }
+
+bool finite(const glm::dvec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
+
+/// The unit vector along v, or zero when v has no usable length.
+glm::dvec3 unitOrZero(const glm::dvec3& v) {
+  double length = glm::length(v);
+  return length > 0.0 && std::isfinite(length) ? v / length : glm::dvec3(0.0);
+}
+
+// ---------------------------------------------------------------------------
+// Textures
+
+/// A texture decoded once to linear RGB (sRGB decode per texel, before filtering).
+struct LinearTexture {
+  uint32_t width = 0, height = 0;
+  std::vector<glm::dvec3> texels;  // row 0 is the image's first row
+  uint32_t wrapS = gpu::kWrapRepeat, wrapT = gpu::kWrapRepeat;
+  bool nearest = false;
+};
+
+double srgbToLinear(uint8_t value) {
+  double c = double(value) / 255.0;
+  return c <= 0.04045 ? c / 12.92 : std::pow((c + 0.055) / 1.055, 2.4);
+}
+
+uint32_t wrapMode(bool repeat, bool mirror) {
+  if (mirror) return gpu::kWrapMirror;
+  return repeat ? gpu::kWrapRepeat : gpu::kWrapClamp;
+}
+
+LinearTexture decode(const scene::Texture& t) {
+  LinearTexture out;
+  const size_t count = size_t(t.width) * t.height;
+  if (count == 0 || t.rgba.size() < count * 4) return out;  // unusable: sampled as white
+  double table[256];
+  for (int v = 0; v < 256; ++v) table[v] = srgbToLinear(uint8_t(v));
+  out.width = t.width;
+  out.height = t.height;
+  out.texels.resize(count);
+  for (size_t i = 0; i < count; ++i) {
+    out.texels[i] = {table[t.rgba[i * 4 + 0]], table[t.rgba[i * 4 + 1]], table[t.rgba[i * 4 + 2]]};
+  }
+  out.wrapS = wrapMode(t.repeatS, t.mirrorS);
+  out.wrapT = wrapMode(t.repeatT, t.mirrorT);
+  out.nearest = !t.linearFilter;
+  return out;
+}
+
+int64_t wrapIndex(int64_t i, int64_t n, uint32_t mode) {
+  if (mode == gpu::kWrapClamp) return std::clamp<int64_t>(i, 0, n - 1);
+  if (mode == gpu::kWrapMirror) {
+    int64_t m = ((i % (2 * n)) + 2 * n) % (2 * n);
+    return m < n ? m : 2 * n - 1 - m;
+  }
+  return ((i % n) + n) % n;
+}
+
+/// floor(x) as an integer; NaN and huge values are kept in a range where the
+/// conversion is defined (they only arise from broken texture coordinates).
+int64_t floorIndex(double x) {
+  if (!(x == x)) return 0;
+  return int64_t(std::floor(std::clamp(x, -1e15, 1e15)));
+}
+
+glm::dvec3 sample(const LinearTexture& t, const glm::dvec2& uv) {
+  const int64_t w = t.width, h = t.height;
+  auto texel = [&](int64_t x, int64_t y) {
+    return t.texels[size_t(wrapIndex(y, h, t.wrapT) * w + wrapIndex(x, w, t.wrapS))];
+  };
+  if (t.nearest) return texel(floorIndex(uv.x * double(w)), floorIndex(uv.y * double(h)));
+  double x = uv.x * double(w) - 0.5, y = uv.y * double(h) - 0.5;
+  int64_t x0 = floorIndex(x), y0 = floorIndex(y);
+  double fx = std::clamp(x - double(x0), 0.0, 1.0), fy = std::clamp(y - double(y0), 0.0, 1.0);
+  glm::dvec3 top = glm::mix(texel(x0, y0), texel(x0 + 1, y0), fx);
+  glm::dvec3 bottom = glm::mix(texel(x0, y0 + 1), texel(x0 + 1, y0 + 1), fx);
+  return glm::mix(top, bottom, fy);
+}
+
+// ---------------------------------------------------------------------------
+// Materials and lights
+
+struct TextureUse {
+  const LinearTexture* texture = nullptr;  // null: white
+  int texCoord = 0;
+  glm::dmat3 transform{1.0};
+};
+
+struct ResolvedMaterial {
+  glm::dvec3 baseFactor{1.0};
+  glm::dvec3 emissiveFactor{0.0};
+  TextureUse base, emissive;
+  bool refractive = false;
+  double ior = 1.5;
+};
+
+struct ResolvedLight {
+  scene::LightType type = scene::LightType::Directional;
+  glm::dvec3 position{0.0};
+  glm::dvec3 direction{0.0, 0.0, -1.0};  // the way it shines, unit
+  glm::dvec3 radiance{0.0};              // colour * intensity
+  double range = kInfinity;
+  double cosInner = 1.0, cosOuter = 0.0;
+};
+
+// ---------------------------------------------------------------------------
+// Geometry
+
+/// What shading needs of a triangle; intersection reads the compact Edges.
+struct TriangleData {
+  glm::dvec3 v[3];
+  glm::dvec3 n[3];   // world, unit, or zero where the shape has none
+  glm::dvec2 uv[2][3];  // TEXCOORD_0 and _1, (0, 0) where missing
+  glm::dvec3 ng;     // unit geometric normal
+  int32_t item = -1, primitive = -1;
+  int material = -1;
+};
+
+struct Edges {
+  glm::dvec3 v0, e1, e2;
+};
+
+struct BvhNode {
+  Aabb box;
+  uint32_t first = 0;  // leaf: first triangle; internal: first of two adjacent children
+  uint32_t count = 0;  // triangles in a leaf; 0 for an internal node
+};
+
+struct Hit {
+  double t = kInfinity;
+  uint32_t triangle = std::numeric_limits<uint32_t>::max();
+  double b1 = 0.0, b2 = 0.0;
+  bool found() const { return triangle != std::numeric_limits<uint32_t>::max(); }
+};
+
+class PreparedScene {
+ public:
+  PreparedScene(const scene::Scene& scene, const scene::Pose& pose, const scene::View& view);
+
+  /// The closest triangle with tMin < t, other than `excluded`. Equal
+  /// distances go to the triangle stored first, so that the answer does not
+  /// depend on the traversal order (nor on the thread count).
+  Hit intersect(const glm::dvec3& origin, const glm::dvec3& direction, double tMin, uint32_t excluded) const;
+
+  const TriangleData& triangle(uint32_t i) const { return data_[i]; }
+  const ResolvedMaterial& material(int index) const {
+    return index >= 0 && size_t(index) < materials_.size() ? materials_[size_t(index)] : defaultMaterial_;
+  }
+  const std::vector<ResolvedLight>& lights() const { return lights_; }
+  double size() const { return size_; }
+
+ private:
+  void addItem(const scene::Scene& scene, const scene::DrawItem& item, int32_t itemIndex);
+  void buildBvh();
+
+  std::vector<TriangleData> data_;
+  std::vector<Edges> edges_;
+  std::vector<BvhNode> nodes_;
+  std::vector<LinearTexture> textures_;
+  std::vector<ResolvedMaterial> materials_;
+  ResolvedMaterial defaultMaterial_;  // white, opaque
+  std::vector<ResolvedLight> lights_;
+  double size_ = 0.0;  // the largest extent of the geometry's bounds
+};
+
+PreparedScene::PreparedScene(const scene::Scene& scene, const scene::Pose& pose, const scene::View& view) {
+  textures_.reserve(scene.textures.size());
+  for (const scene::Texture& t : scene.textures) textures_.push_back(decode(t));
+  auto use = [&](const scene::TextureRef& ref) {
+    TextureUse u;
+    if (ref.texture >= 0 && size_t(ref.texture) < textures_.size() && !textures_[size_t(ref.texture)].texels.empty()) {
+      u.texture = &textures_[size_t(ref.texture)];
+    }
+    u.texCoord = ref.texCoord;
+    u.transform = glm::dmat3(ref.transform);
+    return u;
+  };
+  for (const scene::Material& m : scene.materials) {
+    ResolvedMaterial r;
+    r.baseFactor = glm::dvec3(glm::vec3(m.baseColorFactor));
+    r.emissiveFactor = glm::dvec3(m.emissiveFactor);
+    r.base = use(m.baseColorTexture);
+    r.emissive = use(m.emissiveTexture);
+    r.refractive = m.refractive();
+    r.ior = double(m.ior);
+    materials_.push_back(r);
+  }
+
+  for (size_t n = 0; n < scene.nodes.size() && n < pose.world.size(); ++n) {
+    int index = scene.nodes[n].light;
+    if (index < 0 || size_t(index) >= scene.lights.size()) continue;
+    const scene::Light& light = scene.lights[size_t(index)];
+    glm::dmat4 m(pose.world[n]);
+    ResolvedLight r;
+    r.type = light.type;
+    r.position = glm::dvec3(m[3]);
+    r.direction = -unitOrZero(glm::dvec3(m[2]));  // glTF lights shine down their node's -Z
+    r.radiance = glm::dvec3(light.color) * double(light.intensity);
+    r.range = light.range > 0.0f && std::isfinite(light.range) ? double(light.range) : kInfinity;
+    r.cosInner = std::cos(double(light.innerConeAngle));
+    r.cosOuter = std::cos(double(light.outerConeAngle));
+    lights_.push_back(r);
+  }
+  if (lights_.empty()) {
+    ResolvedLight headlight;
+    headlight.type = scene::LightType::Directional;
+    headlight.direction = unitOrZero(view.forward);
+    headlight.radiance = glm::dvec3(kHeadlight);
+    lights_.push_back(headlight);
+  }
+
+  for (size_t i = 0; i < pose.items.size(); ++i) addItem(scene, pose.items[i], int32_t(i));
+  buildBvh();
+}
+
+void PreparedScene::addItem(const scene::Scene& scene, const scene::DrawItem& item, int32_t itemIndex) {
+  if (item.shape < 0 || size_t(item.shape) >= scene.shapes.size()) return;
+  const scene::Shape& shape = scene.shapes[size_t(item.shape)];
+  const size_t vertices = shape.vertexCount();
+
+  std::vector<glm::dvec3> positions, normals;
+  if (item.deforms()) {
+    if (shape.normals.size() == vertices) {
+      scene::deformOnCpu(item, positions, normals);
+    } else {
+      // deformOnCpu reads a normal per vertex; give it zeros (shading falls back to Ng).
+      scene::Scene scratch;
+      scratch.shapes.push_back(shape);
+      scratch.shapes[0].normals.assign(vertices, glm::vec3(0.0f));
+      scene::DrawItem copy = item;
+      copy.scene = &scratch;
+      copy.shape = 0;
+      scene::deformOnCpu(copy, positions, normals);
+    }
+  } else {
+    positions.assign(shape.positions.begin(), shape.positions.end());
+    normals.assign(vertices, glm::dvec3(0.0));
+    if (shape.normals.size() == vertices) normals.assign(shape.normals.begin(), shape.normals.end());
+  }
+
+  const glm::dmat4 world(item.world);
+  const glm::dmat3 normalMatrix = glm::transpose(glm::inverse(glm::dmat3(world)));
+  for (size_t v = 0; v < vertices; ++v) {
+    positions[v] = glm::dvec3(world * glm::dvec4(positions[v], 1.0));
+    // Vertex normals are unit in world space before they are interpolated;
+    // a non-uniform scale would otherwise weight them unevenly.
+    normals[v] = unitOrZero(normalMatrix * normals[v]);
+  }
+  auto texcoords = [&](const std::vector<glm::vec2>& set, uint32_t v) {
+    return set.size() == vertices ? glm::dvec2(set[v]) : glm::dvec2(0.0);
+  };
+
+  for (size_t t = 0; t < shape.triangleCount(); ++t) {
+    const uint32_t* index = &shape.indices[t * 3];
+    if (index[0] >= vertices || index[1] >= vertices || index[2] >= vertices) continue;
+    TriangleData d;
+    for (int k = 0; k < 3; ++k) {
+      d.v[k] = positions[index[k]];
+      d.n[k] = normals[index[k]];
+      d.uv[0][k] = texcoords(shape.texcoords0, index[k]);
+      d.uv[1][k] = texcoords(shape.texcoords1, index[k]);
+    }
+    if (!finite(d.v[0]) || !finite(d.v[1]) || !finite(d.v[2])) continue;
+    glm::dvec3 e1 = d.v[1] - d.v[0], e2 = d.v[2] - d.v[0];
+    d.ng = unitOrZero(glm::cross(e1, e2));
+    if (d.ng == glm::dvec3(0.0)) continue;  // no area: never hit
+    d.item = itemIndex;
+    d.primitive = int32_t(t);
+    d.material = shape.material;
+    data_.push_back(d);
+  }
+}
+
+void PreparedScene::buildBvh() {
+  const uint32_t count = uint32_t(data_.size());
+  std::vector<Aabb> boxes(count);
+  std::vector<glm::dvec3> centroids(count);
+  Aabb all;
+  for (uint32_t i = 0; i < count; ++i) {
+    for (const glm::dvec3& v : data_[i].v) boxes[i].extend(v);
+    // Padding keeps the slab test conservative where a hit lies on the
+    // box's face and rounding would put the ray a hair outside it.
+    double pad = 1e-9 * std::max(maxAbs(boxes[i].lo), maxAbs(boxes[i].hi));
+    boxes[i].lo -= pad;
+    boxes[i].hi += pad;
+    centroids[i] = boxes[i].centroid();
+    all.extend(boxes[i]);
+  }
+  size_ = count ? maxAbs(all.hi - all.lo) : 0.0;
+
+  std::vector<uint32_t> order(count);
+  for (uint32_t i = 0; i < count; ++i) order[i] = i;
+  nodes_.clear();
+  nodes_.push_back({});
+  struct Task {
+    uint32_t node, begin, end;
+  };
+  std::vector<Task> work{{0, 0, count}};
+  while (!work.empty()) {
+    Task task = work.back();
+    work.pop_back();
+    Aabb box, centres;
+    for (uint32_t i = task.begin; i < task.end; ++i) {
+      box.extend(boxes[order[i]]);
+      centres.extend(centroids[order[i]]);
+    }
+    nodes_[task.node].box = box;
+    if (task.end - task.begin <= kLeafSize) {
+      nodes_[task.node].first = task.begin;
+      nodes_[task.node].count = task.end - task.begin;
+      continue;
+    }
+    // Median split on the axis where the centroids spread the most.
+    glm::dvec3 extent = centres.hi - centres.lo;
+    int axis = extent.x >= extent.y && extent.x >= extent.z ? 0 : extent.y >= extent.z ? 1 : 2;
+    uint32_t middle = task.begin + (task.end - task.begin) / 2;
+    std::nth_element(order.begin() + task.begin, order.begin() + middle, order.begin() + task.end,
+                     [&](uint32_t a, uint32_t b) { return centroids[a][axis] < centroids[b][axis]; });
+    uint32_t children = uint32_t(nodes_.size());
+    nodes_[task.node].first = children;
+    nodes_[task.node].count = 0;
+    nodes_.push_back({});
+    nodes_.push_back({});
+    work.push_back({children + 1, middle, task.end});
+    work.push_back({children, task.begin, middle});
+  }
+
+  // Triangles in leaf order, so a leaf reads a contiguous run.
+  std::vector<TriangleData> sorted(count);
+  edges_.resize(count);
+  for (uint32_t i = 0; i < count; ++i) {
+    sorted[i] = data_[order[i]];
+    edges_[i] = {sorted[i].v[0], sorted[i].v[1] - sorted[i].v[0], sorted[i].v[2] - sorted[i].v[0]};
+  }
+  data_ = std::move(sorted);
+}
+
+/// The ray's parameter interval inside the box, clipped to [tMin, tMax];
+/// false when empty. Axes the ray runs parallel to are tested by the origin,
+/// which avoids 0 * inf.
+bool slabs(const Aabb& box, const glm::dvec3& origin, const glm::dvec3& direction, const glm::dvec3& inverse,
+           double tMin, double tMax, double& entry) {
+  for (int a = 0; a < 3; ++a) {
+    if (direction[a] == 0.0) {
+      if (origin[a] < box.lo[a] || origin[a] > box.hi[a]) return false;
+      continue;
+    }
+    double t0 = (box.lo[a] - origin[a]) * inverse[a], t1 = (box.hi[a] - origin[a]) * inverse[a];
+    if (t0 > t1) std::swap(t0, t1);
+    tMin = std::max(tMin, t0);
+    tMax = std::min(tMax, t1);
+    if (tMin > tMax) return false;
+  }
+  entry = tMin;
+  return true;
+}
+
+Hit PreparedScene::intersect(const glm::dvec3& origin, const glm::dvec3& direction, double tMin,
+                             uint32_t excluded) const {
+  Hit best;
+  if (edges_.empty()) return best;
+  const glm::dvec3 inverse = 1.0 / direction;
+  double entry = 0.0;
+  if (!slabs(nodes_[0].box, origin, direction, inverse, tMin, kInfinity, entry)) return best;
+  struct Entry {
+    uint32_t node;
+    double t;
+  };
+  Entry stack[128];
+  int top = 0;
+  stack[top++] = {0, entry};
+  while (top > 0) {
+    Entry e = stack[--top];
+    if (e.t > best.t) continue;
+    const BvhNode& node = nodes_[e.node];
+    if (node.count > 0) {
+      for (uint32_t i = node.first; i < node.first + node.count; ++i) {
+        if (i == excluded) continue;
+        // Möller and Trumbore 1997, edges inclusive so that shared edges leave no gap.
+        const Edges& tri = edges_[i];
+        glm::dvec3 p = glm::cross(direction, tri.e2);
+        double det = glm::dot(tri.e1, p);
+        if (det == 0.0) continue;
+        double inv = 1.0 / det;
+        glm::dvec3 s = origin - tri.v0;
+        double b1 = glm::dot(s, p) * inv;
+        if (b1 < 0.0 || b1 > 1.0) continue;
+        glm::dvec3 q = glm::cross(s, tri.e1);
+        double b2 = glm::dot(direction, q) * inv;
+        if (b2 < 0.0 || b1 + b2 > 1.0) continue;
+        double t = glm::dot(tri.e2, q) * inv;
+        if (!(t > tMin)) continue;
+        if (t < best.t || (t == best.t && i < best.triangle)) best = {t, i, b1, b2};
+      }
+      continue;
+    }
+    double t0 = 0.0, t1 = 0.0;
+    bool hit0 = slabs(nodes_[node.first].box, origin, direction, inverse, tMin, best.t, t0);
+    bool hit1 = slabs(nodes_[node.first + 1].box, origin, direction, inverse, tMin, best.t, t1);
+    // Nearer child on top of the stack. The depth of a median-split tree is
+    // log2 of the triangle count, far below the stack's size.
+    if (hit0 && hit1) {
+      if (t0 <= t1) {
+        stack[top++] = {node.first + 1, t1};
+        stack[top++] = {node.first, t0};
+      } else {
+        stack[top++] = {node.first, t0};
+        stack[top++] = {node.first + 1, t1};
+      }
+    } else if (hit0) {
+      stack[top++] = {node.first, t0};
+    } else if (hit1) {
+      stack[top++] = {node.first + 1, t1};
+    }
+  }
+  return best;
+}
+
+// ---------------------------------------------------------------------------
+// Tracing
+
+struct PixelResult {
+  glm::dvec3 color{0.0};
+  double distance = kInfinity;
+  int32_t instance = -1, primitive = -1;
+  uint32_t interfaces = 0;
+  uint32_t outcome = gpu::kOutcomeMiss;
+};
+
+glm::dvec3 textureColor(const TextureUse& use, const TriangleData& tri, double b0, double b1, double b2) {
+  if (!use.texture) return glm::dvec3(1.0);
+  glm::dvec2 uv(0.0);
+  if (use.texCoord == 0 || use.texCoord == 1) {
+    const glm::dvec2* set = tri.uv[use.texCoord];
+    uv = b0 * set[0] + b1 * set[1] + b2 * set[2];
+  }
+  glm::dvec3 transformed = use.transform * glm::dvec3(uv, 1.0);  // KHR_texture_transform
+  return sample(*use.texture, glm::dvec2(transformed));
+}
+
+glm::dvec3 shadeOpaque(const PreparedScene& prepared, const glm::dvec3& p, const glm::dvec3& shadingNormal,
+                       const glm::dvec3& d, const glm::dvec3& base, const glm::dvec3& emissive) {
+  const glm::dvec3 v = -d;
+  const glm::dvec3 n = glm::dot(shadingNormal, v) < 0.0 ? -shadingNormal : shadingNormal;
+  glm::dvec3 sum(0.0);
+  for (const ResolvedLight& light : prepared.lights()) {
+    glm::dvec3 l, e;
+    if (light.type == scene::LightType::Directional) {
+      l = -light.direction;
+      e = light.radiance;
+    } else {
+      glm::dvec3 toLight = light.position - p;
+      double distance = glm::length(toLight);
+      if (!(distance > 0.0)) continue;  // a light on the surface has no direction
+      l = toLight / distance;
+      double window = 1.0;
+      if (std::isfinite(light.range)) {
+        double ratio = distance / light.range;
+        window = std::clamp(1.0 - ratio * ratio * ratio * ratio, 0.0, 1.0);
+        window *= window;
+      }
+      e = light.radiance / (distance * distance) * window;
+      if (light.type == scene::LightType::Spot) {
+        double s = std::clamp((glm::dot(light.direction, -l) - light.cosOuter) /
+                                  std::max(1e-4, light.cosInner - light.cosOuter),
+                              0.0, 1.0);
+        e *= s * s;
+      }
+    }
+    double nDotL = glm::dot(n, l);
+    // Also covers l = -v, where H would be undefined (n faces v, so n.l <= 0).
+    if (!(nDotL > 0.0)) continue;
+    glm::dvec3 h = glm::normalize(l + v);
+    double specular = kSpecular * std::pow(std::max(glm::dot(n, h), 0.0), kShininess);
+    sum += e * nDotL * (base / kPi + specular);
+  }
+  return emissive + kAmbient * base + sum;
+}
+
+PixelResult trace(const PreparedScene& prepared, glm::dvec3 origin, glm::dvec3 d, const ReferenceSettings& settings) {
+  PixelResult result;
+  glm::dvec3 throughput(1.0);
+  double tMin = 0.0;  // primary rays: any t > 0
+  uint32_t excluded = std::numeric_limits<uint32_t>::max();
+  for (bool primary = true;; primary = false) {
+    Hit hit = prepared.intersect(origin, d, tMin, excluded);
+    if (!hit.found()) {
+      result.color = throughput * settings.background;
+      result.outcome = gpu::kOutcomeMiss;
+      return result;
+    }
+    const TriangleData& tri = prepared.triangle(hit.triangle);
+    if (primary) {
+      result.distance = hit.t;
+      result.instance = tri.item;
+      result.primitive = tri.primitive;
+    }
+    const double b1 = hit.b1, b2 = hit.b2, b0 = 1.0 - b1 - b2;
+    const glm::dvec3 p = b0 * tri.v[0] + b1 * tri.v[1] + b2 * tri.v[2];
+    const glm::dvec3& ng = tri.ng;
+    glm::dvec3 ns = unitOrZero(b0 * tri.n[0] + b1 * tri.n[1] + b2 * tri.n[2]);
+    if (ns == glm::dvec3(0.0)) ns = ng;
+    if (glm::dot(ns, ng) < 0.0) ns = -ns;
+
+    const ResolvedMaterial& material = prepared.material(tri.material);
+    const glm::dvec3 base = material.baseFactor * textureColor(material.base, tri, b0, b1, b2);
+    if (!material.refractive) {
+      const glm::dvec3 emissive = material.emissiveFactor * textureColor(material.emissive, tri, b0, b1, b2);
+      result.color = throughput * shadeOpaque(prepared, p, ns, d, base, emissive);
+      result.outcome = gpu::kOutcomeOpaque;
+      return result;
+    }
+
+    if (result.interfaces >= settings.maxInterfaces) {
+      result.color = throughput * settings.background;  // ends as a miss
+      result.outcome = gpu::kOutcomeInterfaceLimit;
+      return result;
+    }
+    const bool entering = glm::dot(d, ng) < 0.0;
+    glm::dvec3 n = entering ? ns : -ns;
+    const double eta = entering ? 1.0 / material.ior : material.ior;
+    double c = -glm::dot(d, n);
+    if (c <= 0.0) {
+      n = entering ? ng : -ng;
+      c = -glm::dot(d, n);
+    }
+    const double k = 1.0 - eta * eta * (1.0 - c * c);
+    glm::dvec3 next = k < 0.0 ? d + 2.0 * c * n : eta * d + (eta * c - std::sqrt(k)) * n;
+    next = unitOrZero(next);
+    if (next != glm::dvec3(0.0)) d = next;
+    throughput *= base;
+    ++result.interfaces;
+
+    origin = p;
+    excluded = hit.triangle;
+    tMin = kSecondaryEpsilon * std::max(maxAbs(origin), prepared.size());
+  }
+}
+
+}  // namespace
+
+ReferenceImage renderReference(const scene::Scene& scene, const scene::Pose& pose, const ReferenceSettings& settings) {
+  ReferenceImage image;
+  image.width = settings.width;
+  image.height = settings.height;
+  const size_t pixels = size_t(settings.width) * settings.height;
+  image.color.assign(pixels, glm::dvec3(0.0));
+  image.distance.assign(pixels, kInfinity);
+  image.instance.assign(pixels, -1);
+  image.primitive.assign(pixels, -1);
+  image.interfaces.assign(pixels, 0);
+  image.outcome.assign(pixels, gpu::kOutcomeMiss);
+  if (pixels == 0) return image;
+
+  const PreparedScene prepared(scene, pose, settings.view);
+  const scene::View& view = settings.view;
+  const double w = settings.width, h = settings.height;
+  const glm::dvec3 forward = glm::normalize(view.forward);
+
+  std::atomic<uint32_t> nextRow{0};
+  auto work = [&] {
+    for (uint32_t y = nextRow++; y < settings.height; y = nextRow++) {
+      for (uint32_t x = 0; x < settings.width; ++x) {
+        double sx = (2.0 * (double(x) + 0.5) / w - 1.0) * view.halfHeight * w / h;
+        double sy = (1.0 - 2.0 * (double(y) + 0.5) / h) * view.halfHeight;
+        glm::dvec3 origin = view.eye, direction = forward;
+        if (view.orthographic) {
+          origin = view.eye + view.right * sx + view.up * sy;
+        } else {
+          direction = glm::normalize(view.forward + sx * view.right + sy * view.up);
+        }
+        PixelResult r = trace(prepared, origin, direction, settings);
+        size_t i = image.index(x, y);
+        image.color[i] = r.color;
+        image.distance[i] = r.distance;
+        image.instance[i] = r.instance;
+        image.primitive[i] = r.primitive;
+        image.interfaces[i] = r.interfaces;
+        image.outcome[i] = r.outcome;
+      }
+    }
+  };
+  unsigned threads = settings.threads ? settings.threads : std::max(1u, std::thread::hardware_concurrency());
+  threads = std::min<unsigned>(threads, settings.height);
+  std::vector<std::thread> pool;
+  for (unsigned t = 1; t < threads; ++t) pool.emplace_back(work);
+  work();
+  for (std::thread& t : pool) t.join();
+  return image;
+}
+
+}  // namespace snell::ref

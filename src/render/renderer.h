@@ -1,0 +1,82 @@
+// One frame of snell: deform -> bottom-level BVH (build once, then refit what
+// deformed) -> top level -> trace, each a timed pass on one command buffer.
+// Nothing comes back to the host unless renderFrame is asked for pixels.
+#pragma once
+
+#include "render/bvh.h"
+#include "render/deform_pass.h"
+#include "render/scene_gpu.h"
+#include "scene/evaluate.h"
+#include "scene/scene.h"
+#include "scene/view.h"
+#include "shared/trace.h"
+#include "vk/buffer.h"
+#include "vk/commands.h"
+#include "vk/compute_program.h"
+#include "vk/context.h"
+
+#include <glm/glm.hpp>
+
+#include <memory>
+#include <vector>
+
+namespace snell::render {
+
+struct FrameSettings {
+  uint32_t width = 0, height = 0;
+  scene::View view;
+  glm::vec3 background{0.02f, 0.02f, 0.025f};
+  uint32_t maxInterfaces = gpu::kDefaultMaxInterfaces;
+};
+
+class Renderer {
+ public:
+  /// Uploads the scene and builds the passes for the items of `layout`.
+  Renderer(vk::Context& context, const scene::Scene& scene, const scene::Pose& layout);
+  ~Renderer();
+
+  /// Records a frame of `pose` into `target` (rgba16f, GENERAL layout) and,
+  /// when `aov` is given, per-pixel gpu::TraceAov records. The host writes the
+  /// frame's instances and lights: the previous frame must have finished.
+  void record(vk::Commands& commands, const scene::Pose& pose, const FrameSettings& settings, const vk::Image& target,
+              const vk::Buffer* aov = nullptr);
+
+  /// Forces the next frame to rebuild the bottom level instead of refitting it.
+  void invalidateBlas() { blasBuilt_ = false; }
+
+  const SceneGpu& sceneGpu() const { return scene_; }
+  const Bvh& blas() const { return blas_; }
+  const Bvh& tlas() const { return tlas_; }
+  const BvhBuilder& builder() const { return builder_; }
+  /// GPU memory of geometry, BVHs and per-frame buffers (not the output image).
+  uint64_t memoryBytes() const;
+
+ private:
+  vk::Context& context_;
+  const scene::Scene& sceneModel_;
+  SceneGpu scene_;
+  std::unique_ptr<DeformPass> deform_;
+  BvhBuilder builder_;
+  Bvh blas_, tlas_;
+  bool blasBuilt_ = false;
+  vk::Buffer instances_, lights_, placeholder_;
+  std::unique_ptr<vk::ComputeProgram> trace_;
+};
+
+/// A frame brought back to the host: linear RGBA, row 0 at the top.
+struct RenderedFrame {
+  uint32_t width = 0, height = 0;
+  std::vector<glm::vec4> rgba;
+  std::vector<gpu::TraceAov> aov;  ///< empty unless asked for
+  std::vector<vk::PassTime> passes;
+};
+
+/// Renders one frame and reads it back (waits for the GPU).
+RenderedFrame renderFrame(vk::Context& context, Renderer& renderer, const scene::Pose& pose,
+                          const FrameSettings& settings, bool withAov = false);
+
+/// Checks a requested image size against the device: throws
+/// std::invalid_argument saying what is wrong.
+void checkImageSize(const vk::Context& context, uint32_t width, uint32_t height);
+
+}  // namespace snell::render

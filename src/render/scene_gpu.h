@@ -1,0 +1,45 @@
+// The scene's static data on the GPU, laid out for the BVH, trace and raster
+// passes: every vertex of every geometry in one set of buffers (deforming
+// items write their slice each frame), triangles with absolute vertex
+// indices, materials, textures as one texel buffer.
+#pragma once
+
+#include "scene/evaluate.h"
+#include "scene/scene.h"
+#include "vk/buffer.h"
+#include "vk/context.h"
+
+#include <cstdint>
+#include <vector>
+
+namespace snell::render {
+
+/// One bottom-level group: a static shape (shared by all its instances) or
+/// one deforming draw item's own copy of its shape.
+struct GeometryRange {
+  int shape = -1;
+  int item = -1;  ///< the deforming draw item; -1 for a static shape
+  uint32_t firstVertex = 0, vertexCount = 0;
+  uint32_t firstTriangle = 0, triangleCount = 0;
+};
+
+struct SceneGpu {
+  std::vector<GeometryRange> geometries;
+  std::vector<uint32_t> itemGeometry;  ///< per pose item
+  std::vector<uint32_t> itemMaterial;  ///< per pose item: index into the material table
+  uint32_t vertexCount = 0, triangleCount = 0;
+  vk::Buffer positions, normals;  ///< float[3 * vertexCount]; rest pose, deformed slices rewritten per frame
+  vk::Buffer texcoords;           ///< vec4 per vertex: uv0, uv1
+  vk::Buffer indices;             ///< uint[3 * triangleCount], absolute
+  vk::Buffer materials;           ///< gpu::GpuMaterial[], the scene's then a default one
+  vk::Buffer textures;            ///< gpu::GpuTexture[]
+  vk::Buffer texels;              ///< RGBA8 texels of every texture
+  uint64_t bytes = 0;             ///< GPU memory the buffers above take
+};
+
+/// Uploads the scene for the draw items of `layout` (which items exist does not
+/// change with time). Throws std::runtime_error naming the scene when it is
+/// larger than the device's buffers can hold.
+SceneGpu uploadScene(vk::Context& context, const scene::Scene& scene, const scene::Pose& layout);
+
+}  // namespace snell::render

@@ -1,0 +1,47 @@
+// Where the picture is taken from: a glTF camera, an explicit look-at, or a
+// view that frames the whole scene. Both tracers (GPU and the CPU reference)
+// take their rays from the same View (see shaders/shared/trace.h).
+#pragma once
+
+#include "scene/evaluate.h"
+#include "scene/scene.h"
+
+#include <glm/glm.hpp>
+
+#include <optional>
+
+namespace snell::scene {
+
+struct LookAt {
+  glm::dvec3 eye{0.0, 0.0, 1.0};
+  glm::dvec3 target{0.0};
+  glm::dvec3 up{0.0, 1.0, 0.0};
+};
+
+struct ViewRequest {
+  int camera = -1;                ///< glTF camera index; -1: camera 0 when the scene has one
+  std::optional<LookAt> lookAt;   ///< wins over any camera
+  double yfov = 0.6981317;        ///< radians, for look-at and framed views (40 degrees)
+};
+
+/// A camera frame in world space, orthonormal, in double precision.
+struct View {
+  glm::dvec3 eye{0.0};
+  glm::dvec3 right{1.0, 0.0, 0.0};
+  glm::dvec3 up{0.0, 1.0, 0.0};
+  glm::dvec3 forward{0.0, 0.0, -1.0};
+  bool orthographic = false;
+  /// Perspective: tan(yfov / 2). Orthographic: half the view's height.
+  double halfHeight = 0.36397;
+  std::string description;  ///< for messages: which camera this is
+};
+
+/// Resolves the request at a pose. Throws std::invalid_argument when the
+/// camera index does not exist or no node carries it, or the look-at is degenerate.
+View resolveView(const Scene& scene, const Pose& pose, const ViewRequest& request);
+
+/// World-space bounds of everything drawn at the pose (deformation included);
+/// an empty scene gives min > max.
+void sceneBounds(const Scene& scene, const Pose& pose, glm::dvec3& lo, glm::dvec3& hi);
+
+}  // namespace snell::scene
