@@ -292,9 +292,13 @@ vec3 phong(Surface s, GpuMaterial m, vec3 dir) {
 }
 
 // Wächter & Binder (Ray Tracing Gems, ch. 6): move the point off the surface
-// by a few ulps of its own magnitude (a fixed step near the origin, where ulps vanish).
+// by a few ulps of its own magnitude (a fixed step near the origin, where ulps
+// vanish). Their constants (256 ulps, 1/65536 below 1/32) assume metre-sized
+// scenes; an eye is centimetres, where that shifted what the refracted ray saw
+// by a visible fraction of an iris texel. The interpolated hit point is good
+// to a few ulps, so 32 ulps still clears the surface.
 vec3 offsetRay(vec3 p, vec3 n) {
-  const float kOrigin = 1.0 / 32.0, kFloatScale = 1.0 / 65536.0, kIntScale = 256.0;
+  const float kOrigin = 1.0 / 1024.0, kFloatScale = 1.0 / 1048576.0, kIntScale = 32.0;
   ivec3 of = ivec3(kIntScale * n);
   vec3 pi = intBitsToFloat(floatBitsToInt(p) + mix(of, -of, lessThan(p, vec3(0.0))));
   return mix(pi, p + kFloatScale * n, lessThan(abs(p), vec3(kOrigin)));

@@ -1,7 +1,18 @@
-// OpenImageIO writes and reads; the rename makes writes all-or-nothing.
+// PNG through snell's own encoder (src/scene/gltf_writer.h) and tinygltf's
+// decoder, EXR through OpenImageIO where the build has it; the rename makes
+// every write all-or-nothing. Without OpenImageIO the binary carries to a
+// machine that has only the Vulkan loader (the GPU benchmarks do that).
 #include "cli/image_file.h"
 
+#include "scene/gltf_writer.h"
+
+#if SNELL_WITH_OPENIMAGEIO
 #include <OpenImageIO/imageio.h>
+#endif
+#include <tiny_gltf.h>
+
+#include <fstream>
+#include <iterator>
 
 #include <algorithm>
 #include <cmath>
@@ -52,13 +63,19 @@ void writeAtomically(const std::string& path, WriteFn write) {
   }
 }
 
-void writePixels(const std::string& finalPath, const std::string& path, const OIIO::ImageSpec& spec, const void* pixels,
-                 OIIO::TypeDesc type) {
-  auto out = OIIO::ImageOutput::create(path);
-  if (!out) throw std::runtime_error(finalPath + ": cannot write this format (" + OIIO::geterror() + ")");
-  if (!out->open(path, spec) || !out->write_image(type, pixels) || !out->close()) {
-    throw std::runtime_error(finalPath + ": " + out->geterror());
+void writeBytes(const std::string& finalPath, const std::string& path, const std::vector<uint8_t>& bytes) {
+  std::ofstream out(path, std::ios::binary);
+  out.write(reinterpret_cast<const char*>(bytes.data()), std::streamsize(bytes.size()));
+  out.close();
+  if (!out) throw std::runtime_error(finalPath + ": could not write the file");
+}
+
+std::vector<uint8_t> pngBytes(uint32_t width, uint32_t height, const std::vector<uint8_t>& rgb) {
+  std::vector<uint8_t> rgba(size_t(width) * height * 4, 255);
+  for (size_t i = 0; i < size_t(width) * height; ++i) {
+    for (int c = 0; c < 3; ++c) rgba[4 * i + size_t(c)] = rgb[3 * i + size_t(c)];
   }
+  return scene::encodePng(width, height, rgba);
 }
 
 }  // namespace
@@ -68,36 +85,46 @@ void writeImage(const std::string& path, const LinearImage& image) {
   if (ext != ".png" && ext != ".exr") {
     throw std::runtime_error(path + ": unsupported image type '" + ext + "' (use .png or .exr)");
   }
+#if !SNELL_WITH_OPENIMAGEIO
+  if (ext == ".exr") throw std::runtime_error(path + ": this build has no OpenImageIO, so no EXR; write a .png");
+#endif
   writeAtomically(path, [&](const std::string& temp) {
     if (ext == ".png") {
-      Rgb8Image srgb = toSrgb8(image);
-      OIIO::ImageSpec spec(int(image.width), int(image.height), 3, OIIO::TypeDesc::UINT8);
-      spec.attribute("oiio:ColorSpace", "sRGB");
-      writePixels(path, temp, spec, srgb.rgb.data(), OIIO::TypeDesc::UINT8);
-    } else {
-      OIIO::ImageSpec spec(int(image.width), int(image.height), 4, OIIO::TypeDesc::HALF);
-      spec.attribute("oiio:ColorSpace", "Linear");
-      spec.attribute("compression", "zip");
-      writePixels(path, temp, spec, image.rgba.data(), OIIO::TypeDesc::FLOAT);
+      writeBytes(path, temp, pngBytes(image.width, image.height, toSrgb8(image).rgb));
+      return;
     }
+#if SNELL_WITH_OPENIMAGEIO
+    OIIO::ImageSpec spec(int(image.width), int(image.height), 4, OIIO::TypeDesc::HALF);
+    spec.attribute("oiio:ColorSpace", "Linear");
+    spec.attribute("compression", "zip");
+    auto out = OIIO::ImageOutput::create(temp);
+    if (!out) throw std::runtime_error(path + ": cannot write EXR (" + OIIO::geterror() + ")");
+    if (!out->open(temp, spec) || !out->write_image(OIIO::TypeDesc::FLOAT, image.rgba.data()) || !out->close()) {
+      throw std::runtime_error(path + ": " + out->geterror());
+    }
+#endif
   });
 }
 
 void writeRgb8(const std::string& path, const Rgb8Image& image) {
-  writeAtomically(path, [&](const std::string& temp) {
-    OIIO::ImageSpec spec(int(image.width), int(image.height), 3, OIIO::TypeDesc::UINT8);
-    writePixels(path, temp, spec, image.rgb.data(), OIIO::TypeDesc::UINT8);
-  });
+  writeAtomically(path, [&](const std::string& temp) { writeBytes(path, temp, pngBytes(image.width, image.height, image.rgb)); });
 }
 
 Rgb8Image readRgb8(const std::string& path) {
-  auto in = OIIO::ImageInput::open(path);
-  if (!in) throw std::runtime_error(path + ": cannot read (" + OIIO::geterror() + ")");
-  const OIIO::ImageSpec& spec = in->spec();
-  Rgb8Image image{uint32_t(spec.width), uint32_t(spec.height), {}};
-  image.rgb.resize(size_t(spec.width) * spec.height * 3);
-  if (!in->read_image(0, 0, 0, 3, OIIO::TypeDesc::UINT8, image.rgb.data())) {
-    throw std::runtime_error(path + ": " + in->geterror());
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw std::runtime_error(path + ": cannot open");
+  std::vector<unsigned char> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  tinygltf::Image decoded;
+  std::string err, warn;
+  if (!tinygltf::LoadImageData(&decoded, 0, &err, &warn, 0, 0, bytes.data(), int(bytes.size()), nullptr) ||
+      decoded.bits != 8 || decoded.component < 3) {
+    throw std::runtime_error(path + ": not an 8-bit RGB(A) image " + err);
+  }
+  Rgb8Image image{uint32_t(decoded.width), uint32_t(decoded.height), {}};
+  size_t pixels = size_t(decoded.width) * size_t(decoded.height);
+  image.rgb.resize(pixels * 3);
+  for (size_t i = 0; i < pixels; ++i) {
+    for (int c = 0; c < 3; ++c) image.rgb[3 * i + size_t(c)] = decoded.image[size_t(decoded.component) * i + size_t(c)];
   }
   return image;
 }
