@@ -42,7 +42,11 @@ struct Case {
   scene::ViewRequest view;
 };
 
-fs::path goldenDir() { return fs::path(SNELL_SOURCE_DIR) / "golden"; }
+// SNELL_GOLDEN_DIR in the environment wins: the GPU machine has the checkout elsewhere.
+fs::path goldenDir() {
+  const char* override = std::getenv("SNELL_GOLDEN_DIR");
+  return override ? fs::path(override) : fs::path(SNELL_SOURCE_DIR) / "golden";
+}
 
 cli::Rgb8Image referenceImage(const scene::Scene& s, const scene::Pose& pose, const scene::View& view, const Case& c) {
   ref::ReferenceSettings settings;

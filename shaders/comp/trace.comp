@@ -82,16 +82,19 @@ vec3 vertexAt(uint v) {
 
 // Watertight ray/triangle test; returns t (or kInf) and the barycentrics.
 float intersectTriangle(ShearedRay r, uint tri, float tMax, out vec3 bary) {
-  vec3 A = vertexAt(indices[3u * tri]) - r.origin;
-  vec3 B = vertexAt(indices[3u * tri + 1u]) - r.origin;
-  vec3 C = vertexAt(indices[3u * tri + 2u]) - r.origin;
+  precise vec3 A = vertexAt(indices[3u * tri]) - r.origin;
+  precise vec3 B = vertexAt(indices[3u * tri + 1u]) - r.origin;
+  precise vec3 C = vertexAt(indices[3u * tri + 2u]) - r.origin;
   int kx = r.k.x, ky = r.k.y, kz = r.k.z;
-  float Ax = A[kx] - r.shear.x * A[kz], Ay = A[ky] - r.shear.y * A[kz];
-  float Bx = B[kx] - r.shear.x * B[kz], By = B[ky] - r.shear.y * B[kz];
-  float Cx = C[kx] - r.shear.x * C[kz], Cy = C[ky] - r.shear.y * C[kz];
-  float U = Cx * By - Cy * Bx;
-  float V = Ax * Cy - Ay * Cx;
-  float W = Bx * Ay - By * Ax;
+  // precise: a fused multiply-add rounds one side of an edge differently from
+  // the triangle across it, and rays slipped between them on NVIDIA (golden
+  // eye_front). Unfused, both triangles compute the same edge value.
+  precise float Ax = A[kx] - r.shear.x * A[kz], Ay = A[ky] - r.shear.y * A[kz];
+  precise float Bx = B[kx] - r.shear.x * B[kz], By = B[ky] - r.shear.y * B[kz];
+  precise float Cx = C[kx] - r.shear.x * C[kz], Cy = C[ky] - r.shear.y * C[kz];
+  precise float U = Cx * By - Cy * Bx;
+  precise float V = Ax * Cy - Ay * Cx;
+  precise float W = Bx * Ay - By * Ax;
   if ((U < 0.0 || V < 0.0 || W < 0.0) && (U > 0.0 || V > 0.0 || W > 0.0)) return kInf;
   float det = U + V + W;
   if (det == 0.0) return kInf;
