@@ -186,7 +186,7 @@ scene::Scene prismScene() {
   return s;
 }
 
-scene::Scene model(const std::string& relative) {
+scene::Scene loadModel(const std::string& relative) {
   scene::LoadOptions load;
   load.ignoredExtensions = {"KHR_materials_iridescence"};  // Suzanne's film; her glass is what counts here
   return scene::loadGltf(test::model(relative), load);
@@ -209,26 +209,39 @@ std::vector<Case> cases() {
   list.push_back({"prism_total_internal_reflection", 160, 120, {0.999, 64}, prismScene, 0.0, prismView});
   Tolerance models{0.999, 255};  // a silhouette pixel may flip between hit and miss
   list.push_back({"transmission_roughness_test", 192, 144, models,
-                  [] { return model("TransmissionRoughnessTest/glTF-Binary/TransmissionRoughnessTest.glb"); }, 0.0, {}});
+                  [] { return loadModel("TransmissionRoughnessTest/glTF-Binary/TransmissionRoughnessTest.glb"); }, 0.0, {}});
   list.push_back({"iridescence_suzanne", 192, 144, models,
-                  [] { return model("IridescenceSuzanne/glTF-Binary/IridescenceSuzanne.glb"); }, 0.0, {}});
+                  [] { return loadModel("IridescenceSuzanne/glTF-Binary/IridescenceSuzanne.glb"); }, 0.0, {}});
   // The vase's glass, water and stems share coincident faces; which of two
   // faces at the same distance a ray meets first is decided by rounding, so
   // the GPU (float) and the reference (double) part ways on 4.7% of pixels.
   list.push_back({"glass_vase_flowers", 144, 192, {0.95, 255},
-                  [] { return model("GlassVaseFlowers/glTF-Binary/GlassVaseFlowers.glb"); }, 0.0, {}});
+                  [] { return loadModel("GlassVaseFlowers/glTF-Binary/GlassVaseFlowers.glb"); }, 0.0, {}});
   list.push_back({"attenuation_test", 192, 144, models,
-                  [] { return model("AttenuationTest/glTF-Binary/AttenuationTest.glb"); }, 0.0, {}});
+                  [] { return loadModel("AttenuationTest/glTF-Binary/AttenuationTest.glb"); }, 0.0, {}});
   return list;
 }
+
+// A case's scene at its time and the view it is seen from. Built in place
+// and never moved: the pose's draw items point at the scene.
+struct Shot {
+  explicit Shot(const Case& c)
+      : scene(c.makeScene()), pose(scene::evaluate(scene, c.time)), view(scene::resolveView(scene, pose, c.view)) {}
+  Shot(const Shot&) = delete;
+  Shot& operator=(const Shot&) = delete;
+  scene::Scene scene;
+  scene::Pose pose;
+  scene::View view;
+};
 
 class Golden : public GpuTest, public ::testing::WithParamInterface<Case> {};
 
 TEST_P(Golden, GpuTraceMatchesTheReferenceGolden) {
   const Case& c = GetParam();
-  scene::Scene s = c.makeScene();
-  scene::Pose pose = scene::evaluate(s, c.time);
-  scene::View view = scene::resolveView(s, pose, c.view);
+  Shot shot(c);
+  const scene::Scene& s = shot.scene;
+  const scene::Pose& pose = shot.pose;
+  const scene::View& view = shot.view;
   fs::path goldenPath = goldenDir() / (c.name + ".png");
   const char* update = std::getenv("SNELL_UPDATE_GOLDEN");
   if (update && std::string(update) == "1") cli::writeRgb8(goldenPath.string(), referenceImage(s, pose, view, c));
@@ -261,9 +274,10 @@ TEST_P(Golden, GpuTraceMatchesTheReferenceGolden) {
 
 TEST_P(Golden, GoldenIsWhatTheReferenceRendersToday) {
   const Case& c = GetParam();
-  scene::Scene s = c.makeScene();
-  scene::Pose pose = scene::evaluate(s, c.time);
-  scene::View view = scene::resolveView(s, pose, c.view);
+  Shot shot(c);
+  const scene::Scene& s = shot.scene;
+  const scene::Pose& pose = shot.pose;
+  const scene::View& view = shot.view;
   fs::path goldenPath = goldenDir() / (c.name + ".png");
   ASSERT_TRUE(fs::exists(goldenPath)) << goldenPath << " is missing";
   Comparison result = compare(referenceImage(s, pose, view, c), cli::readRgb8(goldenPath.string()));

@@ -105,6 +105,17 @@ float intersectTriangle(ShearedRay r, uint tri, float tMax, out vec3 bary) {
   return T * inv;
 }
 
+// Pushes the children the ray enters before tMax, the nearer on top. A full
+// stack drops them (only a corrupted tree is that deep): the ray still ends.
+void pushChildren(BvhNode node, ShearedRay r, float tMax, inout uint sp) {
+  float t0 = enterBox(r, vec3(node.box[0], node.box[1], node.box[2]), vec3(node.box[3], node.box[4], node.box[5]), tMax);
+  float t1 = enterBox(r, vec3(node.box[6], node.box[7], node.box[8]), vec3(node.box[9], node.box[10], node.box[11]), tMax);
+  bool swapOrder = t1 < t0;
+  uint nearRef = swapOrder ? node.child[1] : node.child[0], farRef = swapOrder ? node.child[0] : node.child[1];
+  if (max(t0, t1) < kInf && sp < kStackSize) stack[sp++] = farRef;
+  if (min(t0, t1) < kInf && sp < kStackSize) stack[sp++] = nearRef;
+}
+
 // One instance's tree, with the ray in its object space (t is shared: the
 // direction is not renormalised). Uses the stack above `base`.
 void traverseBlas(uint instance, vec3 origin, vec3 dir, uint skipPrim, uint base, inout Hit hit) {
@@ -130,15 +141,7 @@ void traverseBlas(uint instance, vec3 origin, vec3 dir, uint skipPrim, uint base
       if (t < hit.t) hit = Hit(t, instance, tri, bary);
       continue;
     }
-    BvhNode node = blasNodes[ref];
-    float t0 = enterBox(r, vec3(node.box[0], node.box[1], node.box[2]), vec3(node.box[3], node.box[4], node.box[5]), hit.t);
-    float t1 = enterBox(r, vec3(node.box[6], node.box[7], node.box[8]), vec3(node.box[9], node.box[10], node.box[11]), hit.t);
-    // Near child on top; a full stack drops the far one (only a corrupted tree is that deep).
-    bool swapOrder = t1 < t0;
-    uint nearRef = swapOrder ? node.child[1] : node.child[0], farRef = swapOrder ? node.child[0] : node.child[1];
-    float nearT = min(t0, t1), farT = max(t0, t1);
-    if (farT < kInf && sp < kStackSize) stack[sp++] = farRef;
-    if (nearT < kInf && sp < kStackSize) stack[sp++] = nearRef;
+    pushChildren(blasNodes[ref], r, hit.t, sp);
   }
 }
 
@@ -158,14 +161,7 @@ Hit traceClosest(vec3 origin, vec3 dir, uint skipInstance, uint skipPrim) {
       traverseBlas(instance, origin, dir, instance == skipInstance ? skipPrim : kNoHit, sp, hit);
       continue;
     }
-    BvhNode node = tlasNodes[ref];
-    float t0 = enterBox(r, vec3(node.box[0], node.box[1], node.box[2]), vec3(node.box[3], node.box[4], node.box[5]), hit.t);
-    float t1 = enterBox(r, vec3(node.box[6], node.box[7], node.box[8]), vec3(node.box[9], node.box[10], node.box[11]), hit.t);
-    bool swapOrder = t1 < t0;
-    uint nearRef = swapOrder ? node.child[1] : node.child[0], farRef = swapOrder ? node.child[0] : node.child[1];
-    float nearT = min(t0, t1), farT = max(t0, t1);
-    if (farT < kInf && sp < kStackSize) stack[sp++] = farRef;
-    if (nearT < kInf && sp < kStackSize) stack[sp++] = nearRef;
+    pushChildren(tlasNodes[ref], r, hit.t, sp);
   }
   return hit;
 }

@@ -57,10 +57,7 @@ int runBenchFrame(const Args& args) {
     if (i + 1 >= args.size()) throw UsageError{"bench frame: " + a + " needs a value (or is unknown)"};
     const std::string& v = args[++i];
     if (a == "--size") {
-      size_t x = v.find('x');
-      if (x == std::string::npos) throw UsageError{"--size expects WxH, got '" + v + "'"};
-      width = uint32_t(parseCount(a, v.substr(0, x)));
-      height = uint32_t(parseCount(a, v.substr(x + 1)));
+      parseSize(a, v, width, height);
     } else if (a == "--frames") {
       frames = std::max<uint32_t>(1, uint32_t(parseCount(a, v)));
     } else if (a == "--warmup") {

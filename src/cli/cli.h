@@ -3,6 +3,7 @@
 
 #include "vk/context.h"
 
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -25,6 +26,9 @@ int runBenchFrame(const Args& args);
 
 /// A context on the device snell picks; SNELL_VALIDATION=1 turns on the validation layer.
 vk::ContextDesc contextDescFromEnvironment();
+
+/// Parses WxH (each 1..65536) or throws UsageError naming the option.
+void parseSize(const std::string& option, const std::string& value, uint32_t& width, uint32_t& height);
 
 /// Parses an unsigned integer option value or throws UsageError naming the option.
 unsigned long long parseCount(const std::string& option, const std::string& value);

@@ -64,6 +64,17 @@ unsigned long long parseCount(const std::string& option, const std::string& valu
   return result;
 }
 
+void parseSize(const std::string& option, const std::string& value, uint32_t& width, uint32_t& height) {
+  size_t x = value.find('x');
+  if (x == std::string::npos) throw UsageError{option + " expects WxH, e.g. 640x480, got '" + value + "'"};
+  unsigned long long w = parseCount(option, value.substr(0, x)), h = parseCount(option, value.substr(x + 1));
+  if (w == 0 || h == 0 || w > 65536 || h > 65536) {
+    throw UsageError{option + " " + value + " is out of range (1x1 to 65536x65536)"};
+  }
+  width = uint32_t(w);
+  height = uint32_t(h);
+}
+
 }  // namespace snell::cli
 
 int main(int argc, char** argv) {

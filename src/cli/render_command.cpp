@@ -97,12 +97,7 @@ Options parse(const Args& args) {
     if (a == "-o" || a == "--output") {
       o.output = v;
     } else if (a == "--size") {
-      size_t x = v.find('x');
-      if (x == std::string::npos) throw UsageError{"--size expects WxH, e.g. 640x480, got '" + v + "'"};
-      unsigned long long w = parseCount("--size", v.substr(0, x)), h = parseCount("--size", v.substr(x + 1));
-      if (w == 0 || h == 0 || w > 65536 || h > 65536) throw UsageError{"--size " + v + " is out of range (1x1 to 65536x65536)"};
-      o.width = uint32_t(w);
-      o.height = uint32_t(h);
+      parseSize(a, v, o.width, o.height);
     } else if (a == "--camera") {
       o.view.camera = int(parseCount(a, v));
     } else if (a == "--look-at") {
