@@ -3,11 +3,13 @@
 // refit after the triangles move gives boxes that hold the moved triangles.
 #include "gpu_test.h"
 
+#include "ref/sah_bvh.h"
 #include "render/bvh.h"
 #include "vk/commands.h"
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstring>
 #include <random>
 #include <set>
@@ -51,14 +53,27 @@ class BvhTest : public GpuTest {
     return b;
   }
 
-  BvhSnapshot build(BvhBuilder& builder, Bvh& bvh, const Soup& soup) {
+  BvhSnapshot build(BvhBuilder& builder, Bvh& bvh, const Soup& soup,
+                    uint32_t restructureRounds = render::kDefaultRestructureRounds) {
     positions_ = upload(soup.positions.data(), soup.positions.size() * 4, "positions");
     indices_ = upload(soup.indices.data(), soup.indices.size() * 4, "indices");
     vk::Commands commands(context(), "build");
     commands.begin();
     builder.recordTriangleBoxes(commands, bvh, positions_, indices_, 0, bvh.primitiveCount);
     commands.computeToCompute();
-    builder.recordBuild(commands, bvh);
+    builder.recordBuild(commands, bvh, restructureRounds);
+    commands.submitAndWait();
+    return builder.download(bvh);
+  }
+
+  // Uploads the soup's moved positions and refits `group`, whose triangles are [first, first + count).
+  BvhSnapshot refit(BvhBuilder& builder, Bvh& bvh, const Soup& soup, uint32_t group, uint32_t first, uint32_t count) {
+    vk::upload(context(), positions_, soup.positions.data(), soup.positions.size() * 4);
+    vk::Commands commands(context(), "refit");
+    commands.begin();
+    builder.recordTriangleBoxes(commands, bvh, positions_, indices_, first, count);
+    commands.computeToCompute();
+    builder.recordRefit(commands, bvh, group);
     commands.submitAndWait();
     return builder.download(bvh);
   }
@@ -163,18 +178,73 @@ TEST_F(BvhTest, ARefitHoldsTheMovedTrianglesAndKeepsTheTopology) {
   BvhSnapshot before = build(builder, bvh, soup);
   // Move group 1's triangles (primitives 1000..2999) a long way.
   for (size_t i = 9 * 1000; i < soup.positions.size(); ++i) soup.positions[i] = soup.positions[i] * 3.0f + 50.0f;
-  vk::upload(context(), positions_, soup.positions.data(), soup.positions.size() * 4);
-  vk::Commands commands(context(), "refit");
-  commands.begin();
-  builder.recordTriangleBoxes(commands, bvh, positions_, indices_, 1000, 2000);
-  commands.computeToCompute();
-  builder.recordRefit(commands, bvh, 1);
-  commands.submitAndWait();
-  BvhSnapshot after = builder.download(bvh);
+  BvhSnapshot after = refit(builder, bvh, soup, 1, 1000, 2000);
   EXPECT_EQ(after.leafPrims, before.leafPrims);
   EXPECT_EQ(walk(after, 1, soup).size(), 2000u);  // boxes checked against the moved triangles
   EXPECT_GE(after.groups[1].boxLo[0], 50.0f - 3.0f * 10.3f);
   EXPECT_EQ(walk(after, 0, soup).size(), 1000u);
+}
+
+ref::Aabb aabb(const render::BoxFloats& b) {
+  ref::Aabb a;
+  a.extend(glm::dvec3(b[0], b[1], b[2]));
+  a.extend(glm::dvec3(b[3], b[4], b[5]));
+  return a;
+}
+
+double gpuSah(const BvhSnapshot& s, uint32_t group) {
+  BvhSnapshot::TreeBoxes tree = s.treeBoxes(group);
+  std::vector<ref::Aabb> internal, leaves;
+  for (const render::BoxFloats& b : tree.internal) internal.push_back(aabb(b));
+  for (const render::BoxFloats& b : tree.leaves) leaves.push_back(aabb(b));
+  return ref::sahCost(internal, leaves, internal.front());
+}
+
+// Thin triangles along a few long strands with many nearly equal Morton codes:
+// the LBVH splits them by code, far from where the SAH would.
+Soup strands(uint32_t triangles) {
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<float> u(0.0f, 1.0f);
+  Soup s;
+  for (uint32_t t = 0; t < triangles; ++t) {
+    float along = u(rng) * 20.0f, strand = float(t % 5);
+    float c[3] = {along, strand * 0.9f + 0.05f * std::sin(along), 0.01f * u(rng)};
+    for (int v = 0; v < 3; ++v) {
+      for (int k = 0; k < 3; ++k) s.positions.push_back(c[k] + (v == k ? 0.02f : 0.0f));
+      s.indices.push_back(3 * t + uint32_t(v));
+    }
+  }
+  return s;
+}
+
+// The LBVH alone prices these strands at 5.8 times binned SAH.
+TEST_F(BvhTest, TreeletRestructuringBringsTheSahOfStrandsWithin1Point4OfBinnedSah) {
+  Soup soup = strands(6000);
+  BvhBuilder builder(context());
+  Bvh bvh = builder.makeBvh({6000}, "strands");
+  double lbvh = gpuSah(build(builder, bvh, soup, 0), 0);
+  BvhSnapshot restructured = build(builder, bvh, soup);
+  EXPECT_EQ(walk(restructured, 0, soup).size(), 6000u);
+  std::vector<ref::Aabb> triangles;
+  for (uint32_t t = 0; t < 6000; ++t) {
+    ref::Aabb b;
+    for (int v = 0; v < 3; ++v) b.extend(glm::dvec3(soup.positions[9 * t + 3 * v], soup.positions[9 * t + 3 * v + 1],
+                                                    soup.positions[9 * t + 3 * v + 2]));
+    triangles.push_back(b);
+  }
+  double binned = ref::binnedSahCost(triangles);
+  double cost = gpuSah(restructured, 0);
+  EXPECT_LT(cost, 0.3 * lbvh) << "LBVH alone: " << lbvh / binned << " of binned SAH";
+  EXPECT_LT(cost / binned, 1.4) << "LBVH alone: " << lbvh / binned << " of binned SAH";
+}
+
+TEST_F(BvhTest, ARefitAfterRestructuringFindsEveryLeafsNewParent) {
+  Soup soup = strands(3000);
+  BvhBuilder builder(context());
+  Bvh bvh = builder.makeBvh({3000}, "strands");
+  build(builder, bvh, soup);
+  for (float& p : soup.positions) p = -2.0f * p + 7.0f;
+  EXPECT_EQ(walk(refit(builder, bvh, soup, 0, 0, 3000), 0, soup).size(), 3000u);  // every box holds its moved triangles
 }
 
 }  // namespace

@@ -26,13 +26,17 @@ SNELL_CONST kBvhBindingGroups = 2;      // BvhGroup[groupCount]
 SNELL_CONST kBvhBindingKeys = 3;        // uvec2[count]: 64-bit sort keys (lo, hi)
 SNELL_CONST kBvhBindingLeafPrims = 4;   // uint[count]: primitive at each sorted leaf position
 SNELL_CONST kBvhBindingNodes = 5;       // BvhNode[count - 1]: internal nodes
-SNELL_CONST kBvhBindingLeafParents = 6; // uint[count]: parent node of each sorted leaf
+SNELL_CONST kBvhBindingLeafParents = 6; // uint[count]: parent node of each primitive's leaf
 SNELL_CONST kBvhBindingCounters = 7;    // uint[count - 1]: arrivals per node, zeroed before each fit
 // Primitive boxes from triangles (bvh_triangle_boxes.comp) or instances (bvh_instance_boxes.comp).
 SNELL_CONST kBvhBindingPositions = 8;   // float[3 * vertexCount]
 SNELL_CONST kBvhBindingIndices = 9;     // uint[3 * triangleCount], absolute vertex indices
 SNELL_CONST kBvhBindingInstances = 10;  // GpuInstance[instanceCount]
 SNELL_CONST kBvhBindingBlasGroups = 11; // BvhGroup[geometryCount] of the bottom level
+// Treelet restructuring (bvh_restructure.comp): uvec2[count - 1], each internal
+// node's subtree cost (float bits) and leaf count. The build binds the keys
+// buffer here: the keys are spent once the hierarchy exists.
+SNELL_CONST kBvhBindingNodeStats = 12;
 
 SNELL_CONST kBvhSpecWorkgroupSize = 0;
 

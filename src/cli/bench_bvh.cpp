@@ -25,14 +25,17 @@ Builds every bottom-level tree of each scene on the GPU (the procedural eye
 first, then the files given) and prices it with the surface area heuristic
 (Ct = 1 per internal node, Ci = 1 per triangle, one triangle per leaf), next to
 a CPU binned-SAH tree (32 bins) over the same triangles. ratio = GPU / CPU:
-1.0 is as good as binned SAH, higher is worse.
+1.0 is as good as binned SAH, higher is worse. "GPU SAH" is the tree the
+renderer uses (LBVH plus treelet restructuring); "LBVH" is the same build
+without restructuring.
 )";
 
 struct Row {
   std::string scene, mesh;
   uint32_t triangles = 0;
-  double gpuCost = 0, cpuCost = 0;
+  double gpuCost = 0, lbvhCost = 0, cpuCost = 0;
   double ratio() const { return cpuCost > 0 ? gpuCost / cpuCost : 1.0; }
+  double lbvhRatio() const { return cpuCost > 0 ? lbvhCost / cpuCost : 1.0; }
 };
 
 ref::Aabb box(const float* lo, const float* hi) {
@@ -42,6 +45,15 @@ ref::Aabb box(const float* lo, const float* hi) {
   return b;
 }
 
+// SAH cost of group g's tree, priced by the same formula as the CPU tree.
+double treeCost(const render::BvhSnapshot& snapshot, uint32_t g) {
+  render::BvhSnapshot::TreeBoxes tree = snapshot.treeBoxes(g);
+  std::vector<ref::Aabb> internalBoxes, leafBoxes;
+  for (const render::BoxFloats& b : tree.internal) internalBoxes.push_back(box(&b[0], &b[3]));
+  for (const render::BoxFloats& b : tree.leaves) leafBoxes.push_back(box(&b[0], &b[3]));
+  return ref::sahCost(internalBoxes, leafBoxes, internalBoxes.front());
+}
+
 void measure(vk::Context& context, const scene::Scene& scene, const std::string& label, std::vector<Row>& rows) {
   scene::Pose pose = scene::evaluate(scene, 0.0);
   render::Renderer renderer(context, scene, pose);
@@ -49,6 +61,12 @@ void measure(vk::Context& context, const scene::Scene& scene, const std::string&
   render::FrameSettings settings{8, 8, scene::resolveView(scene, pose, {}), {}, gpu::kDefaultMaxInterfaces};
   render::renderFrame(context, renderer, pose, settings);
   render::BvhSnapshot snapshot = renderer.builder().download(renderer.blas());
+  // The same triangles again without restructuring: what the treelets bought.
+  vk::Commands commands(context, "lbvh only");
+  commands.begin();
+  renderer.builder().recordBuild(commands, renderer.blas(), 0);
+  commands.submitAndWait();
+  render::BvhSnapshot lbvh = renderer.builder().download(renderer.blas());
   const render::SceneGpu& gpuScene = renderer.sceneGpu();
   std::vector<float> positions(size_t(gpuScene.vertexCount) * 3);
   std::vector<uint32_t> indices(size_t(gpuScene.triangleCount) * 3);
@@ -67,29 +85,12 @@ void measure(vk::Context& context, const scene::Scene& scene, const std::string&
       }
       triangles.push_back(b);
     }
-    // The GPU tree's boxes: every internal node's child slots, split into internal and leaf boxes.
-    const gpu::BvhGroup& group = snapshot.groups[g];
-    std::vector<ref::Aabb> internalBoxes{box(group.boxLo, group.boxHi)}, leafBoxes;
-    std::vector<uint32_t> stack;
-    if (!(group.root & gpu::kBvhLeafBit) && group.root != gpu::kBvhNone) stack.push_back(group.root);
-    while (!stack.empty() && internalBoxes.size() <= snapshot.nodes.size()) {
-      const gpu::BvhNode& node = snapshot.nodes.at(stack.back());
-      stack.pop_back();
-      for (int c = 0; c < 2; ++c) {
-        ref::Aabb b = box(&node.box[6 * c], &node.box[6 * c + 3]);
-        if (node.child[c] & gpu::kBvhLeafBit) {
-          leafBoxes.push_back(b);
-        } else {
-          internalBoxes.push_back(b);
-          stack.push_back(node.child[c]);
-        }
-      }
-    }
     Row row;
     row.scene = label;
     row.mesh = scene.shapes[size_t(range.shape)].name;
     row.triangles = range.triangleCount;
-    row.gpuCost = ref::sahCost(internalBoxes, leafBoxes, internalBoxes.front());
+    row.gpuCost = treeCost(snapshot, static_cast<uint32_t>(g));
+    row.lbvhCost = treeCost(lbvh, static_cast<uint32_t>(g));
     row.cpuCost = ref::binnedSahCost(triangles);
     rows.push_back(row);
   }
@@ -129,11 +130,12 @@ int runBenchBvh(const Args& args) {
     measure(*context, scene::loadGltf(f, load), std::filesystem::path(f).stem().string(), rows);
   }
 
-  std::printf("%-28s %-28s %9s %10s %10s %7s\n", "scene", "mesh", "triangles", "GPU SAH", "CPU SAH", "ratio");
+  std::printf("%-28s %-28s %9s %10s %10s %10s %7s %10s\n", "scene", "mesh", "triangles", "LBVH", "GPU SAH",
+              "CPU SAH", "ratio", "LBVH ratio");
   double worst = 0;
   for (const Row& r : rows) {
-    std::printf("%-28.28s %-28.28s %9u %10.2f %10.2f %7.3f\n", r.scene.c_str(), r.mesh.c_str(), r.triangles, r.gpuCost,
-                r.cpuCost, r.ratio());
+    std::printf("%-28.28s %-28.28s %9u %10.2f %10.2f %10.2f %7.3f %10.3f\n", r.scene.c_str(), r.mesh.c_str(),
+                r.triangles, r.lbvhCost, r.gpuCost, r.cpuCost, r.ratio(), r.lbvhRatio());
     worst = std::max(worst, r.ratio());
   }
   std::printf("worst ratio %.3f\n", worst);
@@ -143,7 +145,8 @@ int runBenchBvh(const Args& args) {
     for (size_t i = 0; i < rows.size(); ++i) {
       const Row& r = rows[i];
       out << "    {\"scene\": \"" << r.scene << "\", \"mesh\": \"" << r.mesh << "\", \"triangles\": " << r.triangles
-          << ", \"gpu_sah\": " << r.gpuCost << ", \"cpu_binned_sah\": " << r.cpuCost << ", \"ratio\": " << r.ratio()
+          << ", \"gpu_sah\": " << r.gpuCost << ", \"lbvh_sah\": " << r.lbvhCost << ", \"cpu_binned_sah\": " << r.cpuCost
+          << ", \"ratio\": " << r.ratio() << ", \"lbvh_ratio\": " << r.lbvhRatio()
           << "}" << (i + 1 < rows.size() ? "," : "") << "\n";
     }
     out << "  ],\n  \"worst_ratio\": " << worst << "\n}\n";

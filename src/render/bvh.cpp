@@ -8,6 +8,7 @@
 #include "bvh_hierarchy.spv.h"
 #include "bvh_instance_boxes.spv.h"
 #include "bvh_morton.spv.h"
+#include "bvh_restructure.spv.h"
 #include "bvh_triangle_boxes.spv.h"
 
 #include <algorithm>
@@ -51,6 +52,10 @@ BvhBuilder::BvhBuilder(vk::Context& context) : context_(context), sort_(context,
   // the same exchange between workgroups, or within a subgroup, held.
   fit_ = std::make_unique<vk::ComputeProgram>(
       context, vk::ComputeProgramDesc{"bvh fit", kSpvBvhFit,
+                                      {{gpu::kBvhSpecWorkgroupSize, context.caps().maxSubgroupSize}}, false});
+  // The same walk as the fit, so the same workgroup shape.
+  restructure_ = std::make_unique<vk::ComputeProgram>(
+      context, vk::ComputeProgramDesc{"bvh restructure", kSpvBvhRestructure,
                                       {{gpu::kBvhSpecWorkgroupSize, context.caps().maxSubgroupSize}}, false});
 }
 
@@ -127,7 +132,7 @@ void BvhBuilder::recordInstanceBoxes(vk::Commands& commands, const Bvh& bvh, con
                                   push, bvh.primitiveCount);
 }
 
-void BvhBuilder::recordBuild(vk::Commands& commands, const Bvh& bvh) const {
+void BvhBuilder::recordBuild(vk::Commands& commands, const Bvh& bvh, uint32_t restructureRounds) const {
   uint32_t n = bvh.primitiveCount;
   VkDeviceSize groupBytes = std::max<size_t>(bvh.groupSizes.size(), 1) * sizeof(gpu::BvhGroup);
   commands.copyBuffer(bvh.groupsInitial, bvh.groups, groupBytes);
@@ -159,6 +164,24 @@ void BvhBuilder::recordBuild(vk::Commands& commands, const Bvh& bvh) const {
                               push, std::max<uint32_t>(n - 1, 1));
   commands.computeToCompute();
   recordFit(commands, bvh, 0, n);
+  for (uint32_t round = 0; round < restructureRounds && n > 2; ++round) recordRestructure(commands, bvh);
+}
+
+void BvhBuilder::recordRestructure(vk::Commands& commands, const Bvh& bvh) const {
+  uint32_t n = bvh.primitiveCount;
+  gpu::BvhPush push{n, 0, bvh.groupCount(), n};
+  commands.fillBuffer(bvh.counters, 0);
+  commands.transferToCompute();
+  restructure_->dispatchThreads(commands,
+                                {{gpu::kBvhBindingPrimBoxes, &bvh.primBoxes},
+                                 {gpu::kBvhBindingLeafPrims, &bvh.leafPrims},
+                                 {gpu::kBvhBindingLeafParents, &bvh.leafParents},
+                                 {gpu::kBvhBindingNodes, &bvh.nodes},
+                                 {gpu::kBvhBindingCounters, &bvh.counters},
+                                 {gpu::kBvhBindingNodeStats, &bvh.keys}},
+                                push, n);
+  commands.computeToCompute();
+  commands.computeToTransfer();
 }
 
 void BvhBuilder::recordRefit(vk::Commands& commands, const Bvh& bvh, uint32_t group) const {
@@ -195,6 +218,30 @@ BvhSnapshot BvhBuilder::download(const Bvh& bvh) const {
   vk::download(context_, bvh.leafPrims, s.leafPrims.data(), n * 4);
   vk::download(context_, bvh.leafParents, s.leafParents.data(), n * 4);
   return s;
+}
+
+BvhSnapshot::TreeBoxes BvhSnapshot::treeBoxes(uint32_t group) const {
+  const gpu::BvhGroup& g = groups.at(group);
+  TreeBoxes boxes;
+  boxes.internal.push_back({g.boxLo[0], g.boxLo[1], g.boxLo[2], g.boxHi[0], g.boxHi[1], g.boxHi[2]});
+  std::vector<uint32_t> stack;
+  if (!(g.root & gpu::kBvhLeafBit) && g.root != gpu::kBvhNone) stack.push_back(g.root);
+  // Bounded by the node count, so a corrupted tree cannot loop forever.
+  while (!stack.empty() && boxes.internal.size() <= nodes.size()) {
+    const gpu::BvhNode& node = nodes.at(stack.back());
+    stack.pop_back();
+    for (int c = 0; c < 2; ++c) {
+      BoxFloats b;
+      std::copy_n(&node.box[6 * c], 6, b.begin());
+      if (node.child[c] & gpu::kBvhLeafBit) {
+        boxes.leaves.push_back(b);
+      } else {
+        boxes.internal.push_back(b);
+        stack.push_back(node.child[c]);
+      }
+    }
+  }
+  return boxes;
 }
 
 }  // namespace snell::render

@@ -137,7 +137,7 @@ void Renderer::record(vk::Commands& commands, const scene::Pose& pose, const Fra
   commands.beginPass("tlas");
   builder_.recordInstanceBoxes(commands, tlas_, instances_, blas_);
   commands.computeToCompute();
-  builder_.recordBuild(commands, tlas_);
+  builder_.recordBuild(commands, tlas_, 0);  // a handful of instances, rebuilt every frame: LBVH only
   commands.endPass();
 
   commands.beginPass("trace");

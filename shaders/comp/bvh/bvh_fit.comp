@@ -29,7 +29,7 @@ void main() {
   vec3 lo = vec3(primBoxes[6u * prim], primBoxes[6u * prim + 1u], primBoxes[6u * prim + 2u]);
   vec3 hi = vec3(primBoxes[6u * prim + 3u], primBoxes[6u * prim + 4u], primBoxes[6u * prim + 5u]);
   uint ref = kBvhLeafBit | prim;
-  uint parent = leafParents[leaf];
+  uint parent = leafParents[prim];
   uint internalCount = pc.total - 1u;
 
   for (uint step = 0u; step < kBvhMaxDepth; ++step) {

@@ -43,7 +43,7 @@ void link(uint parent, int first, int last, bool isLeaf, int index) {
     groups[groupAt(first)].root = ref;
     up = kBvhNone;
   }
-  if (isLeaf) leafParents[index] = up;
+  if (isLeaf) leafParents[leafPrims[index]] = up;
   else nodes[index].parent = up;
 }
 
