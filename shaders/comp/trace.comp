@@ -26,6 +26,7 @@ layout(std430, binding = kTraceBindingTexels) readonly buffer Texels { uint texe
 layout(std430, binding = kTraceBindingLights) readonly buffer Lights { GpuLight lights[]; };
 layout(binding = kTraceBindingImage, rgba16f) uniform writeonly image2D outImage;
 layout(std430, binding = kTraceBindingAov) writeonly buffer Aovs { TraceAov aovs[]; };
+layout(std430, binding = kTraceBindingRays) readonly buffer Rays { GpuRay rays[]; };
 
 const float kInf = 1.0 / 0.0;  // folded to +infinity at compile time
 const float kPi = 3.14159265358979;
@@ -118,7 +119,7 @@ void pushChildren(BvhNode node, ShearedRay r, float tMax, inout uint sp) {
 
 // One instance's tree, with the ray in its object space (t is shared: the
 // direction is not renormalised). Uses the stack above `base`.
-void traverseBlas(uint instance, vec3 origin, vec3 dir, uint skipPrim, uint base, inout Hit hit) {
+void traverseBlas(uint instance, vec3 origin, vec3 dir, uint skipPrim, float tMin, uint base, inout Hit hit) {
   GpuInstance inst = instances[instance];
   uint root = blasGroups[inst.geometry].root;
   if (root == kBvhNone) return;
@@ -138,14 +139,15 @@ void traverseBlas(uint instance, vec3 origin, vec3 dir, uint skipPrim, uint base
       if (tri == skipPrim) continue;  // the face this ray leaves
       vec3 bary;
       float t = intersectTriangle(r, tri, hit.t, bary);
-      if (t < hit.t) hit = Hit(t, instance, tri, bary);
+      if (t < hit.t && t > tMin) hit = Hit(t, instance, tri, bary);
       continue;
     }
     pushChildren(blasNodes[ref], r, hit.t, sp);
   }
 }
 
-Hit traceClosest(vec3 origin, vec3 dir, uint skipInstance, uint skipPrim) {
+// tMin: hits this close to the origin are the surface the ray leaves.
+Hit traceClosest(vec3 origin, vec3 dir, uint skipInstance, uint skipPrim, float tMin) {
   Hit hit = Hit(kInf, kNoHit, kNoHit, vec3(0.0));
   uint root = tlasGroups[0].root;
   if (root == kBvhNone) return hit;
@@ -158,7 +160,7 @@ Hit traceClosest(vec3 origin, vec3 dir, uint skipInstance, uint skipPrim) {
     ++visits;
     if ((ref & kBvhLeafBit) != 0u) {
       uint instance = ref & ~kBvhLeafBit;
-      traverseBlas(instance, origin, dir, instance == skipInstance ? skipPrim : kNoHit, sp, hit);
+      traverseBlas(instance, origin, dir, instance == skipInstance ? skipPrim : kNoHit, tMin, sp, hit);
       continue;
     }
     pushChildren(tlasNodes[ref], r, hit.t, sp);
@@ -312,7 +314,11 @@ void main() {
   float sx = (2.0 * (float(pixel.x) + 0.5) / float(pc.width) - 1.0) * pc.right.w;
   float sy = (1.0 - 2.0 * (float(pixel.y) + 0.5) / float(pc.height)) * pc.up.w;
   vec3 origin = vec3(0.0), dir;
-  if ((pc.flags & kTraceFlagOrthographic) != 0u) {
+  if ((pc.flags & kTraceFlagRayList) != 0u) {
+    GpuRay ray = rays[pixel.y * pc.width + pixel.x];
+    origin = ray.origin.xyz;
+    dir = ray.direction.xyz;
+  } else if ((pc.flags & kTraceFlagOrthographic) != 0u) {
     origin = sx * pc.right.xyz + sy * pc.up.xyz;
     dir = pc.forward.xyz;
   } else {
@@ -327,9 +333,10 @@ void main() {
   float firstDistance = -1.0;
   uint firstInstance = kNoHit, firstPrimitive = kNoHit;
   uint skipInstance = kNoHit, skipPrim = kNoHit;
+  float tMin = 0.0;
   // Each pass of the loop is one segment; maxInterfaces + 1 segments at most.
   for (uint segment = 0u; segment <= pc.maxInterfaces; ++segment) {
-    Hit hit = traceClosest(origin, dir, skipInstance, skipPrim);
+    Hit hit = traceClosest(origin, dir, skipInstance, skipPrim, tMin);
     if (hit.instance == kNoHit) {
       colour = throughput * pc.background.rgb;
       outcome = kOutcomeMiss;
@@ -366,6 +373,12 @@ void main() {
     throughput *= baseColour(m, s.uvs);
     ++interfaces;
     origin = offsetRay(s.position, dot(dir, s.ng) > 0.0 ? s.ng : -s.ng);
+    // The offset is the hit point's error bound. A face within that distance
+    // of the new origin meets the hit point within its rounding: the surface
+    // the ray leaves, not a new one. Skipping the hit triangle alone let rays
+    // through a cube's edges enter the face across the edge a second time
+    // (bench stress: watertight cube).
+    tMin = length(origin - s.position);
     skipInstance = hit.instance;
     skipPrim = hit.primitive;
   }

@@ -37,6 +37,7 @@ SNELL_CONST kBvhBindingBlasGroups = 11; // BvhGroup[geometryCount] of the bottom
 // node's subtree cost (float bits) and leaf count. The build binds the keys
 // buffer here: the keys are spent once the hierarchy exists.
 SNELL_CONST kBvhBindingNodeStats = 12;
+SNELL_CONST kBvhBindingDropped = 13;    // uint: triangles boxed empty because a vertex was not finite
 
 SNELL_CONST kBvhSpecWorkgroupSize = 0;
 

@@ -8,9 +8,14 @@
 //   orthographic: origin = eye + right sx' + up sy' with tanHalfFovY replaced by
 //                 the half height, direction = forward.
 // (scene/view.h resolves eye, right, up, forward and the fov; both tracers use it.)
+// Ray lists: instead of the camera, pixel i (row-major) may take its primary
+// ray from a list (origin, direction), for tests that aim rays at exact points.
 //
 // Hits. The closest triangle with t > 0 along the ray; a secondary ray never
-// hits the triangle it leaves at its origin. Barycentrics (b0, b1, b2) of
+// hits the triangle it leaves, nor any face that meets its origin within the
+// hit point's rounding (the GPU: closer than the offset the ray starts from;
+// the reference: closer than 1e-9 of the scene's size). Triangle tests are
+// watertight in both: a ray through a shared edge or vertex hits one of its triangles. Barycentrics (b0, b1, b2) of
 // p = b0 v0 + b1 v1 + b2 v2. In world space:
 //   Ng = normalize(cross(v1 - v0, v2 - v0)), the geometric normal;
 //   Ns = normalize(b0 n0 + b1 n1 + b2 n2), the shading normal (Ng where that is zero),
@@ -121,6 +126,7 @@ struct TraceAov {
 SNELL_CONST kNoHit = 0xffffffffu;
 SNELL_CONST kTraceFlagAov = 1u;
 SNELL_CONST kTraceFlagOrthographic = 2u;
+SNELL_CONST kTraceFlagRayList = 4u;  // primary rays from kTraceBindingRays, not the camera
 SNELL_CONST kTraceTile = 8;  // pixels per side of one workgroup's tile
 // Nodes one ray segment may visit before it gives up: a corrupted tree ends here.
 SNELL_CONST kTraceMaxVisits = 1u << 20;
@@ -141,6 +147,14 @@ SNELL_CONST kTraceBindingTexels = 11;     // uint[]: RGBA8
 SNELL_CONST kTraceBindingLights = 12;     // GpuLight[]
 SNELL_CONST kTraceBindingImage = 13;      // rgba16f storage image
 SNELL_CONST kTraceBindingAov = 14;        // TraceAov[width * height]
+SNELL_CONST kTraceBindingRays = 15;       // GpuRay[width * height], with kTraceFlagRayList
+
+// A primary ray from a list, camera-relative like everything the trace sees.
+// 32 bytes, total: 32 bytes
+struct GpuRay {
+  vec4 origin;     // 16: xyz; w unused
+  vec4 direction;  // 16: xyz, unit length; w unused
+};
 
 // Rays start at the camera: the scene is rebased to camera-relative coordinates.
 // 96 bytes, total: 96 bytes

@@ -23,6 +23,7 @@ int runEye(const Args& args);
 int runRender(const Args& args);
 int runBenchBvh(const Args& args);
 int runBenchFrame(const Args& args);
+int runBenchStress(const Args& args);
 
 /// A context on the device snell picks; SNELL_VALIDATION=1 turns on the validation layer.
 vk::ContextDesc contextDescFromEnvironment();

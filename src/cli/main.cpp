@@ -24,6 +24,7 @@ commands:
   bench sort [options]  time the GPU radix sort (see 'snell bench sort --help')
   bench bvh [scenes]    GPU BVH quality (SAH cost) against a CPU binned-SAH build
   bench frame [options] per-pass GPU time of a frame of the eye
+  bench stress          GPU against the CPU reference on the numerical stability grid
   help                  show this text
 
 environment:
@@ -34,16 +35,18 @@ environment:
 
 int runBench(const Args& args) {
   if (args.empty() || args[0] == "--help" || args[0] == "-h") {
-    std::printf("usage: snell bench sort|bvh|frame [options]\n\nbenchmarks:\n  sort   GPU radix sort, pairs per second\n"
+    std::printf("usage: snell bench sort|bvh|frame|stress [options]\n\nbenchmarks:\n  sort   GPU radix sort, pairs per second\n"
                 "  bvh    SAH cost of the GPU trees against a CPU binned-SAH build\n"
-                "  frame  per-pass GPU time of the eye's frame\n");
+                "  frame  per-pass GPU time of the eye's frame\n"
+                "  stress GPU against the CPU reference on the numerical stability grid\n");
     return args.empty() ? 2 : 0;
   }
   Args rest(args.begin() + 1, args.end());
   if (args[0] == "sort") return runBenchSort(rest);
   if (args[0] == "bvh") return runBenchBvh(rest);
   if (args[0] == "frame") return runBenchFrame(rest);
-  throw UsageError{"unknown benchmark '" + args[0] + "' (try: sort, bvh, frame)"};
+  if (args[0] == "stress") return runBenchStress(rest);
+  throw UsageError{"unknown benchmark '" + args[0] + "' (try: sort, bvh, frame, stress)"};
 }
 
 }  // namespace

@@ -138,7 +138,7 @@ struct ResolvedLight {
 // ---------------------------------------------------------------------------
 // Geometry
 
-/// What shading needs of a triangle; intersection reads the compact Edges.
+/// What shading needs of a triangle; intersection reads the compact Corners.
 struct TriangleData {
   glm::dvec3 v[3];
   glm::dvec3 n[3];   // world, unit, or zero where the shape has none
@@ -148,8 +148,10 @@ struct TriangleData {
   int material = -1;
 };
 
-struct Edges {
-  glm::dvec3 v0, e1, e2;
+// The corners exactly as every triangle sharing them sees them: the
+// watertight test needs a shared vertex to be bit-for-bit the same in each.
+struct Corners {
+  glm::dvec3 v[3];
 };
 
 struct BvhNode {
@@ -186,7 +188,7 @@ class PreparedScene {
   void buildBvh();
 
   std::vector<TriangleData> data_;
-  std::vector<Edges> edges_;
+  std::vector<Corners> corners_;
   std::vector<BvhNode> nodes_;
   std::vector<LinearTexture> textures_;
   std::vector<ResolvedMaterial> materials_;
@@ -359,10 +361,10 @@ void PreparedScene::buildBvh() {
 
   // Triangles in leaf order, so a leaf reads a contiguous run.
   std::vector<TriangleData> sorted(count);
-  edges_.resize(count);
+  corners_.resize(count);
   for (uint32_t i = 0; i < count; ++i) {
     sorted[i] = data_[order[i]];
-    edges_[i] = {sorted[i].v[0], sorted[i].v[1] - sorted[i].v[0], sorted[i].v[2] - sorted[i].v[0]};
+    corners_[i] = {{sorted[i].v[0], sorted[i].v[1], sorted[i].v[2]}};
   }
   data_ = std::move(sorted);
 }
@@ -390,8 +392,21 @@ bool slabs(const Aabb& box, const glm::dvec3& origin, const glm::dvec3& directio
 Hit PreparedScene::intersect(const glm::dvec3& origin, const glm::dvec3& direction, double tMin,
                              uint32_t excluded) const {
   Hit best;
-  if (edges_.empty()) return best;
+  if (corners_.empty()) return best;
   const glm::dvec3 inverse = 1.0 / direction;
+  // Watertight ray/triangle test (Woop, Benthin and Wald 2013) in double: the
+  // ray's dominant axis becomes z, the triangle is sheared into the ray's
+  // frame, and three edge functions decide. A shared edge's function is the
+  // same expression of the same two vertices in both of its triangles, so a
+  // ray through the edge is inside one of them whatever the rounding (the
+  // first, Möller-Trumbore version let rays aimed at shared edges slip through).
+  int kz = 0;
+  for (int a = 1; a < 3; ++a) {
+    if (std::abs(direction[a]) > std::abs(direction[kz])) kz = a;
+  }
+  int kx = (kz + 1) % 3, ky = (kx + 1) % 3;
+  if (direction[kz] < 0.0) std::swap(kx, ky);  // keeps the winding, so the edge functions' signs mean the same
+  const double sx = direction[kx] / direction[kz], sy = direction[ky] / direction[kz], sz = 1.0 / direction[kz];
   double entry = 0.0;
   if (!slabs(nodes_[0].box, origin, direction, inverse, tMin, kInfinity, entry)) return best;
   struct Entry {
@@ -408,20 +423,18 @@ Hit PreparedScene::intersect(const glm::dvec3& origin, const glm::dvec3& directi
     if (node.count > 0) {
       for (uint32_t i = node.first; i < node.first + node.count; ++i) {
         if (i == excluded) continue;
-        // Möller and Trumbore 1997, edges inclusive so that shared edges leave no gap.
-        const Edges& tri = edges_[i];
-        glm::dvec3 p = glm::cross(direction, tri.e2);
-        double det = glm::dot(tri.e1, p);
+        const Corners& tri = corners_[i];
+        const glm::dvec3 a = tri.v[0] - origin, b = tri.v[1] - origin, c = tri.v[2] - origin;
+        const double ax = a[kx] - sx * a[kz], ay = a[ky] - sy * a[kz];
+        const double bx = b[kx] - sx * b[kz], by = b[ky] - sy * b[kz];
+        const double cx = c[kx] - sx * c[kz], cy = c[ky] - sy * c[kz];
+        const double u = cx * by - cy * bx, v = ax * cy - ay * cx, w = bx * ay - by * ax;
+        if ((u < 0.0 || v < 0.0 || w < 0.0) && (u > 0.0 || v > 0.0 || w > 0.0)) continue;
+        const double det = u + v + w;
         if (det == 0.0) continue;
-        double inv = 1.0 / det;
-        glm::dvec3 s = origin - tri.v0;
-        double b1 = glm::dot(s, p) * inv;
-        if (b1 < 0.0 || b1 > 1.0) continue;
-        glm::dvec3 q = glm::cross(s, tri.e1);
-        double b2 = glm::dot(direction, q) * inv;
-        if (b2 < 0.0 || b1 + b2 > 1.0) continue;
-        double t = glm::dot(tri.e2, q) * inv;
+        const double t = (u * sz * a[kz] + v * sz * b[kz] + w * sz * c[kz]) / det;
         if (!(t > tMin)) continue;
+        const double b1 = v / det, b2 = w / det;
         if (t < best.t || (t == best.t && i < best.triangle)) best = {t, i, b1, b2};
       }
       continue;
@@ -583,6 +596,10 @@ ReferenceImage renderReference(const scene::Scene& scene, const scene::Pose& pos
   image.interfaces.assign(pixels, 0);
   image.outcome.assign(pixels, gpu::kOutcomeMiss);
   if (pixels == 0) return image;
+  if (!settings.rays.empty() && settings.rays.size() != pixels) {
+    throw std::invalid_argument("reference: " + std::to_string(settings.rays.size()) + " rays for " +
+                                std::to_string(pixels) + " pixels");
+  }
 
   const PreparedScene prepared(scene, pose, settings.view);
   const scene::View& view = settings.view;
@@ -596,7 +613,10 @@ ReferenceImage renderReference(const scene::Scene& scene, const scene::Pose& pos
         double sx = (2.0 * (double(x) + 0.5) / w - 1.0) * view.halfHeight * w / h;
         double sy = (1.0 - 2.0 * (double(y) + 0.5) / h) * view.halfHeight;
         glm::dvec3 origin = view.eye, direction = forward;
-        if (view.orthographic) {
+        if (!settings.rays.empty()) {
+          origin = settings.rays[image.index(x, y)].origin;
+          direction = glm::normalize(settings.rays[image.index(x, y)].direction);
+        } else if (view.orthographic) {
           origin = view.eye + view.right * sx + view.up * sy;
         } else {
           direction = glm::normalize(view.forward + sx * view.right + sy * view.up);

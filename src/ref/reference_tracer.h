@@ -21,6 +21,8 @@ struct ReferenceSettings {
   glm::dvec3 background{0.02, 0.02, 0.025};  ///< linear RGB a miss sees
   uint32_t maxInterfaces = gpu::kDefaultMaxInterfaces;  ///< refractive faces one ray may cross
   unsigned threads = 0;  ///< 0: std::thread::hardware_concurrency()
+  /// When not empty: width * height primary rays, pixel i (row-major) tracing rays[i].
+  std::vector<scene::Ray> rays;
 };
 
 /// Per-pixel results, row-major, row 0 the top of the picture.

@@ -77,6 +77,7 @@ Bvh BvhBuilder::makeBvh(const std::vector<uint32_t>& groupSizes, const std::stri
   bvh.leafParents = deviceBuffer(context_, n * 4, name + " leaf parents");
   bvh.nodes = deviceBuffer(context_, n * sizeof(gpu::BvhNode), name + " nodes");
   bvh.counters = deviceBuffer(context_, n * 4, name + " counters");
+  bvh.dropped = deviceBuffer(context_, 4, name + " dropped triangles");
   bvh.sortScratch = sort_.makeScratch(n);
 
   std::vector<uint32_t> primGroups;
@@ -106,6 +107,7 @@ Bvh BvhBuilder::makeBvh(const std::vector<uint32_t>& groupSizes, const std::stri
   commands.begin();
   // Nodes above the group roots are never fitted; zeroed, they read the same every time.
   commands.fillBuffer(bvh.nodes, 0);
+  commands.fillBuffer(bvh.dropped, 0);
   commands.copyBuffer(bvh.groupsInitial, bvh.groups, groupBytes);
   commands.transferToCompute();
   commands.submitAndWait();
@@ -118,7 +120,8 @@ void BvhBuilder::recordTriangleBoxes(vk::Commands& commands, const Bvh& bvh, con
   triangleBoxes_->dispatchThreads(commands,
                                   {{gpu::kBvhBindingPositions, &positions},
                                    {gpu::kBvhBindingIndices, &indices},
-                                   {gpu::kBvhBindingPrimBoxes, &bvh.primBoxes}},
+                                   {gpu::kBvhBindingPrimBoxes, &bvh.primBoxes},
+                                   {gpu::kBvhBindingDropped, &bvh.dropped}},
                                   push, count);
 }
 

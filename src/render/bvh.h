@@ -30,6 +30,7 @@ struct Bvh {
   uint32_t primitiveCount = 0;
   std::vector<uint32_t> groupSizes;
   vk::Buffer primBoxes, primGroups, groups, groupsInitial, keys, leafPrims, nodes, leafParents, counters;
+  vk::Buffer dropped;  ///< uint: non-finite triangles the box passes met since the caller last zeroed it
   RadixSort::Scratch sortScratch;
   uint32_t groupCount() const { return static_cast<uint32_t>(groupSizes.size()); }
   uint32_t firstPrimitive(uint32_t group) const;

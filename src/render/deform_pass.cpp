@@ -93,7 +93,8 @@ DeformPass::DeformPass(vk::Context& context, const scene::Scene& scene, const sc
   }
 }
 
-void DeformPass::record(vk::Commands& commands, const scene::Pose& pose) {
+void DeformPass::record(vk::Commands& commands, const scene::Pose& pose, const glm::dvec3& origin) {
+  const glm::dmat4 rebase = glm::translate(glm::dmat4(1.0), -origin);
   for (DeformOutput& out : outputs_) {
     const scene::DrawItem* found = static_cast<size_t>(out.item) < pose.items.size() ? &pose.items[size_t(out.item)] : nullptr;
     if (!found || found->scene != &scene_ || found->shape != out.shape || found->jointMatrices.size() != out.jointCount) {
@@ -104,7 +105,8 @@ void DeformPass::record(vk::Commands& commands, const scene::Pose& pose) {
     uint32_t targets = std::min<uint32_t>(in.targetCount, static_cast<uint32_t>(item.weights.size()));
     if (targets) std::memcpy(out.morphWeights.mapped().data(), item.weights.data(), targets * sizeof(float));
     if (out.jointCount) {
-      std::memcpy(out.jointMatrices.mapped().data(), item.jointMatrices.data(), out.jointCount * sizeof(glm::mat4));
+      auto* matrices = reinterpret_cast<glm::mat4*>(out.jointMatrices.mapped().data());
+      for (uint32_t j = 0; j < out.jointCount; ++j) matrices[j] = glm::mat4(rebase * item.jointMatrices[j]);
     }
     gpu::DeformPush push{in.vertexCount, targets, item.skinned ? out.jointCount : 0u, out.slot.firstVertex};
     auto orEmpty = [&](const vk::Buffer& b) { return b.handle() ? &b : &empty_; };

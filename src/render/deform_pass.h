@@ -56,7 +56,10 @@ class DeformPass {
   /// per deforming item, then a barrier that makes the outputs visible to
   /// compute and transfer. The host writes shared buffers: the previous
   /// frame's deform must have finished.
-  void record(vk::Commands& commands, const scene::Pose& pose);
+  /// Skinned positions come out relative to `origin` (the camera, for the
+  /// renderer): the joint matrices are moved there in double, so a character
+  /// far from the world's origin keeps float precision where it is.
+  void record(vk::Commands& commands, const scene::Pose& pose, const glm::dvec3& origin = glm::dvec3(0.0));
 
   const std::vector<DeformOutput>& outputs() const { return outputs_; }
 

@@ -41,6 +41,7 @@ static_assert(sizeof(GpuMaterial) == 112 && offsetof(GpuMaterial, textures) == 9
 static_assert(sizeof(GpuTexture) == 16 && offsetof(GpuTexture, flags) == 12);
 static_assert(sizeof(GpuLight) == 64 && offsetof(GpuLight, cone) == 48);
 static_assert(sizeof(TraceAov) == 32 && offsetof(TraceAov, nodeVisits) == 20);
+static_assert(sizeof(GpuRay) == 32 && offsetof(GpuRay, direction) == 16);
 static_assert(sizeof(TracePush) == 96 && offsetof(TracePush, width) == 64 && offsetof(TracePush, tilesX) == 84);
 
 }  // namespace snell::gpu

@@ -43,8 +43,9 @@ Renderer::Renderer(vk::Context& context, const scene::Scene& scene, const scene:
   for (const scene::Node& node : scene.nodes) lightNodes += node.light >= 0 ? 1 : 0;
   lights_ = vk::Buffer(context, {std::max<size_t>(lightNodes, 1) * sizeof(gpu::GpuLight), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
                                  vk::MemoryDomain::Upload, name + " lights"});
+  static_assert(sizeof(gpu::TraceAov) == sizeof(gpu::GpuRay));
   placeholder_ = vk::Buffer(context, {sizeof(gpu::TraceAov), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
-                                      vk::MemoryDomain::Device, "no AOV"});
+                                      vk::MemoryDomain::Device, "no AOV or ray list"});
   trace_ = std::make_unique<vk::ComputeProgram>(context, vk::ComputeProgramDesc{"trace", kSpvTrace, {}, false});
 }
 
@@ -63,7 +64,7 @@ uint64_t Renderer::memoryBytes() const {
 }
 
 void Renderer::record(vk::Commands& commands, const scene::Pose& pose, const FrameSettings& settings,
-                      const vk::Image& target, const vk::Buffer* aov) {
+                      const vk::Image& target, const vk::Buffer* aov, const vk::Buffer* rays) {
   if (pose.items.size() != scene_.itemGeometry.size()) {
     throw vk::VulkanError("renderer: the pose has " + std::to_string(pose.items.size()) + " draw items; it was built for " +
                           std::to_string(scene_.itemGeometry.size()));
@@ -79,7 +80,8 @@ void Renderer::record(vk::Commands& commands, const scene::Pose& pose, const Fra
   glm::dmat4 rebase = glm::dmat4(1.0);
   rebase[3] = glm::dvec4(-eye, 1.0);
   for (size_t i = 0; i < pose.items.size(); ++i) {
-    glm::dmat4 toWorld = rebase * glm::dmat4(pose.items[i].world);
+    // Skinned positions come out of the deform pass camera-relative already.
+    glm::dmat4 toWorld = pose.items[i].skinned ? glm::dmat4(1.0) : rebase * pose.items[i].world;
     gpu::GpuInstance inst{};
     rows(toWorld, inst.objectToWorld);
     rows(glm::inverse(toWorld), inst.worldToObject);
@@ -106,8 +108,12 @@ void Renderer::record(vk::Commands& commands, const scene::Pose& pose, const Fra
     lights[lightCount++] = g;
   }
 
+  // Counts the triangles this frame's box pass finds non-finite (RenderedFrame::droppedTriangles).
+  commands.fillBuffer(blas_.dropped, 0);
+  commands.transferToCompute();
+
   commands.beginPass("deform");
-  deform_->record(commands, pose);
+  deform_->record(commands, pose, eye);
   commands.endPass();
 
   if (!blasBuilt_) {
@@ -152,7 +158,8 @@ void Renderer::record(vk::Commands& commands, const scene::Pose& pose, const Fra
   push.height = settings.height;
   push.maxInterfaces = settings.maxInterfaces;
   push.lightCount = lightCount;
-  push.flags = (aov ? gpu::kTraceFlagAov : 0u) | (v.orthographic ? gpu::kTraceFlagOrthographic : 0u);
+  push.flags = (aov ? gpu::kTraceFlagAov : 0u) | (v.orthographic ? gpu::kTraceFlagOrthographic : 0u) |
+               (rays ? gpu::kTraceFlagRayList : 0u);
   push.tilesX = (settings.width + gpu::kTraceTile - 1) / gpu::kTraceTile;
   uint32_t tilesY = (settings.height + gpu::kTraceTile - 1) / gpu::kTraceTile;
   trace_->dispatchGroups(commands,
@@ -170,7 +177,8 @@ void Renderer::record(vk::Commands& commands, const scene::Pose& pose, const Fra
                           {gpu::kTraceBindingTexels, &scene_.texels},
                           {gpu::kTraceBindingLights, &lights_},
                           {gpu::kTraceBindingImage, nullptr, &target},
-                          {gpu::kTraceBindingAov, aov ? aov : &placeholder_}},
+                          {gpu::kTraceBindingAov, aov ? aov : &placeholder_},
+                          {gpu::kTraceBindingRays, rays ? rays : &placeholder_}},
                          push, uint64_t(push.tilesX) * tilesY);
   commands.endPass();
 }
@@ -199,10 +207,25 @@ RenderedFrame renderFrame(vk::Context& context, Renderer& renderer, const scene:
                                VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT,
                                vk::MemoryDomain::Device, "trace AOV"});
   }
+  vk::Buffer rays;
+  if (!settings.rays.empty()) {
+    if (settings.rays.size() != pixels) {
+      throw std::invalid_argument("renderFrame: " + std::to_string(settings.rays.size()) + " rays for " +
+                                  std::to_string(pixels) + " pixels");
+    }
+    rays = vk::Buffer(context, {pixels * sizeof(gpu::GpuRay), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
+                                vk::MemoryDomain::Upload, "ray list"});
+    auto* out = reinterpret_cast<gpu::GpuRay*>(rays.mapped().data());
+    for (size_t i = 0; i < pixels; ++i) {
+      // Camera-relative in double, like the instances, before the cast to float.
+      out[i].origin = glm::vec4(glm::vec3(settings.rays[i].origin - settings.view.eye), 1.0f);
+      out[i].direction = glm::vec4(glm::vec3(glm::normalize(settings.rays[i].direction)), 0.0f);
+    }
+  }
   vk::Commands commands(context, "frame");
   commands.begin();
   commands.imageLayout(image, VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_GENERAL);
-  renderer.record(commands, pose, settings, image, withAov ? &aov : nullptr);
+  renderer.record(commands, pose, settings, image, withAov ? &aov : nullptr, settings.rays.empty() ? nullptr : &rays);
   commands.computeToTransfer();
   commands.submitAndWait();
 
@@ -216,6 +239,7 @@ RenderedFrame renderFrame(vk::Context& context, Renderer& renderer, const scene:
   for (size_t i = 0; i < pixels; ++i) {
     for (int c = 0; c < 4; ++c) frame.rgba[i][c] = glm::unpackHalf1x16(halves[4 * i + size_t(c)]);
   }
+  vk::download(context, renderer.blas().dropped, &frame.droppedTriangles, 4);
   if (withAov) {
     frame.aov.resize(pixels);
     vk::download(context, aov, frame.aov.data(), pixels * sizeof(gpu::TraceAov));

@@ -27,6 +27,10 @@ struct FrameSettings {
   scene::View view;
   glm::vec3 background{0.02f, 0.02f, 0.025f};
   uint32_t maxInterfaces = gpu::kDefaultMaxInterfaces;
+  /// When not empty: width * height primary rays in world space, pixel i
+  /// (row-major) tracing rays[i] instead of the camera's ray through it.
+  /// The view's eye still sets the camera-relative origin the trace works in.
+  std::vector<scene::Ray> rays;
 };
 
 class Renderer {
@@ -36,10 +40,12 @@ class Renderer {
   ~Renderer();
 
   /// Records a frame of `pose` into `target` (rgba16f, GENERAL layout) and,
-  /// when `aov` is given, per-pixel gpu::TraceAov records. The host writes the
-  /// frame's instances and lights: the previous frame must have finished.
+  /// when `aov` is given, per-pixel gpu::TraceAov records. `rays`, when given,
+  /// holds width * height gpu::GpuRay (camera-relative) to trace instead of the
+  /// camera's. The host writes the frame's instances and lights: the previous
+  /// frame must have finished.
   void record(vk::Commands& commands, const scene::Pose& pose, const FrameSettings& settings, const vk::Image& target,
-              const vk::Buffer* aov = nullptr);
+              const vk::Buffer* aov = nullptr, const vk::Buffer* rays = nullptr);
 
   /// Forces the next frame to rebuild the bottom level instead of refitting it.
   void invalidateBlas() { blasBuilt_ = false; }
@@ -68,6 +74,9 @@ struct RenderedFrame {
   uint32_t width = 0, height = 0;
   std::vector<glm::vec4> rgba;
   std::vector<gpu::TraceAov> aov;  ///< empty unless asked for
+  /// Triangles left out of this frame's tree because deformation made a vertex
+  /// NaN or infinite (all triangles are checked on a build, deforming ones on a refit).
+  uint32_t droppedTriangles = 0;
   std::vector<vk::PassTime> passes;
 };
 

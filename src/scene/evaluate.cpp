@@ -121,18 +121,18 @@ Pose evaluate(const Scene& scene, double time) {
   }
 
   // Parents before children: walk down from the roots (the loader refused cycles).
-  pose.world.assign(nodeCount, glm::mat4(1.0f));
-  std::vector<std::pair<int, glm::mat4>> stack;
-  for (auto it = scene.roots.rbegin(); it != scene.roots.rend(); ++it) stack.push_back({*it, glm::mat4(1.0f)});
+  pose.world.assign(nodeCount, glm::dmat4(1.0));
+  std::vector<std::pair<int, glm::dmat4>> stack;
+  for (auto it = scene.roots.rbegin(); it != scene.roots.rend(); ++it) stack.push_back({*it, glm::dmat4(1.0)});
   std::vector<int> order;
   while (!stack.empty()) {
     auto [n, parent] = stack.back();
     stack.pop_back();
     const Node& node = scene.nodes[size_t(n)];
     const LocalTransform& l = local[size_t(n)];
-    glm::mat4 m = node.matrix ? *node.matrix
-                              : glm::translate(glm::mat4(1.0f), l.translation) * glm::mat4_cast(l.rotation) *
-                                    glm::scale(glm::mat4(1.0f), l.scale);
+    glm::dmat4 m = node.matrix ? glm::dmat4(*node.matrix)
+                               : glm::translate(glm::dmat4(1.0), glm::dvec3(l.translation)) *
+                                     glm::mat4_cast(glm::dquat(l.rotation)) * glm::scale(glm::dmat4(1.0), glm::dvec3(l.scale));
     pose.world[size_t(n)] = parent * m;
     order.push_back(n);
     for (auto child = node.children.rbegin(); child != node.children.rend(); ++child) {
@@ -143,16 +143,17 @@ Pose evaluate(const Scene& scene, double time) {
   for (int n : order) {
     const Node& node = scene.nodes[size_t(n)];
     if (node.mesh < 0) continue;
-    std::vector<glm::mat4> joints;
+    std::vector<glm::dmat4> joints;
     if (node.skin >= 0) {
       const Skin& skin = scene.skins[size_t(node.skin)];
       for (size_t j = 0; j < skin.joints.size(); ++j) {
-        joints.push_back(pose.world[size_t(skin.joints[j])] * skin.inverseBindMatrices[j]);
+        joints.push_back(pose.world[size_t(skin.joints[j])] * glm::dmat4(skin.inverseBindMatrices[j]));
       }
     }
     std::vector<glm::mat4> copies = node.instances;
     if (copies.empty()) copies.push_back(glm::mat4(1.0f));
     for (const glm::mat4& copy : copies) {
+      const glm::dmat4 instance(copy);
       for (int shapeIndex : scene.meshes[size_t(node.mesh)].shapes) {
         DrawItem item;
         item.scene = &scene;
@@ -160,7 +161,7 @@ Pose evaluate(const Scene& scene, double time) {
         item.node = n;
         item.skinned = node.skin >= 0 && scene.shapes[size_t(shapeIndex)].skinned();
         // glTF: a skinned mesh ignores its node's transform; the joints place it.
-        item.world = item.skinned ? glm::mat4(1.0f) : pose.world[size_t(n)] * copy;
+        item.world = item.skinned ? glm::dmat4(1.0) : pose.world[size_t(n)] * instance;
         item.weights = weights[size_t(n)];
         if (item.skinned) item.jointMatrices = joints;
         pose.items.push_back(std::move(item));
@@ -185,7 +186,7 @@ void deformOnCpu(const DrawItem& item, std::vector<glm::dvec3>& positions, std::
     }
     if (item.skinned) {
       glm::dmat4 m(0.0);
-      for (int k = 0; k < 4; ++k) m += double(shape.weights[v][k]) * glm::dmat4(item.jointMatrices[shape.joints[v][k]]);
+      for (int k = 0; k < 4; ++k) m += double(shape.weights[v][k]) * item.jointMatrices[shape.joints[v][k]];
       p = glm::dvec3(m * glm::dvec4(p, 1.0));
       // The cofactor is det * inverse-transpose: right under non-uniform scale,
       // and the sign keeps a mirrored normal pointing out of the surface.

@@ -15,19 +15,21 @@ namespace snell::scene {
 struct DrawItem {
   int shape = -1;
   int node = -1;
-  /// Object to world. Identity for skinned items: their joints place them.
-  glm::mat4 world{1.0f};
+  /// Object to world, in double: a float matrix would round a child's offset
+  /// against a parent's large translation (1 mm lost at 10 km). Identity for
+  /// skinned items: their joints place them.
+  glm::dmat4 world{1.0};
   bool skinned = false;  ///< deformed by the node's skin
   bool deforms() const;  ///< skinned or morphed: the deform pass runs for it
   std::vector<float> weights;          ///< morph weights (the node's, or the mesh's defaults)
-  std::vector<glm::mat4> jointMatrices;  ///< jointWorld * inverseBind, per skin joint
+  std::vector<glm::dmat4> jointMatrices;  ///< jointWorld * inverseBind, per skin joint
   const Scene* scene = nullptr;
 };
 
 /// Node transforms and everything drawn, at one time.
 struct Pose {
   double time = 0.0;
-  std::vector<glm::mat4> world;  ///< per node
+  std::vector<glm::dmat4> world;  ///< per node, in double (see DrawItem::world)
   std::vector<DrawItem> items;
 };
 

@@ -24,6 +24,12 @@ struct ViewRequest {
   double yfov = 0.6981317;        ///< radians, for look-at and framed views (40 degrees)
 };
 
+/// A ray in world space, for ray lists (FrameSettings::rays, ReferenceSettings::rays).
+struct Ray {
+  glm::dvec3 origin{0.0};
+  glm::dvec3 direction{0.0, 0.0, -1.0};  ///< unit length
+};
+
 /// A camera frame in world space, orthonormal, in double precision.
 struct View {
   glm::dvec3 eye{0.0};

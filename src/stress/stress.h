@@ -1,0 +1,110 @@
+// The numerical stability grid (issue 6): hard scenes rendered by the GPU and
+// by the CPU double-precision reference, compared pixel by pixel or ray by
+// ray. `snell bench stress` runs the whole grid; tests/stress_test.cpp runs a
+// smaller one and asserts every case's bounds.
+#pragma once
+
+#include "scene/evaluate.h"
+#include "scene/scene.h"
+#include "scene/view.h"
+#include "vk/context.h"
+
+#include <functional>
+#include <string>
+#include <vector>
+
+namespace snell::stress {
+
+// ---- Scenes (stress_scenes.cpp) ----
+
+/// `s` under a new root node that scales it by `scale`, then moves it by `offset`.
+scene::Scene placed(scene::Scene s, const glm::vec3& offset, float scale);
+/// The procedural eye with its cornea's IOR, in front of a coloured backdrop.
+scene::Scene eyeScene(float ior);
+/// A closed UV sphere (shared vertices, outward winding) of radius 1 at the origin.
+scene::Scene sphereScene(uint32_t segments, float ior);
+/// A closed cube [-1, 1]^3, each face split into n x n quads sharing their vertices.
+scene::Scene cubeScene(uint32_t n, float ior);
+/// A closed slab [-1, 1]^2 x [0, thickness] in front of the backdrop.
+scene::Scene slabScene(float thickness, float ior);
+/// A quad of good triangles plus zero-area, duplicated and sliver triangles, before the backdrop.
+scene::Scene degenerateScene();
+/// A shape whose every vertex is the same point, before the backdrop.
+scene::Scene collapsedScene();
+/// `count` small opaque triangles in a square grid (0 and 1 included).
+scene::Scene gridScene(uint64_t count);
+/// A sphere with two morph targets: the first at weight 1 squashes it to 1% of
+/// its depth, the second at weight 1 turns it inside out (every vertex through the centre).
+scene::Scene morphingSphereScene(float ior);
+/// A sphere whose one morph target (at weight 1) sends a band of vertices to NaN
+/// and one to infinity; `poisonedTriangles` says how many triangles that spoils.
+scene::Scene nonFiniteMorphScene(uint32_t& poisonedTriangles);
+
+// ---- The grid (stress_grid.cpp) ----
+
+enum class Kind {
+  Image,      ///< camera rays; compared with the reference pixel by pixel
+  AimedRays,  ///< rays aimed at exact points on a surface (ray list); leaks and self-hits counted
+};
+
+struct Case {
+  std::string name;
+  std::string group;  ///< far, scale, grazing, ior, watertight, self-hit, degenerate, deform, size
+  Kind kind = Kind::Image;
+  std::function<scene::Scene()> makeScene;
+  uint32_t width = 64, height = 48;
+  /// Where the camera is (also the camera-relative origin for ray lists).
+  std::function<scene::View(const scene::Scene&, const scene::Pose&)> view;
+  /// Ray lists: width * height rays and, per ray, how far its aimed point is.
+  std::function<void(const scene::Scene&, const scene::Pose&, std::vector<scene::Ray>&, std::vector<double>&)> aim;
+  /// Whether every aimed ray must come out again: a closed mesh of IOR 1, where
+  /// every crossing is a refraction (internal reflections also count as crossings).
+  bool closed = false;
+  /// Whether a ray crossing more faces than the reference counts as a self-hit.
+  /// Not for the glass cube: a ray entering exactly at a corner takes that
+  /// corner's normal from whichever triangle it meets, and its internal
+  /// reflections then diverge from the reference's without touching any origin.
+  bool countSelfHits = true;
+  /// Frames to render (deformation cases): weights per frame set by `morph`.
+  uint32_t frames = 1;
+  std::function<void(scene::Pose&, uint32_t frame)> morph;
+  double time = 0.0;
+  uint32_t maxInterfaces = 8;
+  /// Bounds the test asserts, stated per case: the largest channel error in
+  /// 1/255 anywhere, and the share of pixels that may differ by more than 1/255.
+  int maxError = 255;
+  double overOneShare = 0.002;
+  /// Triangles the GPU must report dropped (non-finite after deformation); -1: not checked.
+  int64_t expectDropped = -1;
+};
+
+struct Result {
+  std::string name, group;
+  uint64_t pixels = 0;
+  int maxError = 0;          ///< largest channel difference, 1/255 (sRGB 8-bit)
+  double meanError = 0.0;    ///< mean channel difference, 1/255
+  uint64_t overOne = 0;      ///< pixels with a channel more than 1/255 off
+  uint64_t nanCount = 0;     ///< GPU pixels with a NaN or infinite channel
+  uint64_t leakCount = 0;    ///< aimed rays that slipped through, or entered a closed mesh and never left
+  uint64_t selfHitCount = 0; ///< aimed rays that crossed more faces than the reference (hit their own surface)
+  uint64_t capHits = 0;      ///< rays that ran into the traversal's step cap
+  uint64_t dropped = 0;      ///< triangles the GPU dropped as non-finite
+  std::string error;         ///< set when the case could not run (a clear error instead of a picture)
+  std::string firstProblems; ///< the first few pixels or rays that leaked, self-hit or differ, GPU against reference
+  double seconds = 0.0;      ///< wall time, GPU and reference together
+};
+
+struct GridOptions {
+  uint32_t imageWidth = 96, imageHeight = 72;
+  uint32_t aimedRaysSide = 128;  ///< aimed-ray cases trace side x side rays
+  bool huge = false;             ///< include the 10^7-triangle case
+};
+
+std::vector<Case> grid(const GridOptions& options);
+
+/// Renders one case on the GPU and with the reference and compares them.
+/// Throws only for a bug in the case itself; errors of the scene or the
+/// device (too large, say) come back in Result::error.
+Result run(vk::Context& context, const Case& c);
+
+}  // namespace snell::stress

@@ -1,0 +1,326 @@
+// Scenes for the stability grid, built in code so every case is exact and
+// small enough to trace on the CPU in double.
+#include "scene/procedural_eye.h"
+#include "stress/stress.h"
+
+#include <glm/gtc/constants.hpp>
+
+#include <cmath>
+#include <limits>
+
+namespace snell::stress {
+
+namespace {
+
+int addMaterial(scene::Scene& s, const scene::Material& m) {
+  s.materials.push_back(m);
+  return int(s.materials.size()) - 1;
+}
+
+scene::Material glass(float ior) {
+  scene::Material m;
+  m.name = "glass";
+  m.transmission = 1.0f;
+  m.ior = ior;
+  m.baseColorFactor = {0.95f, 0.97f, 1.0f, 1.0f};
+  return m;
+}
+
+scene::Material selfLit(const glm::vec3& colour) {
+  scene::Material m;
+  m.name = "wall";
+  m.baseColorFactor = glm::vec4(colour, 1.0f);
+  m.emissiveFactor = colour * 0.8f;
+  return m;
+}
+
+// Adds `shape` as a root node of its own; smooth normals are computed when absent.
+int addShape(scene::Scene& s, scene::Shape shape) {
+  if (shape.normals.empty()) {
+    shape.normals.assign(shape.positions.size(), glm::vec3(0.0f));
+    for (size_t t = 0; t + 2 < shape.indices.size(); t += 3) {
+      const glm::vec3& a = shape.positions[shape.indices[t]];
+      glm::vec3 n = glm::cross(shape.positions[shape.indices[t + 1]] - a, shape.positions[shape.indices[t + 2]] - a);
+      for (int k = 0; k < 3; ++k) shape.normals[shape.indices[t + size_t(k)]] += n;
+    }
+    for (glm::vec3& n : shape.normals) {
+      float l = glm::length(n);
+      n = std::isfinite(l) && l > 0.0f ? n / l : glm::vec3(0.0f, 0.0f, 1.0f);
+    }
+  }
+  s.shapes.push_back(std::move(shape));
+  scene::Mesh mesh;
+  mesh.name = s.shapes.back().name;
+  mesh.shapes = {int(s.shapes.size()) - 1};
+  mesh.weights.assign(s.shapes.back().targets.size(), 0.0f);
+  s.meshes.push_back(mesh);
+  scene::Node node;
+  node.name = mesh.name;
+  node.mesh = int(s.meshes.size()) - 1;
+  s.nodes.push_back(node);
+  s.roots.push_back(int(s.nodes.size()) - 1);
+  return int(s.nodes.size()) - 1;
+}
+
+void quad(scene::Shape& shape, glm::vec3 a, glm::vec3 b, glm::vec3 c, glm::vec3 d) {
+  uint32_t base = uint32_t(shape.positions.size());
+  shape.positions.insert(shape.positions.end(), {a, b, c, d});
+  shape.indices.insert(shape.indices.end(), {base, base + 1, base + 2, base, base + 2, base + 3});
+}
+
+// A wall of self-lit coloured tiles at z = depth facing +z, `half` wide each
+// way: sharp colour edges make any bend of a refracted ray show.
+void addBackdrop(scene::Scene& s, float half, float depth) {
+  const glm::vec3 colours[4] = {{0.9f, 0.2f, 0.1f}, {0.1f, 0.3f, 0.9f}, {0.95f, 0.85f, 0.2f}, {0.1f, 0.7f, 0.3f}};
+  int materials[4];
+  for (int i = 0; i < 4; ++i) materials[i] = addMaterial(s, selfLit(colours[i]));
+  const int tiles = 8;
+  float step = 2.0f * half / tiles;
+  for (int i = 0; i < 4; ++i) {
+    scene::Shape shape;
+    shape.name = "backdrop" + std::to_string(i);
+    shape.material = materials[i];
+    for (int y = 0; y < tiles; ++y) {
+      for (int x = 0; x < tiles; ++x) {
+        if ((x + 2 * y) % 4 != i) continue;
+        float x0 = -half + float(x) * step, y0 = -half + float(y) * step;
+        quad(shape, {x0, y0, depth}, {x0 + step, y0, depth}, {x0 + step, y0 + step, depth}, {x0, y0 + step, depth});
+      }
+    }
+    addShape(s, shape);
+  }
+}
+
+scene::Shape uvSphere(uint32_t segments, float radius) {
+  scene::Shape shape;
+  shape.name = "sphere";
+  uint32_t rings = std::max(segments / 2, 2u);
+  // Poles are single shared vertices: no gap where the fans meet.
+  shape.positions.push_back({0, 0, radius});
+  for (uint32_t r = 1; r < rings; ++r) {
+    float theta = glm::pi<float>() * float(r) / float(rings);
+    for (uint32_t k = 0; k < segments; ++k) {
+      float phi = 2.0f * glm::pi<float>() * float(k) / float(segments);
+      shape.positions.push_back(radius * glm::vec3(std::sin(theta) * std::cos(phi), std::sin(theta) * std::sin(phi),
+                                                   std::cos(theta)));
+    }
+  }
+  uint32_t south = uint32_t(shape.positions.size());
+  shape.positions.push_back({0, 0, -radius});
+  auto at = [&](uint32_t r, uint32_t k) { return 1 + (r - 1) * segments + k % segments; };
+  for (uint32_t k = 0; k < segments; ++k) {
+    shape.indices.insert(shape.indices.end(), {0, at(1, k), at(1, k + 1)});
+    shape.indices.insert(shape.indices.end(), {south, at(rings - 1, k + 1), at(rings - 1, k)});
+  }
+  for (uint32_t r = 1; r + 1 < rings; ++r) {
+    for (uint32_t k = 0; k < segments; ++k) {
+      shape.indices.insert(shape.indices.end(), {at(r, k), at(r + 1, k), at(r + 1, k + 1)});
+      shape.indices.insert(shape.indices.end(), {at(r, k), at(r + 1, k + 1), at(r, k + 1)});
+    }
+  }
+  return shape;
+}
+
+}  // namespace
+
+scene::Scene placed(scene::Scene s, const glm::vec3& offset, float scale) {
+  scene::Node root;
+  root.name = "stress placement";
+  root.translation = offset;
+  root.scale = glm::vec3(scale);
+  int index = int(s.nodes.size());
+  for (int r : s.roots) {
+    s.nodes[size_t(r)].parent = index;
+    root.children.push_back(r);
+  }
+  s.nodes.push_back(root);
+  s.roots = {index};
+  return s;
+}
+
+scene::Scene eyeScene(float ior) {
+  // makeEye takes a human range of IORs; the grid also wants ones below 1.
+  scene::Scene s = scene::makeEye();
+  for (scene::Material& m : s.materials) {
+    if (m.refractive()) m.ior = ior;
+  }
+  addBackdrop(s, 0.03f, -0.02f);
+  return s;
+}
+
+scene::Scene sphereScene(uint32_t segments, float ior) {
+  scene::Scene s;
+  s.source = "stress sphere";
+  scene::Shape shape = uvSphere(segments, 1.0f);
+  shape.material = addMaterial(s, glass(ior));
+  addShape(s, shape);
+  addBackdrop(s, 3.0f, -3.0f);
+  return s;
+}
+
+scene::Scene cubeScene(uint32_t n, float ior) {
+  scene::Scene s;
+  s.source = "stress cube";
+  scene::Shape shape;
+  shape.name = "cube";
+  shape.material = addMaterial(s, glass(ior));
+  // Six faces, each an (n+1)^2 vertex grid; the faces' border vertices are
+  // welded so that the cube is one closed, indexed surface.
+  auto vertex = [&](glm::vec3 p) {
+    for (uint32_t i = 0; i < shape.positions.size(); ++i) {
+      if (shape.positions[i] == p) return i;
+    }
+    shape.positions.push_back(p);
+    return uint32_t(shape.positions.size() - 1);
+  };
+  for (int axis = 0; axis < 3; ++axis) {
+    for (float side : {-1.0f, 1.0f}) {
+      int u = (axis + 1) % 3, v = (axis + 2) % 3;
+      for (uint32_t i = 0; i < n; ++i) {
+        for (uint32_t j = 0; j < n; ++j) {
+          auto corner = [&](uint32_t a, uint32_t b) {
+            glm::vec3 p(0.0f);
+            p[axis] = side;
+            p[u] = -1.0f + 2.0f * float(a) / float(n);
+            p[v] = -1.0f + 2.0f * float(b) / float(n);
+            return vertex(p);
+          };
+          uint32_t a = corner(i, j), b = corner(i + 1, j), c = corner(i + 1, j + 1), d = corner(i, j + 1);
+          // (u, v, axis) is right-handed: counter-clockwise seen from +axis.
+          if (side > 0) shape.indices.insert(shape.indices.end(), {a, b, c, a, c, d});
+          else shape.indices.insert(shape.indices.end(), {a, c, b, a, d, c});
+        }
+      }
+    }
+  }
+  // Flat normals would split the vertices; the cube's refraction is per face anyway.
+  addShape(s, shape);
+  addBackdrop(s, 4.0f, -4.0f);
+  return s;
+}
+
+scene::Scene slabScene(float thickness, float ior) {
+  scene::Scene s;
+  s.source = "stress slab";
+  scene::Shape shape;
+  shape.name = "slab";
+  shape.material = addMaterial(s, glass(ior));
+  float t = thickness;
+  glm::vec3 c[8] = {{-1, -1, 0}, {1, -1, 0}, {1, 1, 0}, {-1, 1, 0}, {-1, -1, t}, {1, -1, t}, {1, 1, t}, {-1, 1, t}};
+  shape.positions.assign(c, c + 8);
+  shape.indices = {4, 5, 6, 4, 6, 7,  // top, +z
+                   0, 2, 1, 0, 3, 2,  // bottom, -z
+                   0, 1, 5, 0, 5, 4, 1, 2, 6, 1, 6, 5, 2, 3, 7, 2, 7, 6, 3, 0, 4, 3, 4, 7};
+  // Face normals: the top and bottom must bend the ray as flat glass does.
+  shape.normals.assign(8, glm::vec3(0.0f));
+  for (int i = 0; i < 4; ++i) shape.normals[size_t(i)] = {0, 0, -1};
+  for (int i = 4; i < 8; ++i) shape.normals[size_t(i)] = {0, 0, 1};
+  addShape(s, shape);
+  addBackdrop(s, 2.0f, -1.0f);
+  return s;
+}
+
+scene::Scene degenerateScene() {
+  scene::Scene s;
+  s.source = "stress degenerate triangles";
+  scene::Shape shape;
+  shape.name = "degenerate";
+  shape.material = addMaterial(s, glass(1.5f));
+  quad(shape, {-0.5f, -0.5f, 0}, {0.5f, -0.5f, 0}, {0.5f, 0.5f, 0}, {-0.5f, 0.5f, 0});
+  uint32_t n = uint32_t(shape.positions.size());
+  // Zero area: three collinear points, and a triangle with a repeated vertex.
+  shape.positions.insert(shape.positions.end(), {{-0.4f, 0.1f, 0.2f}, {0.0f, 0.1f, 0.2f}, {0.4f, 0.1f, 0.2f}});
+  shape.indices.insert(shape.indices.end(), {n, n + 1, n + 2, n, n, n + 1});
+  // Duplicates of the quad's first triangle, same and opposite winding.
+  shape.indices.insert(shape.indices.end(), {0, 1, 2, 0, 2, 1});
+  // A sliver: 1e-7 high over a unit base.
+  uint32_t m = uint32_t(shape.positions.size());
+  shape.positions.insert(shape.positions.end(), {{-0.5f, -0.2f, 0.1f}, {0.5f, -0.2f, 0.1f}, {0.0f, -0.2f + 1e-7f, 0.1f}});
+  shape.indices.insert(shape.indices.end(), {m, m + 1, m + 2});
+  addShape(s, shape);
+  addBackdrop(s, 1.0f, -1.0f);
+  return s;
+}
+
+scene::Scene collapsedScene() {
+  scene::Scene s;
+  s.source = "stress collapsed shape";
+  scene::Shape shape;
+  shape.name = "point";
+  shape.material = addMaterial(s, glass(1.5f));
+  shape.positions.assign(30, glm::vec3(0.1f, 0.2f, 0.3f));
+  for (uint32_t i = 0; i < 30; ++i) shape.indices.push_back(i);
+  addShape(s, shape);
+  addBackdrop(s, 1.0f, -1.0f);
+  return s;
+}
+
+scene::Scene gridScene(uint64_t count) {
+  scene::Scene s;
+  s.source = "stress grid of " + std::to_string(count) + " triangles";
+  scene::Material grey;
+  grey.baseColorFactor = {0.7f, 0.7f, 0.7f, 1.0f};
+  int material = addMaterial(s, grey);
+  scene::Shape shape;
+  shape.name = "grid";
+  shape.material = material;
+  uint64_t side = std::max<uint64_t>(1, uint64_t(std::ceil(std::sqrt(double(count)))));
+  shape.positions.reserve(size_t(count) * 3);
+  shape.indices.reserve(size_t(count) * 3);
+  float cell = 2.0f / float(side);
+  for (uint64_t t = 0; t < count; ++t) {
+    float x = -1.0f + cell * float(t % side), y = -1.0f + cell * float(t / side);
+    uint32_t base = uint32_t(shape.positions.size());
+    shape.positions.insert(shape.positions.end(), {{x, y, 0}, {x + 0.8f * cell, y, 0}, {x, y + 0.8f * cell, 0}});
+    shape.indices.insert(shape.indices.end(), {base, base + 1, base + 2});
+  }
+  shape.normals.assign(shape.positions.size(), glm::vec3(0, 0, 1));
+  addShape(s, shape);
+  return s;
+}
+
+scene::Scene morphingSphereScene(float ior) {
+  scene::Scene s;
+  s.source = "stress morphing sphere";
+  scene::Shape shape = uvSphere(32, 1.0f);
+  shape.material = addMaterial(s, glass(ior));
+  scene::MorphTarget squash, insideOut;
+  for (const glm::vec3& p : shape.positions) {
+    squash.positions.push_back({0.0f, 0.0f, -0.99f * p.z});
+    insideOut.positions.push_back(-2.0f * p);
+  }
+  shape.targets = {squash, insideOut};
+  addShape(s, shape);
+  addBackdrop(s, 3.0f, -3.0f);
+  return s;
+}
+
+scene::Scene nonFiniteMorphScene(uint32_t& poisonedTriangles) {
+  scene::Scene s;
+  s.source = "stress non-finite deformation";
+  scene::Shape shape = uvSphere(24, 1.0f);
+  shape.material = addMaterial(s, glass(1.5f));
+  scene::MorphTarget poison;
+  poison.positions.assign(shape.positions.size(), glm::vec3(0.0f));
+  // A band of vertices in the upper half goes to NaN, one vertex to infinity.
+  for (size_t v = 0; v < shape.positions.size(); ++v) {
+    if (shape.positions[v].z > 0.55f && shape.positions[v].z < 0.7f) poison.positions[v].x = std::numeric_limits<float>::quiet_NaN();
+  }
+  poison.positions[shape.positions.size() / 2].y = std::numeric_limits<float>::infinity();
+  poisonedTriangles = 0;
+  for (size_t t = 0; t < shape.indices.size(); t += 3) {
+    bool bad = false;
+    for (int k = 0; k < 3; ++k) {
+      const glm::vec3& d = poison.positions[shape.indices[t + size_t(k)]];
+      bad = bad || !std::isfinite(d.x) || !std::isfinite(d.y);
+    }
+    poisonedTriangles += bad ? 1 : 0;
+  }
+  shape.targets = {poison};
+  addShape(s, shape);
+  s.meshes.back().weights = {1.0f};
+  addBackdrop(s, 3.0f, -3.0f);
+  return s;
+}
+
+}  // namespace snell::stress
