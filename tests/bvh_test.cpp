@@ -185,19 +185,9 @@ TEST_F(BvhTest, ARefitHoldsTheMovedTrianglesAndKeepsTheTopology) {
   EXPECT_EQ(walk(after, 0, soup).size(), 1000u);
 }
 
-ref::Aabb aabb(const render::BoxFloats& b) {
-  ref::Aabb a;
-  a.extend(glm::dvec3(b[0], b[1], b[2]));
-  a.extend(glm::dvec3(b[3], b[4], b[5]));
-  return a;
-}
-
 double gpuSah(const BvhSnapshot& s, uint32_t group) {
   BvhSnapshot::TreeBoxes tree = s.treeBoxes(group);
-  std::vector<ref::Aabb> internal, leaves;
-  for (const render::BoxFloats& b : tree.internal) internal.push_back(aabb(b));
-  for (const render::BoxFloats& b : tree.leaves) leaves.push_back(aabb(b));
-  return ref::sahCost(internal, leaves, internal.front());
+  return ref::sahCost(tree.internal, tree.leaves);
 }
 
 // Thin triangles along a few long strands with many nearly equal Morton codes:

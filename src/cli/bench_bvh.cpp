@@ -38,20 +38,10 @@ struct Row {
   double lbvhRatio() const { return cpuCost > 0 ? lbvhCost / cpuCost : 1.0; }
 };
 
-ref::Aabb box(const float* lo, const float* hi) {
-  ref::Aabb b;
-  b.lo = {lo[0], lo[1], lo[2]};
-  b.hi = {hi[0], hi[1], hi[2]};
-  return b;
-}
-
 // SAH cost of group g's tree, priced by the same formula as the CPU tree.
 double treeCost(const render::BvhSnapshot& snapshot, uint32_t g) {
   render::BvhSnapshot::TreeBoxes tree = snapshot.treeBoxes(g);
-  std::vector<ref::Aabb> internalBoxes, leafBoxes;
-  for (const render::BoxFloats& b : tree.internal) internalBoxes.push_back(box(&b[0], &b[3]));
-  for (const render::BoxFloats& b : tree.leaves) leafBoxes.push_back(box(&b[0], &b[3]));
-  return ref::sahCost(internalBoxes, leafBoxes, internalBoxes.front());
+  return ref::sahCost(tree.internal, tree.leaves);
 }
 
 void measure(vk::Context& context, const scene::Scene& scene, const std::string& label, std::vector<Row>& rows) {

@@ -23,6 +23,20 @@ double surfaceArea(const Aabb& box) {
   return 2.0 * (e.x * e.y + e.y * e.z + e.z * e.x);
 }
 
+double sahCost(const std::vector<std::array<float, 6>>& internalBoxes,
+               const std::vector<std::array<float, 6>>& leafBoxes) {
+  auto toAabb = [](const std::array<float, 6>& b) {
+    Aabb a;
+    a.lo = {b[0], b[1], b[2]};
+    a.hi = {b[3], b[4], b[5]};
+    return a;
+  };
+  std::vector<Aabb> internal, leaves;
+  for (const auto& b : internalBoxes) internal.push_back(toAabb(b));
+  for (const auto& b : leafBoxes) leaves.push_back(toAabb(b));
+  return internal.empty() ? 0.0 : sahCost(internal, leaves, internal.front());
+}
+
 double sahCost(const std::vector<Aabb>& internalBoxes, const std::vector<Aabb>& leafBoxes, const Aabb& root) {
   double rootArea = surfaceArea(root);
   if (!(rootArea > 0.0)) return 0.0;

@@ -4,6 +4,7 @@
 
 #include <glm/glm.hpp>
 
+#include <array>
 #include <limits>
 #include <vector>
 
@@ -36,6 +37,11 @@ double surfaceArea(const Aabb& box);
 /// node by node is priced with the same formula as binnedSahCost's own tree.
 /// A root of zero area (every box flat on a line or a point) costs 0.
 double sahCost(const std::vector<Aabb>& internalBoxes, const std::vector<Aabb>& leafBoxes, const Aabb& root);
+
+/// The same for a tree brought back from the GPU: boxes as six floats (lo
+/// xyz, hi xyz), the root's box first among the internal ones.
+double sahCost(const std::vector<std::array<float, 6>>& internalBoxes,
+               const std::vector<std::array<float, 6>>& leafBoxes);
 
 /// Builds a binary tree top-down by binned SAH (`bins` centroid bins per
 /// axis, every axis with a centroid extent tried, the cheapest plane by
