@@ -116,13 +116,13 @@ TEST_F(ComputeProgramTest, PassTimesAreReportedInMilliseconds) {
 
 TEST(SpirvReflection, RejectsBytesThatAreNotSpirv) {
   std::vector<uint32_t> junk = {1, 2, 3, 4, 5, 6};
-  EXPECT_THROW(vk::reflectCompute(junk, {}, "junk"), std::runtime_error);
+  EXPECT_THROW(vk::reflectShader(junk, {}, "junk"), std::runtime_error);
 }
 
 TEST(SpirvReflection, RejectsTruncatedModules) {
   std::vector<uint32_t> truncated(std::begin(kSpvFillIndex), std::begin(kSpvFillIndex) + 40);
   truncated.push_back(0xFFFF0000u | 71u);  // claims 65535 words
-  EXPECT_THROW(vk::reflectCompute(truncated, {}, "truncated"), std::runtime_error);
+  EXPECT_THROW(vk::reflectShader(truncated, {}, "truncated"), std::runtime_error);
 }
 
 }  // namespace

@@ -1,5 +1,5 @@
-// The trace pass: one ray per pixel from the camera (at the origin: the scene
-// is camera-relative), through the top-level tree into each instance's
+// The trace pass: one ray per pixel from the camera (at or near the origin:
+// the scene is rebased to the camera), through the top-level tree into each instance's
 // bottom-level tree; refracted at transmissive faces, reflected when Snell's
 // law has no solution, Phong-shaded where it lands. The contract it follows
 // is written out in shaders/shared/trace.h; src/ref is its double twin.
@@ -29,7 +29,6 @@ layout(std430, binding = kTraceBindingAov) writeonly buffer Aovs { TraceAov aovs
 layout(std430, binding = kTraceBindingRays) readonly buffer Rays { GpuRay rays[]; };
 
 const float kInf = 1.0 / 0.0;  // folded to +infinity at compile time
-const float kPi = 3.14159265358979;
 const uint kStackSize = 64u;
 
 // ---------------------------------------------------------------- traversal
@@ -168,46 +167,7 @@ Hit traceClosest(vec3 origin, vec3 dir, uint skipInstance, uint skipPrim, float 
   return hit;
 }
 
-// ----------------------------------------------------------------- textures
-
-vec3 srgbToLinear(vec3 c) {
-  return mix(c / 12.92, pow((c + 0.055) / 1.055, vec3(2.4)), greaterThan(c, vec3(0.04045)));
-}
-
-int wrapIndex(int i, int size, uint mode) {
-  if (mode == kWrapClamp) return clamp(i, 0, size - 1);
-  if (mode == kWrapMirror) {
-    int period = 2 * size;
-    int m = ((i % period) + period) % period;
-    return m < size ? m : period - 1 - m;
-  }
-  return ((i % size) + size) % size;
-}
-
-vec3 texel(GpuTexture tex, int x, int y) {
-  x = wrapIndex(x, int(tex.width), tex.flags & 3u);
-  y = wrapIndex(y, int(tex.height), (tex.flags >> 2) & 3u);
-  uint rgba = texels[tex.firstTexel + uint(y) * tex.width + uint(x)];
-  return srgbToLinear(unpackUnorm4x8(rgba).rgb);
-}
-
-vec3 sampleTexture(uint index, vec2 uv) {
-  GpuTexture tex = textures[index];
-  if ((tex.flags & 16u) != 0u) return texel(tex, int(floor(uv.x * float(tex.width))), int(floor(uv.y * float(tex.height))));
-  vec2 p = uv * vec2(tex.width, tex.height) - 0.5;
-  vec2 base = floor(p);
-  vec2 f = p - base;
-  int x = int(base.x), y = int(base.y);
-  vec3 top = mix(texel(tex, x, y), texel(tex, x + 1, y), f.x);
-  vec3 bottom = mix(texel(tex, x, y + 1), texel(tex, x + 1, y + 1), f.x);
-  return mix(top, bottom, f.y);
-}
-
-vec3 textured(uint texture, vec4 uvs, uint texCoord, vec4 row0, vec4 row1) {
-  if (texture == kNoTexture) return vec3(1.0);
-  vec3 uv = vec3(texCoord == 1u ? uvs.zw : uvs.xy, 1.0);
-  return sampleTexture(texture, vec2(dot(row0.xyz, uv), dot(row1.xyz, uv)));
-}
+#include "../common/shading.glsl"
 
 // ------------------------------------------------------------------ shading
 
@@ -243,55 +203,6 @@ Surface surfaceAt(Hit hit) {
   return s;
 }
 
-vec3 baseColour(GpuMaterial m, vec4 uvs) {
-  return m.baseColorFactor.rgb * textured(m.textures.x, uvs, m.textures.y, m.baseUvRow0, m.baseUvRow1);
-}
-
-vec3 phong(Surface s, GpuMaterial m, vec3 dir) {
-  vec3 base = baseColour(m, s.uvs);
-  vec3 n = dot(s.ns, dir) > 0.0 ? -s.ns : s.ns;  // towards the viewer
-  vec3 v = -dir;
-  vec3 colour = m.emissiveFactor.rgb * textured(m.textures.z, s.uvs, m.textures.w, m.emissiveUvRow0, m.emissiveUvRow1) +
-                kAmbient * base;
-  uint count = max(pc.lightCount, 1u);
-  for (uint i = 0u; i < count; ++i) {
-    vec3 l, e;
-    if (pc.lightCount == 0u) {
-      l = -pc.forward.xyz;
-      e = vec3(kHeadlight);
-    } else {
-      GpuLight light = lights[i];
-      uint type = uint(light.positionType.w);
-      if (type == kLightDirectional) {
-        l = -light.direction.xyz;
-        e = light.radiance.rgb;
-      } else {
-        vec3 toLight = light.positionType.xyz - s.position;
-        float distance2 = dot(toLight, toLight);
-        float distance = sqrt(distance2);
-        l = toLight / distance;
-        e = light.radiance.rgb / distance2;
-        float range = light.direction.w;
-        if (range > 0.0) {
-          float ratio = distance / range;
-          float window = clamp(1.0 - ratio * ratio * ratio * ratio, 0.0, 1.0);
-          e *= window * window;
-        }
-        if (type == kLightSpot) {
-          float cd = dot(light.direction.xyz, -l);
-          float s2 = clamp((cd - light.cone.y) / max(1e-4, light.cone.x - light.cone.y), 0.0, 1.0);
-          e *= s2 * s2;
-        }
-      }
-    }
-    float nl = dot(n, l);
-    if (nl <= 0.0) continue;
-    vec3 h = normalize(l + v);
-    colour += e * nl * (base / kPi + kSpecular * pow(max(dot(n, h), 0.0), kShininess));
-  }
-  return colour;
-}
-
 // Wächter & Binder (Ray Tracing Gems, ch. 6): move the point off the surface
 // by a few ulps of its own magnitude (a fixed step near the origin, where ulps
 // vanish). Their constants (256 ulps, 1/65536 below 1/32) assume metre-sized
@@ -311,15 +222,15 @@ void main() {
                 uvec2(gl_LocalInvocationID.x % kTraceTile, gl_LocalInvocationID.x / kTraceTile);
   if (pixel.x >= pc.width || pixel.y >= pc.height) return;
 
-  float sx = (2.0 * (float(pixel.x) + 0.5) / float(pc.width) - 1.0) * pc.right.w;
-  float sy = (1.0 - 2.0 * (float(pixel.y) + 0.5) / float(pc.height)) * pc.up.w;
-  vec3 origin = vec3(0.0), dir;
+  float sx = (2.0 * (float(pixel.x) + 0.5) / float(pc.width) - 1.0) * pc.right.w + pc.shiftX;
+  float sy = (1.0 - 2.0 * (float(pixel.y) + 0.5) / float(pc.height)) * pc.up.w + pc.shiftY;
+  vec3 origin = pc.eye.xyz, dir;
   if ((pc.flags & kTraceFlagRayList) != 0u) {
     GpuRay ray = rays[pixel.y * pc.width + pixel.x];
     origin = ray.origin.xyz;
     dir = ray.direction.xyz;
   } else if ((pc.flags & kTraceFlagOrthographic) != 0u) {
-    origin = sx * pc.right.xyz + sy * pc.up.xyz;
+    origin += sx * pc.right.xyz + sy * pc.up.xyz;
     dir = pc.forward.xyz;
   } else {
     dir = normalize(pc.forward.xyz + sx * pc.right.xyz + sy * pc.up.xyz);
@@ -350,7 +261,7 @@ void main() {
     Surface s = surfaceAt(hit);
     GpuMaterial m = materials[s.material];
     if (m.emissiveFactor.w <= 0.0) {
-      colour = throughput * phong(s, m, dir);
+      colour = throughput * phong(s.position, s.ns, s.uvs, m, dir, pc.lightCount, pc.forward.xyz);
       outcome = kOutcomeOpaque;
       break;
     }

@@ -3,7 +3,8 @@
 // the constants and the GPU record layouts live here.
 //
 // Rays. One per pixel through its centre: for pixel (x, y), y = 0 the top row,
-//   sx = (2 (x + 0.5) / W - 1) * tanHalfFovY * W / H,  sy = (1 - 2 (y + 0.5) / H) * tanHalfFovY,
+//   sx = (2 (x + 0.5) / W - 1) * tanHalfFovY * W / H + shiftX,  sy = (1 - 2 (y + 0.5) / H) * tanHalfFovY + shiftY,
+//   (shift: the film back's 2D pan, View::shift; zero unless a viewer pans it)
 //   perspective:  origin = eye, direction = normalize(forward + sx right + sy up);
 //   orthographic: origin = eye + right sx' + up sy' with tanHalfFovY replaced by
 //                 the half height, direction = forward.
@@ -156,21 +157,24 @@ struct GpuRay {
   vec4 direction;  // 16: xyz, unit length; w unused
 };
 
-// Rays start at the camera: the scene is rebased to camera-relative coordinates.
-// 96 bytes, total: 96 bytes
+// The scene is rebased to a frame origin near the camera (Renderer::update);
+// `eye` is the camera relative to it: zero when a frame has one view, the
+// offset of a second viewport's camera from the first's otherwise.
+// 112 bytes, total: 112 bytes
 struct TracePush {
   vec4 right;       // 16: xyz; w: half width of the view at unit distance (or of the ortho view)
   vec4 up;          // 16: xyz; w: half height
   vec4 forward;     // 16: xyz; w unused
   vec4 background;  // 16: rgb; w unused
+  vec4 eye;         // 16: xyz; w unused
   uint width;       // 4
   uint height;      // 4
   uint maxInterfaces;  // 4
   uint lightCount;  // 4: 0: the headlight
   uint flags;       // 4: kTraceFlag*
   uint tilesX;      // 4: tiles per row
-  uint pad0;        // 4
-  uint pad1;        // 4
+  float shiftX;     // 4: the film back's offset (View::shift)
+  float shiftY;     // 4
 };
 
 SNELL_GPU_END

@@ -3,7 +3,6 @@
 
 #include "vk/error.h"
 
-#include <charconv>
 #include <cstdio>
 #include <cstdlib>
 #include <exception>
@@ -50,33 +49,6 @@ int runBench(const Args& args) {
 }
 
 }  // namespace
-
-vk::ContextDesc contextDescFromEnvironment() {
-  vk::ContextDesc desc;
-  const char* validation = std::getenv("SNELL_VALIDATION");
-  desc.validation = validation && std::string(validation) == "1";
-  return desc;
-}
-
-unsigned long long parseCount(const std::string& option, const std::string& value) {
-  unsigned long long result = 0;
-  auto [end, error] = std::from_chars(value.data(), value.data() + value.size(), result);
-  if (value.empty() || error != std::errc() || end != value.data() + value.size()) {
-    throw UsageError{option + " expects a whole number, got '" + value + "'"};
-  }
-  return result;
-}
-
-void parseSize(const std::string& option, const std::string& value, uint32_t& width, uint32_t& height) {
-  size_t x = value.find('x');
-  if (x == std::string::npos) throw UsageError{option + " expects WxH, e.g. 640x480, got '" + value + "'"};
-  unsigned long long w = parseCount(option, value.substr(0, x)), h = parseCount(option, value.substr(x + 1));
-  if (w == 0 || h == 0 || w > 65536 || h > 65536) {
-    throw UsageError{option + " " + value + " is out of range (1x1 to 65536x65536)"};
-  }
-  width = uint32_t(w);
-  height = uint32_t(h);
-}
 
 }  // namespace snell::cli
 

@@ -1,9 +1,11 @@
 // `snell render SCENE -o OUT.png|OUT.exr`: headless frames of a glTF scene,
-// traced on the GPU (or by the CPU reference with --reference).
+// traced on the GPU (or by the CPU reference with --reference), or with
+// --viewport the viewer's composite: rasterized, with the trace on glass.
 #include "cli/cli.h"
 
 #include "cli/image_file.h"
 #include "ref/reference_tracer.h"
+#include "render/raster_pass.h"
 #include "render/renderer.h"
 #include "scene/evaluate.h"
 #include "scene/gltf_loader.h"
@@ -47,6 +49,12 @@ options:
   --ignore-extension E   load a file that requires extension E anyway
   --reference            render with the CPU double-precision reference instead
                          of the GPU (slow; golden images are made this way)
+  --viewport             write the viewport's composite instead of the trace
+                         alone: every face rasterized and Phong-shaded, and
+                         transmissive faces showing the traced image (what
+                         snell-view shows)
+  --no-refraction        with --viewport: see through glass without bending
+  --wireframe            with --viewport: draw triangle edges over the image
 )";
 
 struct Options {
@@ -63,6 +71,8 @@ struct Options {
   glm::vec3 background{0.02f, 0.02f, 0.025f};
   scene::LoadOptions load;
   bool reference = false;
+  bool viewport = false;
+  render::RasterOptions raster;
 };
 
 std::vector<double> parseNumbers(const std::string& option, const std::string& value, size_t count) {
@@ -87,6 +97,9 @@ Options parse(const Args& args) {
     const std::string& a = args[i];
     if (a == "--eye") { o.eye = true; continue; }
     if (a == "--reference") { o.reference = true; continue; }
+    if (a == "--viewport") { o.viewport = true; continue; }
+    if (a == "--no-refraction") { o.raster.refraction = false; continue; }
+    if (a == "--wireframe") { o.raster.wireframe = true; continue; }
     if (!a.empty() && a[0] != '-') {
       if (!o.input.empty()) throw UsageError{"render: more than one scene given ('" + o.input + "', '" + a + "')"};
       o.input = a;
@@ -135,6 +148,12 @@ Options parse(const Args& args) {
   if (o.input.empty() && !o.eye) throw UsageError{"render: give a scene file (or --eye)"};
   if (!o.input.empty() && o.eye) throw UsageError{"render: give a scene file or --eye, not both"};
   if (o.output.empty()) throw UsageError{"render: give the output image with -o FILE.png or FILE.exr"};
+  if (o.viewport && o.reference) {
+    throw UsageError{"render: --viewport is drawn on the GPU; the reference traces (--reference) without it"};
+  }
+  if (!o.viewport && (!o.raster.refraction || o.raster.wireframe)) {
+    throw UsageError{"render: --no-refraction and --wireframe need --viewport"};
+  }
   std::string ext = std::filesystem::path(o.output).extension().string();
   if (ext != ".png" && ext != ".exr" && ext != ".PNG" && ext != ".EXR") {
     throw UsageError{"render: the output must end in .png or .exr, got '" + o.output + "'"};
@@ -220,6 +239,12 @@ int runRender(const Args& args) {
       ref::ReferenceImage r = ref::renderReference(scene, pose, settings);
       image.rgba.reserve(r.color.size());
       for (const glm::dvec3& c : r.color) image.rgba.emplace_back(glm::vec3(c), 1.0f);
+    } else if (o.viewport) {
+      render::FrameSettings settings{o.width, o.height, view, o.background, o.maxInterfaces};
+      glm::dvec3 lo, hi;
+      scene::sceneBounds(scene, pose, lo, hi);
+      render::fitDepthRange(view, lo, hi, o.raster);
+      image.rgba = render::renderComposite(*context, *renderer, pose, settings, o.raster).rgba;
     } else {
       render::FrameSettings settings{o.width, o.height, view, o.background, o.maxInterfaces};
       image.rgba = render::renderFrame(*context, *renderer, pose, settings).rgba;
@@ -232,6 +257,7 @@ int runRender(const Args& args) {
     } else {
       std::printf("wrote %s: %ux%u, %s, %s, %.2f s\n", path.c_str(), o.width, o.height, view.description.c_str(),
                   o.reference ? "CPU reference" : context->facts().name.c_str(), seconds);
+      if (o.viewport) std::printf("  viewport composite: raster + trace on transmissive faces\n");
     }
   }
   if (context && context->validationMessageCount() > 0) {

@@ -610,8 +610,8 @@ ReferenceImage renderReference(const scene::Scene& scene, const scene::Pose& pos
   auto work = [&] {
     for (uint32_t y = nextRow++; y < settings.height; y = nextRow++) {
       for (uint32_t x = 0; x < settings.width; ++x) {
-        double sx = (2.0 * (double(x) + 0.5) / w - 1.0) * view.halfHeight * w / h;
-        double sy = (1.0 - 2.0 * (double(y) + 0.5) / h) * view.halfHeight;
+        double sx = (2.0 * (double(x) + 0.5) / w - 1.0) * view.halfHeight * w / h + view.shift.x;
+        double sy = (1.0 - 2.0 * (double(y) + 0.5) / h) * view.halfHeight + view.shift.y;
         glm::dvec3 origin = view.eye, direction = forward;
         if (!settings.rays.empty()) {
           origin = settings.rays[image.index(x, y)].origin;

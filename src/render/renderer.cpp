@@ -65,14 +65,17 @@ uint64_t Renderer::memoryBytes() const {
 
 void Renderer::record(vk::Commands& commands, const scene::Pose& pose, const FrameSettings& settings,
                       const vk::Image& target, const vk::Buffer* aov, const vk::Buffer* rays) {
+  update(commands, pose, settings.view.eye);
+  trace(commands, settings, target, aov, rays);
+}
+
+void Renderer::update(vk::Commands& commands, const scene::Pose& pose, const glm::dvec3& origin) {
   if (pose.items.size() != scene_.itemGeometry.size()) {
     throw vk::VulkanError("renderer: the pose has " + std::to_string(pose.items.size()) + " draw items; it was built for " +
                           std::to_string(scene_.itemGeometry.size()));
   }
-  if (target.width() != settings.width || target.height() != settings.height) {
-    throw vk::VulkanError("renderer: the target image is not the frame's size");
-  }
-  const glm::dvec3 eye = settings.view.eye;
+  const glm::dvec3 eye = origin;
+  origin_ = origin;
 
   // Instances and lights, camera-relative: subtracted in double so the float
   // data near the camera keeps its precision however far it is from the origin.
@@ -107,6 +110,7 @@ void Renderer::record(vk::Commands& commands, const scene::Pose& pose, const Fra
     g.cone = glm::vec4(std::cos(light.innerConeAngle), std::cos(light.outerConeAngle), 0.0f, 0.0f);
     lights[lightCount++] = g;
   }
+  lightCount_ = lightCount;
 
   // Counts the triangles this frame's box pass finds non-finite (RenderedFrame::droppedTriangles).
   commands.fillBuffer(blas_.dropped, 0);
@@ -145,7 +149,16 @@ void Renderer::record(vk::Commands& commands, const scene::Pose& pose, const Fra
   commands.computeToCompute();
   builder_.recordBuild(commands, tlas_, 0);  // a handful of instances, rebuilt every frame: LBVH only
   commands.endPass();
+  updated_ = true;
+}
 
+void Renderer::trace(vk::Commands& commands, const FrameSettings& settings, const vk::Image& target,
+                     const vk::Buffer* aov, const vk::Buffer* rays) {
+  if (!updated_) throw vk::VulkanError("renderer: trace() before any update()");
+  if (target.width() != settings.width || target.height() != settings.height) {
+    throw vk::VulkanError("renderer: the target image is not the frame's size");
+  }
+  commands.computeToCompute();  // the top level, and an earlier view's trace of the same image
   commands.beginPass("trace");
   const scene::View& v = settings.view;
   double aspect = double(settings.width) / double(settings.height);
@@ -154,13 +167,16 @@ void Renderer::record(vk::Commands& commands, const scene::Pose& pose, const Fra
   push.up = glm::vec4(glm::vec3(v.up), float(v.halfHeight));
   push.forward = glm::vec4(glm::vec3(v.forward), 0.0f);
   push.background = glm::vec4(settings.background, 1.0f);
+  push.eye = glm::vec4(glm::vec3(v.eye - origin_), 0.0f);
   push.width = settings.width;
   push.height = settings.height;
   push.maxInterfaces = settings.maxInterfaces;
-  push.lightCount = lightCount;
+  push.lightCount = lightCount_;
   push.flags = (aov ? gpu::kTraceFlagAov : 0u) | (v.orthographic ? gpu::kTraceFlagOrthographic : 0u) |
                (rays ? gpu::kTraceFlagRayList : 0u);
   push.tilesX = (settings.width + gpu::kTraceTile - 1) / gpu::kTraceTile;
+  push.shiftX = float(v.shift.x);
+  push.shiftY = float(v.shift.y);
   uint32_t tilesY = (settings.height + gpu::kTraceTile - 1) / gpu::kTraceTile;
   trace_->dispatchGroups(commands,
                          {{gpu::kTraceBindingTlasNodes, &tlas_.nodes},
@@ -195,56 +211,71 @@ void checkImageSize(const vk::Context& context, uint32_t width, uint32_t height)
   }
 }
 
-RenderedFrame renderFrame(vk::Context& context, Renderer& renderer, const scene::Pose& pose,
-                          const FrameSettings& settings, bool withAov) {
+FrameTargets makeFrameTargets(vk::Context& context, const FrameSettings& settings, bool withAov) {
   checkImageSize(context, settings.width, settings.height);
-  vk::Image image(context, {settings.width, settings.height, VK_FORMAT_R16G16B16A16_SFLOAT,
-                            VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT, "trace image"});
+  FrameTargets t;
+  t.image = vk::Image(context, {settings.width, settings.height, VK_FORMAT_R16G16B16A16_SFLOAT,
+                                VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT, "trace image"});
   size_t pixels = size_t(settings.width) * settings.height;
-  vk::Buffer aov;
   if (withAov) {
-    aov = vk::Buffer(context, {pixels * sizeof(gpu::TraceAov),
-                               VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT,
-                               vk::MemoryDomain::Device, "trace AOV"});
+    t.aov = vk::Buffer(context, {pixels * sizeof(gpu::TraceAov),
+                                 VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT,
+                                 vk::MemoryDomain::Device, "trace AOV"});
   }
-  vk::Buffer rays;
   if (!settings.rays.empty()) {
     if (settings.rays.size() != pixels) {
       throw std::invalid_argument("renderFrame: " + std::to_string(settings.rays.size()) + " rays for " +
                                   std::to_string(pixels) + " pixels");
     }
-    rays = vk::Buffer(context, {pixels * sizeof(gpu::GpuRay), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
-                                vk::MemoryDomain::Upload, "ray list"});
-    auto* out = reinterpret_cast<gpu::GpuRay*>(rays.mapped().data());
+    t.rays = vk::Buffer(context, {pixels * sizeof(gpu::GpuRay), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
+                                  vk::MemoryDomain::Upload, "ray list"});
+    auto* out = reinterpret_cast<gpu::GpuRay*>(t.rays.mapped().data());
     for (size_t i = 0; i < pixels; ++i) {
       // Camera-relative in double, like the instances, before the cast to float.
       out[i].origin = glm::vec4(glm::vec3(settings.rays[i].origin - settings.view.eye), 1.0f);
       out[i].direction = glm::vec4(glm::vec3(glm::normalize(settings.rays[i].direction)), 0.0f);
     }
   }
-  vk::Commands commands(context, "frame");
-  commands.begin();
-  commands.imageLayout(image, VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_GENERAL);
-  renderer.record(commands, pose, settings, image, withAov ? &aov : nullptr, settings.rays.empty() ? nullptr : &rays);
-  commands.computeToTransfer();
-  commands.submitAndWait();
+  return t;
+}
 
-  RenderedFrame frame;
-  frame.width = settings.width;
-  frame.height = settings.height;
-  frame.passes = commands.passTimes();
+std::vector<glm::vec4> downloadRgba16f(vk::Context& context, const vk::Image& image) {
+  size_t pixels = size_t(image.width()) * image.height();
   std::vector<uint16_t> halves(pixels * 4);
   vk::downloadImage(context, image, halves.data());
-  frame.rgba.resize(pixels);
+  std::vector<glm::vec4> rgba(pixels);
   for (size_t i = 0; i < pixels; ++i) {
-    for (int c = 0; c < 4; ++c) frame.rgba[i][c] = glm::unpackHalf1x16(halves[4 * i + size_t(c)]);
+    for (int c = 0; c < 4; ++c) rgba[i][c] = glm::unpackHalf1x16(halves[4 * i + size_t(c)]);
   }
+  return rgba;
+}
+
+RenderedFrame readFrame(vk::Context& context, const Renderer& renderer, const FrameTargets& targets,
+                        const vk::Commands& commands) {
+  RenderedFrame frame;
+  frame.width = targets.image.width();
+  frame.height = targets.image.height();
+  frame.passes = commands.passTimes();
+  frame.rgba = downloadRgba16f(context, targets.image);
   vk::download(context, renderer.blas().dropped, &frame.droppedTriangles, 4);
-  if (withAov) {
-    frame.aov.resize(pixels);
-    vk::download(context, aov, frame.aov.data(), pixels * sizeof(gpu::TraceAov));
+  if (targets.aov.handle()) {
+    frame.aov.resize(frame.rgba.size());
+    vk::download(context, targets.aov, frame.aov.data(), frame.aov.size() * sizeof(gpu::TraceAov));
   }
   return frame;
+}
+
+RenderedFrame renderFrame(vk::Context& context, Renderer& renderer, const scene::Pose& pose,
+                          const FrameSettings& settings, bool withAov) {
+  FrameTargets targets = makeFrameTargets(context, settings, withAov);
+  vk::Commands commands(context, "frame");
+  commands.begin();
+  commands.imageLayout(targets.image, VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_GENERAL);
+  renderer.record(commands, pose, settings, targets.image, withAov ? &targets.aov : nullptr,
+                  settings.rays.empty() ? nullptr : &targets.rays);
+  commands.computeToTransfer();
+  commands.submitAndWait();
+  return readFrame(context, renderer, targets, commands);
 }
 
 }  // namespace snell::render

@@ -39,18 +39,34 @@ class Renderer {
   Renderer(vk::Context& context, const scene::Scene& scene, const scene::Pose& layout);
   ~Renderer();
 
-  /// Records a frame of `pose` into `target` (rgba16f, GENERAL layout) and,
-  /// when `aov` is given, per-pixel gpu::TraceAov records. `rays`, when given,
-  /// holds width * height gpu::GpuRay (camera-relative) to trace instead of the
-  /// camera's. The host writes the frame's instances and lights: the previous
-  /// frame must have finished.
+  /// Records a frame of `pose` seen from settings.view into `target` (rgba16f,
+  /// GENERAL layout) and, when `aov` is given, per-pixel gpu::TraceAov records.
+  /// `rays`, when given, holds width * height gpu::GpuRay (camera-relative) to
+  /// trace instead of the camera's. update() at the view's eye, then trace().
   void record(vk::Commands& commands, const scene::Pose& pose, const FrameSettings& settings, const vk::Image& target,
               const vk::Buffer* aov = nullptr, const vk::Buffer* rays = nullptr);
+
+  /// Records the passes that depend on the pose but not on a view: deform,
+  /// bottom level, top level, with the scene rebased to `origin` (world space,
+  /// in double) so float precision does not depend on where the scene is. The
+  /// host writes the frame's instances and lights: the previous frame must
+  /// have finished.
+  void update(vk::Commands& commands, const scene::Pose& pose, const glm::dvec3& origin);
+  /// Records the trace pass of one view of the pose last updated; a frame may
+  /// trace several views (viewports) whose eyes are near its origin.
+  void trace(vk::Commands& commands, const FrameSettings& settings, const vk::Image& target,
+             const vk::Buffer* aov = nullptr, const vk::Buffer* rays = nullptr);
 
   /// Forces the next frame to rebuild the bottom level instead of refitting it.
   void invalidateBlas() { blasBuilt_ = false; }
 
   const SceneGpu& sceneGpu() const { return scene_; }
+  /// The last update's instances (gpu::GpuInstance, rebased to its origin) and
+  /// lights (gpu::GpuLight), which the raster pass shares.
+  const vk::Buffer& instances() const { return instances_; }
+  const vk::Buffer& lights() const { return lights_; }
+  uint32_t lightCount() const { return lightCount_; }
+  const glm::dvec3& origin() const { return origin_; }
   const Bvh& blas() const { return blas_; }
   const Bvh& tlas() const { return tlas_; }
   const BvhBuilder& builder() const { return builder_; }
@@ -65,6 +81,9 @@ class Renderer {
   BvhBuilder builder_;
   Bvh blas_, tlas_;
   bool blasBuilt_ = false;
+  bool updated_ = false;
+  glm::dvec3 origin_{0.0};
+  uint32_t lightCount_ = 0;
   vk::Buffer instances_, lights_, placeholder_;
   std::unique_ptr<vk::ComputeProgram> trace_;
 };
@@ -79,6 +98,19 @@ struct RenderedFrame {
   uint32_t droppedTriangles = 0;
   std::vector<vk::PassTime> passes;
 };
+
+/// What one frame writes, sized for its settings: the trace image (rgba16f),
+/// the AOV buffer when asked for, the ray list when the settings give one.
+struct FrameTargets {
+  vk::Image image;
+  vk::Buffer aov, rays;
+};
+FrameTargets makeFrameTargets(vk::Context& context, const FrameSettings& settings, bool withAov);
+/// Reads a completed frame's targets back, with the passes `commands` timed.
+RenderedFrame readFrame(vk::Context& context, const Renderer& renderer, const FrameTargets& targets,
+                        const vk::Commands& commands);
+/// A whole rgba16f image (GENERAL layout) as linear floats, row 0 at the top.
+std::vector<glm::vec4> downloadRgba16f(vk::Context& context, const vk::Image& image);
 
 /// Renders one frame and reads it back (waits for the GPU).
 RenderedFrame renderFrame(vk::Context& context, Renderer& renderer, const scene::Pose& pose,

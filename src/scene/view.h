@@ -39,6 +39,9 @@ struct View {
   bool orthographic = false;
   /// Perspective: tan(yfov / 2). Orthographic: half the view's height.
   double halfHeight = 0.36397;
+  /// The film back's offset from the optical axis in the units of halfHeight
+  /// (a 2D pan that moves the picture, not the camera; halfHeight zooms).
+  glm::dvec2 shift{0.0};
   std::string description;  ///< for messages: which camera this is
 };
 

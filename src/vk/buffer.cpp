@@ -106,6 +106,10 @@ void Buffer::release() {
   context_ = nullptr;
 }
 
+VkImageAspectFlags aspectOf(VkFormat format) {
+  return format == VK_FORMAT_D32_SFLOAT ? VK_IMAGE_ASPECT_DEPTH_BIT : VK_IMAGE_ASPECT_COLOR_BIT;
+}
+
 Image::Image(Context& context, const ImageDesc& desc)
     : context_(&context), format_(desc.format), width_(desc.width), height_(desc.height), name_(desc.name) {
   VkImageCreateInfo info{VK_STRUCTURE_TYPE_IMAGE_CREATE_INFO};
@@ -138,7 +142,7 @@ Image::Image(Context& context, const ImageDesc& desc)
     viewInfo.image = image_;
     viewInfo.viewType = VK_IMAGE_VIEW_TYPE_2D;
     viewInfo.format = desc.format;
-    viewInfo.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
+    viewInfo.subresourceRange = {aspectOf(desc.format), 0, 1, 0, 1};
     VK_CHECK(vkCreateImageView(context.device(), &viewInfo, nullptr, &view_));
   } catch (...) {
     release();
@@ -185,6 +189,9 @@ uint32_t Image::bytesPerPixel() const {
   switch (format_) {
     case VK_FORMAT_R8G8B8A8_UNORM:
     case VK_FORMAT_R8G8B8A8_SRGB:
+    case VK_FORMAT_B8G8R8A8_UNORM:
+    case VK_FORMAT_B8G8R8A8_SRGB:
+    case VK_FORMAT_D32_SFLOAT:
     case VK_FORMAT_R32_UINT:
     case VK_FORMAT_R32_SFLOAT:
       return 4;

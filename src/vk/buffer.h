@@ -66,6 +66,9 @@ struct ImageDesc {
   std::string name;
 };
 
+/// The aspect of an image of `format`: depth for D32_SFLOAT, else colour.
+VkImageAspectFlags aspectOf(VkFormat format);
+
 /// A 2D VkImage in device memory with a view of its one mip level.
 class Image {
  public:

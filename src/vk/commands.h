@@ -48,6 +48,12 @@ class Commands {
   void computeToTransfer();
   /// Transfer writes become visible to the host after wait().
   void transferToHost();
+  /// Compute writes (deformed vertices, the trace image) become visible to the
+  /// vertex and fragment shaders of later draws: the one barrier between the
+  /// trace and the raster pass.
+  void computeToGraphics();
+  /// Colour attachment writes become visible to transfers (readbacks).
+  void graphicsToTransfer();
   /// Transfer writes become visible to later transfers.
   void transferToTransfer();
   /// Moves a whole colour image between layouts with a full memory barrier.

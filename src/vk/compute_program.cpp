@@ -5,11 +5,12 @@
 
 #include <algorithm>
 
+
 namespace snell::vk {
 
 ComputeProgram::ComputeProgram(Context& context, const ComputeProgramDesc& desc) : context_(&context), name_(desc.name) {
   try {
-    reflection_ = reflectCompute(desc.spirv, desc.specialization, desc.name);
+    reflection_ = reflectShader(desc.spirv, desc.specialization, desc.name);
   } catch (const std::runtime_error& e) {
     throw VulkanError(e.what());
   }
@@ -35,16 +36,7 @@ ComputeProgram::ComputeProgram(Context& context, const ComputeProgramDesc& desc)
   VK_CHECK(vkCreateShaderModule(device, &moduleInfo, nullptr, &module_));
   context.setName(VK_OBJECT_TYPE_SHADER_MODULE, module_, name_);
 
-  std::vector<VkDescriptorSetLayoutBinding> layoutBindings;
-  for (const ReflectedBinding& b : reflection_.bindings) {
-    if (b.set != 0) throw VulkanError("program '" + name_ + "' uses descriptor set " + std::to_string(b.set) + "; only set 0 is supported");
-    layoutBindings.push_back({b.binding, b.type, 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr});
-  }
-  VkDescriptorSetLayoutCreateInfo setInfo{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO};
-  setInfo.bindingCount = static_cast<uint32_t>(layoutBindings.size());
-  setInfo.pBindings = layoutBindings.data();
-  VK_CHECK(vkCreateDescriptorSetLayout(device, &setInfo, nullptr, &setLayout_));
-  context.setName(VK_OBJECT_TYPE_DESCRIPTOR_SET_LAYOUT, setLayout_, name_);
+  setLayout_ = createSetLayout(context, reflection_.bindings, VK_SHADER_STAGE_COMPUTE_BIT, name_);
 
   VkPushConstantRange range{VK_SHADER_STAGE_COMPUTE_BIT, 0, reflection_.pushConstantBytes};
   VkPipelineLayoutCreateInfo layoutInfo{VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO};
@@ -138,40 +130,7 @@ void ComputeProgram::record(Commands& commands, std::initializer_list<BufferBind
                       " bindings; the call gave " + std::to_string(buffers.size()));
   }
   if (groups == 0) return;
-
-  std::vector<VkDescriptorBufferInfo> infos;
-  std::vector<VkDescriptorImageInfo> imageInfos;
-  std::vector<VkWriteDescriptorSet> writes;
-  infos.reserve(buffers.size());  // writes point into these: no reallocation
-  imageInfos.reserve(buffers.size());
-  VkDescriptorSet set = commands.allocateSet(setLayout_);
-  for (const BufferBinding& b : buffers) {
-    auto reflected = std::find_if(reflection_.bindings.begin(), reflection_.bindings.end(),
-                                  [&](const ReflectedBinding& r) { return r.binding == b.slot; });
-    if (reflected == reflection_.bindings.end()) {
-      throw VulkanError("program '" + name_ + "' has no binding " + std::to_string(b.slot));
-    }
-    VkWriteDescriptorSet write{VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
-    write.dstSet = set;
-    write.dstBinding = b.slot;
-    write.descriptorCount = 1;
-    write.descriptorType = reflected->type;
-    if (reflected->type == VK_DESCRIPTOR_TYPE_STORAGE_IMAGE) {
-      if (!b.image || !b.image->view()) {
-        throw VulkanError("program '" + name_ + "': binding " + std::to_string(b.slot) + " needs a storage image");
-      }
-      imageInfos.push_back({VK_NULL_HANDLE, b.image->view(), VK_IMAGE_LAYOUT_GENERAL});
-      write.pImageInfo = &imageInfos.back();
-    } else {
-      if (!b.buffer || !b.buffer->handle()) {
-        throw VulkanError("program '" + name_ + "': binding " + std::to_string(b.slot) + " has no buffer");
-      }
-      infos.push_back({b.buffer->handle(), 0, VK_WHOLE_SIZE});
-      write.pBufferInfo = &infos.back();
-    }
-    writes.push_back(write);
-  }
-  vkUpdateDescriptorSets(context_->device(), static_cast<uint32_t>(writes.size()), writes.data(), 0, nullptr);
+  VkDescriptorSet set = writeSet(commands, setLayout_, reflection_.bindings, buffers, name_);
 
   VkCommandBuffer cmd = commands.handle();
   vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline_);

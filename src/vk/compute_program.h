@@ -6,6 +6,7 @@
 #include "vk/buffer.h"
 #include "vk/commands.h"
 #include "vk/context.h"
+#include "vk/descriptors.h"
 #include "vk/spirv_reflect.h"
 
 #include <vulkan/vulkan.h>
@@ -26,13 +27,6 @@ struct ComputeProgramDesc {
   /// Every subgroup is full and the subgroup numbering is dense; needed by
   /// shaders that rank or scan in (gl_SubgroupID, gl_SubgroupInvocationID) order.
   bool requireFullSubgroups = false;
-};
-
-/// One buffer, or one storage image in GENERAL layout, bound to a slot of set 0.
-struct BufferBinding {
-  uint32_t slot;
-  const Buffer* buffer = nullptr;
-  const Image* image = nullptr;
 };
 
 class ComputeProgram {

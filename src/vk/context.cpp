@@ -44,6 +44,7 @@ struct InstanceRequest {
   std::string applicationName = "snell";
   bool validation = false;
   bool synchronizationValidation = false;
+  std::vector<std::string> extensions;
 };
 
 VkInstance createInstance(const InstanceRequest& request, bool& debugUtils) {
@@ -64,6 +65,10 @@ VkInstance createInstance(const InstanceRequest& request, bool& debugUtils) {
   std::vector<const char*> extensions;
   debugUtils = hasInstanceExtension(VK_EXT_DEBUG_UTILS_EXTENSION_NAME);
   if (debugUtils) extensions.push_back(VK_EXT_DEBUG_UTILS_EXTENSION_NAME);
+  for (const std::string& e : request.extensions) {
+    if (!hasInstanceExtension(e.c_str())) throw VulkanError("the Vulkan instance lacks the extension " + e);
+    extensions.push_back(e.c_str());
+  }
 
   VkApplicationInfo app{VK_STRUCTURE_TYPE_APPLICATION_INFO};
   app.pApplicationName = request.applicationName.c_str();
@@ -146,7 +151,8 @@ std::unique_ptr<Context> Context::create(const ContextDesc& desc) {
   Context& c = *context;
   c.owned_ = true;
   bool debugUtils = false;
-  c.instance_ = createInstance({desc.applicationName, desc.validation, desc.synchronizationValidation}, debugUtils);
+  c.instance_ = createInstance(
+      {desc.applicationName, desc.validation, desc.synchronizationValidation, desc.instanceExtensions}, debugUtils);
   c.validation_ = desc.validation;
   c.pipelineStatisticsRequested_ = desc.pipelineStatistics;
 
@@ -185,9 +191,27 @@ std::unique_ptr<Context> Context::create(const ContextDesc& desc) {
   features13.subgroupSizeControl = VK_TRUE;
   features13.computeFullSubgroups = VK_TRUE;
   features13.maintenance4 = VK_TRUE;
+  // The raster pass: offered by every Vulkan 1.3 device, and enabled when it is.
+  VkPhysicalDeviceVulkan13Features supported13{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_3_FEATURES};
+  VkPhysicalDeviceFeatures2 supported{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2, &supported13};
+  vkGetPhysicalDeviceFeatures2(physical, &supported);
+  features13.dynamicRendering = supported13.dynamicRendering;
   VkPhysicalDeviceFeatures2 features{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2, &features13};
+  features.features.fillModeNonSolid = supported.features.fillModeNonSolid;
 
   std::vector<const char*> extensions;
+  {
+    uint32_t count = 0;
+    VK_CHECK(vkEnumerateDeviceExtensionProperties(physical, nullptr, &count, nullptr));
+    std::vector<VkExtensionProperties> available(count);
+    VK_CHECK(vkEnumerateDeviceExtensionProperties(physical, nullptr, &count, available.data()));
+    for (const std::string& e : desc.deviceExtensions) {
+      bool found = std::any_of(available.begin(), available.end(),
+                               [&](const VkExtensionProperties& a) { return e == a.extensionName; });
+      if (!found) throw VulkanError(chosen.name + " lacks the device extension " + e);
+      extensions.push_back(e.c_str());
+    }
+  }
   VkPhysicalDevicePipelineExecutablePropertiesFeaturesKHR executableInfo{
       VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PIPELINE_EXECUTABLE_PROPERTIES_FEATURES_KHR};
   if (desc.pipelineStatistics && chosen.pipelineStatistics) {
@@ -209,7 +233,7 @@ std::unique_ptr<Context> Context::create(const ContextDesc& desc) {
     c.setObjectName_ = reinterpret_cast<PFN_vkSetDebugUtilsObjectNameEXT>(
         vkGetInstanceProcAddr(c.instance_, "vkSetDebugUtilsObjectNameEXT"));
   }
-  c.initialise(physical, chosen);
+  c.initialise(physical, chosen, features13.dynamicRendering, features.features.fillModeNonSolid);
   return context;
 }
 
@@ -245,13 +269,16 @@ std::unique_ptr<Context> Context::adopt(const AdoptedDevice& host) {
   // Present only if the host enabled VK_EXT_debug_utils; otherwise names are skipped.
   c.setObjectName_ = reinterpret_cast<PFN_vkSetDebugUtilsObjectNameEXT>(
       vkGetInstanceProcAddr(host.instance, "vkSetDebugUtilsObjectNameEXT"));
-  c.initialise(host.physicalDevice, facts);
+  c.initialise(host.physicalDevice, facts, host.enabled13.dynamicRendering, host.fillModeNonSolid);
   return context;
 }
 
-void Context::initialise(VkPhysicalDevice physicalDevice, const DeviceFacts& facts) {
+void Context::initialise(VkPhysicalDevice physicalDevice, const DeviceFacts& facts, bool dynamicRendering,
+                         bool fillModeNonSolid) {
   physicalDevice_ = physicalDevice;
   facts_ = facts;
+  caps_.dynamicRendering = dynamicRendering;
+  caps_.fillModeNonSolid = fillModeNonSolid;
   VkPhysicalDeviceProperties props{};
   vkGetPhysicalDeviceProperties(physicalDevice, &props);
   VkPhysicalDeviceMaintenance3Properties maintenance3{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_MAINTENANCE_3_PROPERTIES};

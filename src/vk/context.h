@@ -27,6 +27,9 @@ struct ContextDesc {
   std::string deviceOverride;
   /// Ask the driver for per-pipeline statistics where it offers them.
   bool pipelineStatistics = false;
+  /// Extra extensions a window needs (a surface on the instance, the swapchain
+  /// on the device); creation fails naming any the system lacks.
+  std::vector<std::string> instanceExtensions, deviceExtensions;
 };
 
 /// Handles a host application created; snell uses them and never destroys them.
@@ -40,6 +43,8 @@ struct AdoptedDevice {
   uint32_t queueFamily = 0;
   VkQueue queue = VK_NULL_HANDLE;
   VkPhysicalDeviceVulkan13Features enabled13{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_3_FEATURES};
+  /// Whether the host enabled fillModeNonSolid (snell's wireframes need it).
+  bool fillModeNonSolid = false;
 };
 
 /// Limits and properties the passes size themselves by.
@@ -56,6 +61,10 @@ struct DeviceCaps {
   uint32_t timestampValidBits = 0;  ///< 0: the queue cannot time passes
   /// Pipelines capture the driver's statistics (ComputeProgram::statistics).
   bool pipelineStatistics = false;
+  /// Graphics through vkCmdBeginRendering (the raster pass needs it).
+  bool dynamicRendering = false;
+  /// Wireframes (VK_POLYGON_MODE_LINE).
+  bool fillModeNonSolid = false;
 };
 
 /// Every devices' facts and the verdict on each, without creating a device.
@@ -120,7 +129,8 @@ class Context {
 
  private:
   Context() = default;
-  void initialise(VkPhysicalDevice physicalDevice, const DeviceFacts& facts);
+  void initialise(VkPhysicalDevice physicalDevice, const DeviceFacts& facts, bool dynamicRendering,
+                  bool fillModeNonSolid);
   static VkBool32 VKAPI_PTR onDebugMessage(VkDebugUtilsMessageSeverityFlagBitsEXT severity,
                                            VkDebugUtilsMessageTypeFlagsEXT types,
                                            const VkDebugUtilsMessengerCallbackDataEXT* data, void* user);

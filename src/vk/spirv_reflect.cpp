@@ -141,7 +141,7 @@ struct Reader {
 
 }  // namespace
 
-ShaderReflection reflectCompute(std::span<const uint32_t> spirv, std::span<const SpecConstant> specialization,
+ShaderReflection reflectShader(std::span<const uint32_t> spirv, std::span<const SpecConstant> specialization,
                                 const std::string& name) {
   Reader r;
   r.name = name;

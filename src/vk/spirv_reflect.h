@@ -1,5 +1,6 @@
-// Reads what a compute pipeline needs to know from its SPIR-V: the workgroup
-// size (after specialization), the descriptor bindings and the push-constant size.
+// Reads what a pipeline needs to know from a shader's SPIR-V: the descriptor
+// bindings, the push-constant size and, for compute, the workgroup size
+// (after specialization).
 #pragma once
 
 #include <vulkan/vulkan.h>
@@ -29,10 +30,10 @@ struct ShaderReflection {
   uint32_t pushConstantBytes = 0;
 };
 
-/// Reflects a compute shader's SPIR-V; `specialization` overrides spec-constant
+/// Reflects one shader stage's SPIR-V; `specialization` overrides spec-constant
 /// defaults so a local_size_x_id workgroup size resolves to what the pipeline
 /// will use. Throws std::runtime_error naming `name` on malformed input.
-ShaderReflection reflectCompute(std::span<const uint32_t> spirv, std::span<const SpecConstant> specialization,
+ShaderReflection reflectShader(std::span<const uint32_t> spirv, std::span<const SpecConstant> specialization,
                                 const std::string& name);
 
 }  // namespace snell::vk

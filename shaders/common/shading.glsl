@@ -1,0 +1,103 @@
+// Texture sampling and Phong shading as shaders/shared/trace.h states them,
+// shared by the trace pass (where a ray lands) and the raster pass (opaque
+// fragments), so both draw an opaque face the same way. The including shader
+// declares the readonly buffers `textures` (GpuTexture[]), `texels` (uint[])
+// and `lights` (GpuLight[]).
+
+#ifndef SNELL_SHADING_GLSL
+#define SNELL_SHADING_GLSL
+
+const float kPi = 3.14159265358979;
+
+vec3 srgbToLinear(vec3 c) {
+  return mix(c / 12.92, pow((c + 0.055) / 1.055, vec3(2.4)), greaterThan(c, vec3(0.04045)));
+}
+
+int wrapIndex(int i, int size, uint mode) {
+  if (mode == kWrapClamp) return clamp(i, 0, size - 1);
+  if (mode == kWrapMirror) {
+    int period = 2 * size;
+    int m = ((i % period) + period) % period;
+    return m < size ? m : period - 1 - m;
+  }
+  return ((i % size) + size) % size;
+}
+
+vec3 texel(GpuTexture tex, int x, int y) {
+  x = wrapIndex(x, int(tex.width), tex.flags & 3u);
+  y = wrapIndex(y, int(tex.height), (tex.flags >> 2) & 3u);
+  uint rgba = texels[tex.firstTexel + uint(y) * tex.width + uint(x)];
+  return srgbToLinear(unpackUnorm4x8(rgba).rgb);
+}
+
+vec3 sampleTexture(uint index, vec2 uv) {
+  GpuTexture tex = textures[index];
+  if ((tex.flags & 16u) != 0u) return texel(tex, int(floor(uv.x * float(tex.width))), int(floor(uv.y * float(tex.height))));
+  vec2 p = uv * vec2(tex.width, tex.height) - 0.5;
+  vec2 base = floor(p);
+  vec2 f = p - base;
+  int x = int(base.x), y = int(base.y);
+  vec3 top = mix(texel(tex, x, y), texel(tex, x + 1, y), f.x);
+  vec3 bottom = mix(texel(tex, x, y + 1), texel(tex, x + 1, y + 1), f.x);
+  return mix(top, bottom, f.y);
+}
+
+vec3 textured(uint texture, vec4 uvs, uint texCoord, vec4 row0, vec4 row1) {
+  if (texture == kNoTexture) return vec3(1.0);
+  vec3 uv = vec3(texCoord == 1u ? uvs.zw : uvs.xy, 1.0);
+  return sampleTexture(texture, vec2(dot(row0.xyz, uv), dot(row1.xyz, uv)));
+}
+
+vec3 baseColour(GpuMaterial m, vec4 uvs) {
+  return m.baseColorFactor.rgb * textured(m.textures.x, uvs, m.textures.y, m.baseUvRow0, m.baseUvRow1);
+}
+
+// Lit colour of a surface point seen along `dir`: `position` camera-relative,
+// `ns` the shading normal, `lightCount` lights (0: the headlight shining along
+// `headlight`).
+vec3 phong(vec3 position, vec3 ns, vec4 uvs, GpuMaterial m, vec3 dir, uint lightCount, vec3 headlight) {
+  vec3 base = baseColour(m, uvs);
+  vec3 n = dot(ns, dir) > 0.0 ? -ns : ns;  // towards the viewer
+  vec3 v = -dir;
+  vec3 colour = m.emissiveFactor.rgb * textured(m.textures.z, uvs, m.textures.w, m.emissiveUvRow0, m.emissiveUvRow1) +
+                kAmbient * base;
+  uint count = max(lightCount, 1u);
+  for (uint i = 0u; i < count; ++i) {
+    vec3 l, e;
+    if (lightCount == 0u) {
+      l = -headlight;
+      e = vec3(kHeadlight);
+    } else {
+      GpuLight light = lights[i];
+      uint type = uint(light.positionType.w);
+      if (type == kLightDirectional) {
+        l = -light.direction.xyz;
+        e = light.radiance.rgb;
+      } else {
+        vec3 toLight = light.positionType.xyz - position;
+        float distance2 = dot(toLight, toLight);
+        float distance = sqrt(distance2);
+        l = toLight / distance;
+        e = light.radiance.rgb / distance2;
+        float range = light.direction.w;
+        if (range > 0.0) {
+          float ratio = distance / range;
+          float window = clamp(1.0 - ratio * ratio * ratio * ratio, 0.0, 1.0);
+          e *= window * window;
+        }
+        if (type == kLightSpot) {
+          float cd = dot(light.direction.xyz, -l);
+          float s2 = clamp((cd - light.cone.y) / max(1e-4, light.cone.x - light.cone.y), 0.0, 1.0);
+          e *= s2 * s2;
+        }
+      }
+    }
+    float nl = dot(n, l);
+    if (nl <= 0.0) continue;
+    vec3 h = normalize(l + v);
+    colour += e * nl * (base / kPi + kSpecular * pow(max(dot(n, h), 0.0), kShininess));
+  }
+  return colour;
+}
+
+#endif

@@ -1,0 +1,47 @@
+// What the golden tests share: where goldens live, how two 8-bit images are
+// compared, the reference's picture of a view, and the test scenes.
+#pragma once
+
+#include "cli/image_file.h"
+#include "scene/evaluate.h"
+#include "scene/scene.h"
+#include "scene/view.h"
+
+#include <cstdint>
+#include <filesystem>
+#include <string>
+
+namespace snell::test {
+
+struct Tolerance {
+  double withinOne = 0.999;  ///< share of pixels whose channels all differ by at most 1/255
+  int maxDifference = 255;   ///< the largest channel difference allowed anywhere, in 1/255
+};
+
+/// golden/ of the checkout; SNELL_GOLDEN_DIR in the environment wins (the GPU
+/// machine has the checkout elsewhere).
+std::filesystem::path goldenDir();
+
+/// The CPU double-precision reference's picture, as 8-bit sRGB.
+cli::Rgb8Image referenceImage(const scene::Scene& s, const scene::Pose& pose, const scene::View& view, uint32_t width,
+                              uint32_t height);
+
+struct Comparison {
+  size_t pixels = 0, withinOne = 0;
+  int maxDifference = 0;
+  std::string firstMismatches;  ///< the first five pixels over 1/255, one per line
+  cli::Rgb8Image diff;          ///< mismatches in red over a dim copy of `want`
+};
+
+Comparison compare(const cli::Rgb8Image& got, const cli::Rgb8Image& want);
+
+/// The procedural eye with the cornea's index of refraction set.
+scene::Scene eyeWith(float ior);
+/// The eye with every transmissive face taken out: what IOR 1 must look like.
+scene::Scene eyeWithoutCorneaTip();
+/// A right-angle glass prism showing total internal reflection, with coloured walls.
+scene::Scene prismScene();
+/// A model of ../shared/assets, its iridescence ignored.
+scene::Scene loadModel(const std::string& relative);
+
+}  // namespace snell::test
