@@ -1,6 +1,7 @@
 // `snell eye`: the written file reads back as the eye the issue describes,
 // passes the Khronos glTF validator, and deforms on the GPU like on the CPU.
 #include "assets.h"
+#include "command_run.h"
 
 #include "scene/gltf_loader.h"
 #include "scene/gltf_writer.h"
@@ -110,13 +111,10 @@ TEST(ProceduralEye, FailedWriteLeavesNoFile) {
 
 /// Runs tests/tools/validate_gltf.js (the npm gltf-validator) on a file.
 int validate(const std::string& path, std::string& output) {
-  std::string command = "NODE_PATH='" + std::string(SNELL_GLTF_VALIDATOR_DIR) + "' node '" + SNELL_SOURCE_DIR +
-                        "/tests/tools/validate_gltf.js' '" + path + "' 2>&1";
-  FILE* pipe = popen(command.c_str(), "r");
-  char buffer[4096];
-  while (size_t n = fread(buffer, 1, sizeof buffer, pipe)) output.append(buffer, n);
-  int status = pclose(pipe);
-  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  CommandRun run = runCommand("NODE_PATH='" + std::string(SNELL_GLTF_VALIDATOR_DIR) + "' node '" + SNELL_SOURCE_DIR +
+                              "/tests/tools/validate_gltf.js' '" + path + "'");
+  output += run.output;
+  return run.exitCode;
 }
 
 TEST(ProceduralEye, PassesTheKhronosValidatorWithNoErrorOrWarning) {

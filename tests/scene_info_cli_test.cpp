@@ -1,32 +1,15 @@
 // `snell info SCENE` as a user runs it: exit codes and what it prints.
 #include "assets.h"
+#include "command_run.h"
 
 #include <gtest/gtest.h>
 
-#include <array>
-#include <cstdio>
-#include <memory>
 #include <string>
 
 namespace snell::test {
 namespace {
 
-struct CommandRun {
-  int exitCode;
-  std::string output;  // stdout and stderr together
-};
-
-CommandRun snell(const std::string& arguments) {
-  std::string command = std::string(SNELL_BINARY) + " " + arguments + " 2>&1";
-  std::unique_ptr<FILE, int (*)(FILE*)> pipe(popen(command.c_str(), "r"), pclose);
-  std::string output;
-  std::array<char, 4096> buffer;
-  while (size_t n = fread(buffer.data(), 1, buffer.size(), pipe.get())) output.append(buffer.data(), n);
-  int status = pclose(pipe.release());
-  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, output};
-}
-
-std::string shellQuoted(const std::string& path) { return "'" + path + "'"; }
+CommandRun snell(const std::string& arguments) { return runCommand(std::string(SNELL_BINARY) + " " + arguments); }
 
 TEST(SceneInfoCommand, DescribesAModelAndExitsZero) {
   CommandRun run = snell("info " + shellQuoted(model("TransmissionRoughnessTest/glTF-Binary/TransmissionRoughnessTest.glb")));

@@ -47,7 +47,11 @@ std::vector<ViewportCase> cases() {
   prismView.lookAt = scene::LookAt{{0.6, 0.3, -6.0}, {0.6, 0.0, 0.0}, {0.0, 1.0, 0.0}};
   prismView.yfov = 0.6;
   list.push_back({"prism", "prism_total_internal_reflection", 160, 120, {0.999, 8}, 0.999, prismScene, prismView});
-  list.push_back({"transmission_roughness_test", "transmission_roughness_test", 192, 144, {0.999, 255}, 0.995,
+  // Its textured floor: NVIDIA's interpolation of texture coordinates across a
+  // triangle differs from the ray's barycentrics by a fraction of a texel, so
+  // 0.3% of rasterized pixels land 2 to 6/255 away there (lavapipe: 0.004%);
+  // a silhouette pixel may fall to either face, so any difference is allowed.
+  list.push_back({"transmission_roughness_test", "transmission_roughness_test", 192, 144, {0.995, 255}, 0.995,
                   [] { return loadModel("TransmissionRoughnessTest/glTF-Binary/TransmissionRoughnessTest.glb"); }, {}});
   return list;
 }

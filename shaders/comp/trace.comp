@@ -35,6 +35,7 @@ const uint kStackSize = 64u;
 
 uint stack[kStackSize];
 uint visits;  // nodes visited by this pixel's whole path
+uint budget;  // nodes this segment may still visit, top and bottom levels together
 
 struct Hit {
   float t;
@@ -129,8 +130,8 @@ void traverseBlas(uint instance, vec3 origin, vec3 dir, uint skipPrim, float tMi
   ShearedRay r = shearRay(o, d);
   uint sp = base;
   stack[sp++] = root;
-  uint budget = kTraceMaxVisits;
-  while (sp > base && budget-- > 0u) {
+  while (sp > base && budget > 0u) {
+    --budget;
     uint ref = stack[--sp];
     ++visits;
     if ((ref & kBvhLeafBit) != 0u) {
@@ -153,8 +154,11 @@ Hit traceClosest(vec3 origin, vec3 dir, uint skipInstance, uint skipPrim, float 
   ShearedRay r = shearRay(origin, dir);
   uint sp = 0u;
   stack[sp++] = root;
-  uint budget = kTraceMaxVisits;
-  while (sp > 0u && budget-- > 0u) {
+  // One budget for the whole segment: a corrupted bottom level cannot spend
+  // it again in every instance the top level leads to.
+  budget = kTraceMaxVisits;
+  while (sp > 0u && budget > 0u) {
+    --budget;
     uint ref = stack[--sp];
     ++visits;
     if ((ref & kBvhLeafBit) != 0u) {

@@ -15,6 +15,9 @@ layout(binding = kRasterBindingTraceImage, rgba16f) uniform readonly image2D tra
 
 #include "../common/shading.glsl"
 
+// The depth pre-pass has settled visibility: each pixel is shaded once.
+layout(early_fragment_tests) in;
+
 layout(location = 0) in vec3 inPosition;
 layout(location = 1) in vec3 inNormal;
 layout(location = 2) in vec4 inUvs;
@@ -30,8 +33,6 @@ void main() {
   }
   GpuMaterial m = materials[inMaterial];
   if (m.emissiveFactor.w > 0.0) {
-    // Without refraction glass is seen straight through, as IOR 1 would show it.
-    if ((pc.flags & kRasterFlagNoRefraction) != 0u) discard;
     outColour = vec4(imageLoad(traceImage, ivec2(gl_FragCoord.xy)).rgb, 1.0);
     return;
   }

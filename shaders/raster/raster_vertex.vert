@@ -27,7 +27,7 @@ void main() {
   uint i0 = indices[3u * triangle], i1 = indices[3u * triangle + 1u], i2 = indices[3u * triangle + 2u];
   uint v = corner == 0u ? i0 : (corner == 1u ? i1 : i2);
   vec4 p = vec4(vertexAt(v), 1.0);
-  vec3 world = vec3(dot(inst.objectToWorld[0], p), dot(inst.objectToWorld[1], p), dot(inst.objectToWorld[2], p));
+  precise vec3 world = vec3(dot(inst.objectToWorld[0], p), dot(inst.objectToWorld[1], p), dot(inst.objectToWorld[2], p));
   // Normals by the inverse transpose, as the trace does: worldToObject's columns.
   mat3 toWorldNormal = transpose(mat3(inst.worldToObject[0].xyz, inst.worldToObject[1].xyz, inst.worldToObject[2].xyz));
   vec3 p0 = vertexAt(i0), p1 = vertexAt(i1), p2 = vertexAt(i2);
@@ -37,16 +37,18 @@ void main() {
   outMaterial = inst.material;
   outPosition = world;
 
-  vec3 rel = world - pc.eye.xyz;
-  float z = dot(rel, pc.forward.xyz);
+  // precise: the depth pre-pass and the shading pass (EQUAL) must agree on
+  // every depth bit, so no compiler may fuse this arithmetic differently in
+  // the two pipelines. (`invariant gl_Position` says the same, but Mesa warns
+  // about the decoration glslang emits for it.)
+  precise vec3 rel = world - pc.eye.xyz;
+  precise float z = dot(rel, pc.forward.xyz);
   // The film shift moves the picture: subtract it where the trace adds it to
   // the ray (times z in perspective, where clip x/w is the view's slope).
-  float w = (pc.flags & kRasterFlagOrthographic) != 0u ? 1.0 : z;
-  float x = (dot(rel, pc.right.xyz) - pc.shiftX * w) * pc.right.w;
-  float y = -(dot(rel, pc.up.xyz) - pc.shiftY * w) * pc.up.w;  // Vulkan's y points down the image, as row 0 is the top
-  if ((pc.flags & kRasterFlagOrthographic) != 0u) {
-    gl_Position = vec4(x, y, clamp((pc.eye.w - z) / (pc.eye.w - pc.forward.w), 0.0, 1.0), 1.0);
-  } else {
-    gl_Position = vec4(x, y, pc.forward.w, z);  // depth = near / z: reverse Z, far plane at infinity
-  }
+  bool ortho = (pc.flags & kRasterFlagOrthographic) != 0u;
+  precise float w = ortho ? 1.0 : z;
+  precise float x = (dot(rel, pc.right.xyz) - pc.shiftX * w) * pc.right.w;
+  precise float y = -(dot(rel, pc.up.xyz) - pc.shiftY * w) * pc.up.w;  // Vulkan's y points down the image, as row 0 is the top
+  precise float depth = ortho ? clamp((pc.eye.w - z) / (pc.eye.w - pc.forward.w), 0.0, 1.0) : pc.forward.w;
+  gl_Position = vec4(x, y, depth, w);  // perspective: depth = near / z, reverse Z, far plane at infinity
 }

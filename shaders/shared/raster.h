@@ -1,7 +1,8 @@
 // The raster pass (shaders/raster/): draws every draw item from the same
 // deformed vertex buffers the trace uses (vertex pulling), Phong-shades opaque
 // fragments as trace.h states, and gives each transmissive fragment the trace
-// image's texel at its own pixel. Coverage is sampled at pixel centres, the
+// image's texel at its own pixel. A depth-only pre-pass comes first, so the
+// shading pass runs once per pixel (depth test EQUAL). Coverage is sampled at pixel centres, the
 // points the trace's primary rays go through, so the two agree pixel for pixel
 // away from silhouettes. Depth is reverse Z (near is 1, infinity is 0).
 #ifndef SNELL_RASTER_H
@@ -11,7 +12,6 @@
 SNELL_GPU_BEGIN
 
 SNELL_CONST kRasterFlagOrthographic = 1u;
-SNELL_CONST kRasterFlagNoRefraction = 2u;  // transmissive faces are left out: glass seen straight through
 SNELL_CONST kRasterFlagWireframe = 4u;     // the wireframe overlay: one flat colour
 
 // Binding slots of set 0 (the same buffers the trace binds).

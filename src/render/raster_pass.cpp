@@ -4,6 +4,7 @@
 #include "shared/raster.h"
 #include "vk/error.h"
 
+#include "raster_depth.spv.h"
 #include "raster_fragment.spv.h"
 #include "raster_vertex.spv.h"
 
@@ -42,6 +43,13 @@ RasterPass::RasterPass(vk::Context& context) : context_(context) {
   desc.fragmentSpirv = kSpvRasterFragment;
   desc.colorFormat = kCompositeFormat;
   desc.depthFormat = kDepthFormat;
+  vk::GraphicsProgramDesc depthOnly = desc;
+  depthOnly.name = "raster depth";
+  depthOnly.fragmentSpirv = kSpvRasterDepth;
+  depthOnly.colorWrite = false;
+  depth_ = std::make_unique<vk::GraphicsProgram>(context, depthOnly);
+  desc.depthCompare = VK_COMPARE_OP_EQUAL;  // only the fragment the pre-pass kept
+  desc.depthWrite = false;
   fill_ = std::make_unique<vk::GraphicsProgram>(context, desc);
   if (context.caps().fillModeNonSolid) {
     desc.name = "raster wireframe";
@@ -75,7 +83,7 @@ void RasterPass::record(vk::Commands& commands, const Renderer& renderer, const 
   push.forward = glm::vec4(glm::vec3(v.forward), float(options.nearPlane));
   push.eye = glm::vec4(glm::vec3(v.eye - renderer.origin()), float(options.farPlane));
   push.wireColor = options.wireColor;
-  push.flags = (v.orthographic ? gpu::kRasterFlagOrthographic : 0u) | (options.refraction ? 0u : gpu::kRasterFlagNoRefraction);
+  push.flags = v.orthographic ? gpu::kRasterFlagOrthographic : 0u;
   push.lightCount = renderer.lightCount();
   push.shiftX = float(v.shift.x);
   push.shiftY = float(v.shift.y);
@@ -89,24 +97,42 @@ void RasterPass::record(vk::Commands& commands, const Renderer& renderer, const 
   {
     vk::RenderingScope scope(commands, target, &depth, area, clear);
     const SceneGpu& scene = renderer.sceneGpu();
+    const scene::Scene& model = renderer.scene();
+    auto refractive = [&](int shape) {
+      int material = shape >= 0 ? model.shapes[size_t(shape)].material : -1;
+      return material >= 0 && model.materials[size_t(material)].refractive();
+    };
     auto drawItems = [&](const vk::GraphicsProgram& program, const gpu::RasterPush& p) {
-      program.bind(commands,
-                   {{gpu::kRasterBindingInstances, &renderer.instances()},
-                    {gpu::kRasterBindingPositions, &scene.positions},
-                    {gpu::kRasterBindingNormals, &scene.normals},
-                    {gpu::kRasterBindingTexcoords, &scene.texcoords},
-                    {gpu::kRasterBindingIndices, &scene.indices},
-                    {gpu::kRasterBindingMaterials, &scene.materials},
-                    {gpu::kRasterBindingTextures, &scene.textures},
-                    {gpu::kRasterBindingTexels, &scene.texels},
-                    {gpu::kRasterBindingLights, &renderer.lights()},
-                    {gpu::kRasterBindingTraceImage, nullptr, &traceImage}},
-                   area);
+      if (&program == depth_.get()) {  // vertices only
+        program.bind(commands,
+                     {{gpu::kRasterBindingInstances, &renderer.instances()},
+                      {gpu::kRasterBindingPositions, &scene.positions},
+                      {gpu::kRasterBindingNormals, &scene.normals},
+                      {gpu::kRasterBindingTexcoords, &scene.texcoords},
+                      {gpu::kRasterBindingIndices, &scene.indices}},
+                     area);
+      } else {
+        program.bind(commands,
+                     {{gpu::kRasterBindingInstances, &renderer.instances()},
+                      {gpu::kRasterBindingPositions, &scene.positions},
+                      {gpu::kRasterBindingNormals, &scene.normals},
+                      {gpu::kRasterBindingTexcoords, &scene.texcoords},
+                      {gpu::kRasterBindingIndices, &scene.indices},
+                      {gpu::kRasterBindingMaterials, &scene.materials},
+                      {gpu::kRasterBindingTextures, &scene.textures},
+                      {gpu::kRasterBindingTexels, &scene.texels},
+                      {gpu::kRasterBindingLights, &renderer.lights()},
+                      {gpu::kRasterBindingTraceImage, nullptr, &traceImage}},
+                     area);
+      }
       for (size_t item = 0; item < scene.itemGeometry.size(); ++item) {
         const GeometryRange& g = scene.geometries[scene.itemGeometry[item]];
+        // Without refraction glass is left out and seen straight through, as IOR 1 would show it.
+        if (!options.refraction && refractive(g.shape)) continue;
         program.draw(commands, p, 3 * g.triangleCount, 3 * g.firstTriangle, static_cast<uint32_t>(item));
       }
     };
+    drawItems(*depth_, push);
     drawItems(*fill_, push);
     if (options.wireframe) {
       gpu::RasterPush wirePush = push;

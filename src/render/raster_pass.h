@@ -52,7 +52,7 @@ class RasterPass {
 
  private:
   vk::Context& context_;
-  std::unique_ptr<vk::GraphicsProgram> fill_, wire_;
+  std::unique_ptr<vk::GraphicsProgram> depth_, fill_, wire_;
 };
 
 /// A traced frame and its raster composite, read back (tests, `snell render --viewport`).

@@ -61,6 +61,7 @@ class Renderer {
   void invalidateBlas() { blasBuilt_ = false; }
 
   const SceneGpu& sceneGpu() const { return scene_; }
+  const scene::Scene& scene() const { return sceneModel_; }
   /// The last update's instances (gpu::GpuInstance, rebased to its origin) and
   /// lights (gpu::GpuLight), which the raster pass shares.
   const vk::Buffer& instances() const { return instances_; }

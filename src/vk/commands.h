@@ -31,6 +31,9 @@ class Commands {
   void begin();
   /// Ends recording and submits to the context's queue with this object's fence.
   void submit();
+  /// The same, waiting for `wait` (if any) at `waitStage` and signalling
+  /// `signal` (if any) when done: a swapchain image's acquire and present.
+  void submit(VkSemaphore wait, VkPipelineStageFlags waitStage, VkSemaphore signal);
   /// Waits for the submission, then reads back its pass timings.
   void wait();
   /// submit() then wait().
@@ -56,6 +59,10 @@ class Commands {
   void graphicsToTransfer();
   /// Transfer writes become visible to later transfers.
   void transferToTransfer();
+  /// Any other dependency: writes of `srcAccess` at `srcStage` become visible
+  /// to `dstAccess` at `dstStage`.
+  void barrier(VkPipelineStageFlags srcStage, VkAccessFlags srcAccess, VkPipelineStageFlags dstStage,
+               VkAccessFlags dstAccess);
   /// Moves a whole colour image between layouts with a full memory barrier.
   void imageLayout(const Image& image, VkImageLayout from, VkImageLayout to);
 
@@ -74,8 +81,6 @@ class Commands {
   VkDescriptorSet allocateSet(VkDescriptorSetLayout layout);
 
  private:
-  void memoryBarrier(VkPipelineStageFlags srcStage, VkAccessFlags srcAccess, VkPipelineStageFlags dstStage,
-                     VkAccessFlags dstAccess);
   void readTimestamps();
   VkDescriptorPool addDescriptorPool();
 

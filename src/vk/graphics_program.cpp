@@ -96,8 +96,9 @@ GraphicsProgram::GraphicsProgram(Context& context, const GraphicsProgramDesc& de
   depth.depthWriteEnable = desc.depthFormat != VK_FORMAT_UNDEFINED && desc.depthWrite;
   depth.depthCompareOp = desc.depthCompare;
   VkPipelineColorBlendAttachmentState attachment{};
-  attachment.colorWriteMask =
-      VK_COLOR_COMPONENT_R_BIT | VK_COLOR_COMPONENT_G_BIT | VK_COLOR_COMPONENT_B_BIT | VK_COLOR_COMPONENT_A_BIT;
+  attachment.colorWriteMask = desc.colorWrite ? VK_COLOR_COMPONENT_R_BIT | VK_COLOR_COMPONENT_G_BIT |
+                                                   VK_COLOR_COMPONENT_B_BIT | VK_COLOR_COMPONENT_A_BIT
+                                             : 0;
   if (desc.blend) {
     attachment.blendEnable = VK_TRUE;
     attachment.srcColorBlendFactor = VK_BLEND_FACTOR_SRC_ALPHA;

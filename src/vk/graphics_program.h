@@ -33,6 +33,8 @@ struct GraphicsProgramDesc {
   float depthBias = 0.0f;
   /// Source-over blending with the fragment's alpha.
   bool blend = false;
+  /// False: a depth-only pass (the colour attachment is left untouched).
+  bool colorWrite = true;
 };
 
 class GraphicsProgram {
