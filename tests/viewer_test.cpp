@@ -74,6 +74,25 @@ TEST(Viewer, OpensAglTFFileGivenOnTheCommandLineInTwoViewports) {
   EXPECT_EQ(run.exitCode, 0) << run.output;
 }
 
+// What a file dropped on the window goes through: a file that fails to load
+// is reported and the current scene stays; a good one replaces it.
+TEST(Viewer, AFailedLoadKeepsTheCurrentSceneAndAGoodOneReplacesIt) {
+  fs::path script = scratchDir("viewer-load") / "load.script";
+  {
+    std::ofstream out(script);
+    out << "1 load /nonexistent/dropped.glb\n"
+        << "2 load " << model("TransmissionRoughnessTest/glTF-Binary/TransmissionRoughnessTest.glb") << "\n";
+  }
+  CommandRun run = runCommand("env -u DISPLAY " + std::string(SNELL_VIEWER_BINARY) +
+                              " --offscreen --frames 4 --size 160x90 --script " + shellQuoted(script.string()));
+  EXPECT_EQ(run.exitCode, 0) << run.output;
+  EXPECT_NE(run.output.find("/nonexistent/dropped.glb"), std::string::npos) << run.output;
+  EXPECT_NE(run.output.find("opened " + model("TransmissionRoughnessTest/glTF-Binary/TransmissionRoughnessTest.glb")),
+            std::string::npos)
+      << run.output;
+  EXPECT_EQ(run.output.find("[vulkan"), std::string::npos) << run.output;
+}
+
 TEST(Viewer, RunsItsFrameCodeOffscreenWithoutADisplay) {
   fs::path dir = scratchDir("viewer-offscreen");
   std::string shot = (dir / "offscreen.png").string(), json = (dir / "times.json").string();

@@ -13,7 +13,8 @@ Swapchain::Swapchain(vk::Context& context, VkSurfaceKHR surface, bool vsync)
   VK_CHECK(vkGetPhysicalDeviceSurfaceSupportKHR(context.physicalDevice(), context.queueFamily(), surface, &supported));
   if (!supported) {
     vkDestroySurfaceKHR(context.instance(), surface, nullptr);
-    throw vk::VulkanError(context.facts().name + " cannot present to this window from its compute queue");
+    throw vk::VulkanError(context.facts().name + " cannot present to this window from the queue snell uses; pick "
+                          "another device with SNELL_DEVICE (see 'snell info --devices')");
   }
 }
 
@@ -41,6 +42,7 @@ bool Swapchain::recreate(uint32_t width, uint32_t height) {
     extent.height = std::clamp(height, caps.minImageExtent.height, caps.maxImageExtent.height);
   }
   vkDeviceWaitIdle(context_.device());
+  requested_ = {width, height};
   if (extent.width == 0 || extent.height == 0 || width == 0 || height == 0) {
     destroy();
     return false;
@@ -54,13 +56,20 @@ bool Swapchain::recreate(uint32_t width, uint32_t height) {
   std::vector<VkSurfaceFormatKHR> formats(count);
   VK_CHECK(vkGetPhysicalDeviceSurfaceFormatsKHR(physical, surface_, &count, formats.data()));
   // UNORM: the display pass writes sRGB-encoded values itself, and ImGui's colours are sRGB already.
-  VkSurfaceFormatKHR chosen = formats.empty() ? VkSurfaceFormatKHR{} : formats[0];
+  VkSurfaceFormatKHR chosen{VK_FORMAT_UNDEFINED, VK_COLOR_SPACE_SRGB_NONLINEAR_KHR};
   for (const VkSurfaceFormatKHR& f : formats) {
+    VkFormatProperties properties{};
+    vkGetPhysicalDeviceFormatProperties(physical, f.format, &properties);
     if ((f.format == VK_FORMAT_B8G8R8A8_UNORM || f.format == VK_FORMAT_R8G8B8A8_UNORM) &&
-        f.colorSpace == VK_COLOR_SPACE_SRGB_NONLINEAR_KHR) {
+        f.colorSpace == VK_COLOR_SPACE_SRGB_NONLINEAR_KHR &&
+        (properties.optimalTilingFeatures & VK_FORMAT_FEATURE_BLIT_DST_BIT)) {
       chosen = f;
       break;
     }
+  }
+  // An sRGB swapchain would encode the display pass's sRGB values a second time.
+  if (chosen.format == VK_FORMAT_UNDEFINED) {
+    throw vk::VulkanError("the window offers no 8-bit UNORM sRGB-display format snell can copy to; try --offscreen");
   }
   VK_CHECK(vkGetPhysicalDeviceSurfacePresentModesKHR(physical, surface_, &count, nullptr));
   std::vector<VkPresentModeKHR> modes(count);
@@ -116,7 +125,7 @@ std::optional<uint32_t> Swapchain::acquire(VkSemaphore ready) {
   uint32_t index = 0;
   constexpr uint64_t kTimeoutNs = 10ull * 1000 * 1000 * 1000;
   VkResult result = vkAcquireNextImageKHR(context_.device(), swapchain_, kTimeoutNs, ready, VK_NULL_HANDLE, &index);
-  if (result == VK_ERROR_OUT_OF_DATE_KHR) return std::nullopt;
+  if (result == VK_ERROR_OUT_OF_DATE_KHR || result == VK_TIMEOUT || result == VK_NOT_READY) return std::nullopt;
   if (result != VK_SUBOPTIMAL_KHR) VK_CHECK(result);  // suboptimal still signals `ready`: use it, recreate after
   return index;
 }

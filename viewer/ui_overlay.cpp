@@ -108,13 +108,7 @@ void UiOverlay::newFrame(uint32_t width, uint32_t height, double seconds) {
 VkFramebuffer UiOverlay::framebufferFor(const vk::Image& target) {
   auto found = framebuffers_.find(target.view());
   if (found != framebuffers_.end()) return found->second;
-  // A new window image (after a resize): the old ones' framebuffers go once the GPU is done.
-  for (auto& [view, framebuffer] : framebuffers_) {
-    VkDevice device = context_.device();
-    VkFramebuffer old = framebuffer;
-    context_.retire([device, old] { vkDestroyFramebuffer(device, old, nullptr); });
-  }
-  framebuffers_.clear();
+  forgetTargets();
   VkImageView view = target.view();
   VkFramebufferCreateInfo info{VK_STRUCTURE_TYPE_FRAMEBUFFER_CREATE_INFO};
   info.renderPass = renderPass_;
@@ -127,6 +121,16 @@ VkFramebuffer UiOverlay::framebufferFor(const vk::Image& target) {
   VK_CHECK(vkCreateFramebuffer(context_.device(), &info, nullptr, &framebuffer));
   framebuffers_[view] = framebuffer;
   return framebuffer;
+}
+
+void UiOverlay::forgetTargets() {
+  // Their images are going: the framebuffers go too, once the GPU is done with them.
+  for (auto& [view, framebuffer] : framebuffers_) {
+    VkDevice device = context_.device();
+    VkFramebuffer old = framebuffer;
+    context_.retire([device, old] { vkDestroyFramebuffer(device, old, nullptr); });
+  }
+  framebuffers_.clear();
 }
 
 void UiOverlay::render(vk::Commands& commands, const vk::Image& target) {

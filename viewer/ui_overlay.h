@@ -30,6 +30,9 @@ class UiOverlay {
   void newFrame(uint32_t width, uint32_t height, double seconds);
   /// Ends the frame and records its drawing onto `target` (kWindowImageFormat, GENERAL).
   void render(vk::Commands& commands, const vk::Image& target);
+  /// Drops the framebuffers of window images about to be replaced (a new
+  /// image's view may reuse an old handle's value).
+  void forgetTargets();
   /// Whether ImGui wants the mouse or keyboard (the camera then leaves them alone).
   bool wantsMouse() const;
   bool wantsKeyboard() const;

@@ -74,7 +74,8 @@ class Viewer {
 
  private:
   void openWindow();
-  void loadScene(const std::string& path);
+  void useScene(std::unique_ptr<scene::Scene> scene, int camera);
+  bool cameraResolves(int camera) const;
   void layoutViewports(uint32_t width, uint32_t height);
   void applyScript(uint64_t frame);
   void drawUi(double frameSeconds);
@@ -116,6 +117,7 @@ class Viewer {
   std::vector<ScriptAction> script_;
   size_t nextAction_ = 0;
   bool quit_ = false;
+  bool shotWritten_ = false;
   std::string pendingLoad_;
   // Mouse state for camera drags.
   double lastX_ = 0, lastY_ = 0;
@@ -136,16 +138,17 @@ Viewer::Viewer(const ViewerOptions& options) : options_(options) {
   if (!options.script.empty()) script_ = loadScript(options.script);
 
   // The scene first: a bad file is reported before any window opens.
+  std::unique_ptr<scene::Scene> initial;
   if (options.scene.empty()) {
-    scene_ = std::make_unique<scene::Scene>(scene::makeEye());
-    scene_->source = "procedural eye";
+    initial = std::make_unique<scene::Scene>(scene::makeEye());
+    initial->source = "procedural eye";
   } else {
-    scene_ = std::make_unique<scene::Scene>(scene::loadGltf(options.scene, options.load));
+    initial = std::make_unique<scene::Scene>(scene::loadGltf(options.scene, options.load));
   }
-  for (const std::string& w : scene_->warnings) std::fprintf(stderr, "snell-view: note: %s\n", w.c_str());
-  if (options.camera >= 0 && size_t(options.camera) >= scene_->cameras.size()) {
+  for (const std::string& w : initial->warnings) std::fprintf(stderr, "snell-view: note: %s\n", w.c_str());
+  if (options.camera >= 0 && size_t(options.camera) >= initial->cameras.size()) {
     throw cli::UsageError{"--camera " + std::to_string(options.camera) + ": the scene has " +
-                          std::to_string(scene_->cameras.size()) + " camera(s)"};
+                          std::to_string(initial->cameras.size()) + " camera(s)"};
   }
 
   vk::ContextDesc desc = cli::contextDescFromEnvironment();
@@ -171,7 +174,7 @@ Viewer::Viewer(const ViewerOptions& options) : options_(options) {
   raster_ = std::make_unique<render::RasterPass>(*context_);
   placeholderAov_ = vk::Buffer(*context_, {sizeof(gpu::TraceAov), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
                                            vk::MemoryDomain::Device, "no heat map"});
-  loadScene("");
+  useScene(std::move(initial), options.camera);
 }
 
 Viewer::~Viewer() {
@@ -202,46 +205,64 @@ void Viewer::openWindow() {
   glfwSetDropCallback(window_, onDrop);
 }
 
-// Loads `path` (empty: the scene already in scene_) and rebuilds what depends on it.
-void Viewer::loadScene(const std::string& path) {
-  if (!path.empty()) {
-    std::unique_ptr<scene::Scene> loaded;
+// Switches to `scene`, seen from its glTF camera `camera` (-1: camera 0 when
+// a node places it, else the view `snell render` frames the scene with).
+// Everything new is built before anything old is let go: a scene that fails
+// at any step throws and leaves the current one as it was.
+void Viewer::useScene(std::unique_ptr<scene::Scene> scene, int camera) {
+  double duration = scene::animationDuration(*scene);
+  double time = std::clamp(time_, 0.0, duration);
+  scene::Pose pose = scene::evaluate(*scene, time);
+  glm::dvec3 lo, hi;
+  scene::sceneBounds(*scene, pose, lo, hi);
+  auto resolves = [&](int c) {
     try {
-      loaded = std::make_unique<scene::Scene>(scene::loadGltf(path, options_.load));
-    } catch (const std::exception& e) {
-      message_ = e.what();  // the current scene stays
-      std::fprintf(stderr, "snell-view: %s\n", e.what());
-      return;
+      scene::resolveView(*scene, pose, {c, std::nullopt, 0.6981317});
+      return true;
+    } catch (const std::invalid_argument&) {
+      return false;
     }
-    vkDeviceWaitIdle(context_->device());
-    renderer_.reset();
-    scene_ = std::move(loaded);
-    options_.camera = -1;
-    message_.clear();
+  };
+  if (camera >= 0 && !resolves(camera)) {
+    throw std::runtime_error(scene->source + ": camera " + std::to_string(camera) + " is not placed by any node");
   }
-  sceneName_ = scene_->source.empty() ? "scene" : scene_->source;
-  duration_ = scene::animationDuration(*scene_);
-  time_ = std::clamp(time_, 0.0, duration_);
-  pose_ = scene::evaluate(*scene_, time_);
-  scene::sceneBounds(*scene_, pose_, boundsLo_, boundsHi_);
-  renderer_ = std::make_unique<render::Renderer>(*context_, *scene_, pose_);
-
-  viewports_.clear();
-  viewports_.resize(2);
-  int camera = options_.camera >= 0 ? options_.camera : (scene_->cameras.empty() ? -1 : 0);
-  Viewport& main = viewports_[0];
+  if (camera < 0 && !scene->cameras.empty() && resolves(0)) camera = 0;
+  std::vector<Viewport> viewports(2);
+  Viewport& main = viewports[0];
+  glm::dvec3 centre = 0.5 * (lo + hi);
   if (camera >= 0) {
     main.rig.sceneCamera = camera;
   } else {
-    // The view `snell render` frames the scene with, so the two agree.
-    main.rig.adopt(scene::resolveView(*scene_, pose_, {}), 0.5 * (boundsLo_ + boundsHi_));
+    // No placed camera: the view `snell render` frames the scene with, so the two agree.
+    main.rig.adopt(scene::resolveView(*scene, pose, {}), centre);
   }
   // The second viewport: the same subject from 50 degrees to the side.
-  viewports_[1].rig.adopt(main.rig.view(*scene_, pose_), 0.5 * (boundsLo_ + boundsHi_));
-  viewports_[1].rig.orbit(-50.0 / 0.008 * 3.14159265358979 / 180.0, 0.0);
+  viewports[1].rig.adopt(main.rig.view(*scene, pose), centre);
+  viewports[1].rig.orbit(-50.0 / 0.008 * 3.14159265358979 / 180.0, 0.0);
+  auto renderer = std::make_unique<render::Renderer>(*context_, *scene, pose);
+
+  if (renderer_) vkDeviceWaitIdle(context_->device());
+  renderer_ = std::move(renderer);  // the old renderer goes before the scene it refers to
+  scene_ = std::move(scene);
+  pose_ = std::move(pose);
+  boundsLo_ = lo;
+  boundsHi_ = hi;
+  duration_ = duration;
+  time_ = time;
+  sceneName_ = scene_->source.empty() ? "scene" : scene_->source;
+  viewports_ = std::move(viewports);  // sized on the next frame
   active_ = 0;
   freshImages_ = true;
-  for (Viewport& vp : viewports_) vp.width = 0;  // re-sized on the next frame
+}
+
+bool Viewer::cameraResolves(int camera) const {
+  if (camera < 0 || size_t(camera) >= scene_->cameras.size()) return false;
+  try {
+    scene::resolveView(*scene_, pose_, {camera, std::nullopt, 0.6981317});
+    return true;
+  } catch (const std::invalid_argument&) {
+    return false;
+  }
 }
 
 void Viewer::layoutViewports(uint32_t width, uint32_t height) {
@@ -273,6 +294,7 @@ void Viewer::layoutViewports(uint32_t width, uint32_t height) {
     freshImages_ = true;
   }
   if (windowImage_.width() != width || windowImage_.height() != height) {
+    ui_->forgetTargets();
     windowImage_ = vk::Image(*context_, {width, height, kWindowImageFormat,
                                          VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT |
                                              VK_IMAGE_USAGE_TRANSFER_SRC_BIT,
@@ -338,12 +360,24 @@ void Viewer::onKey(GLFWwindow* w, int key, int, int action, int mods) {
   (void)mods;
 }
 
+// Cursor positions come in window units; viewports are laid out in framebuffer
+// pixels, which differ on scaled (HiDPI) displays.
+double pixelsPerUnit(GLFWwindow* w) {
+  int windowWidth = 0, windowHeight = 0, pixelWidth = 0, pixelHeight = 0;
+  glfwGetWindowSize(w, &windowWidth, &windowHeight);
+  glfwGetFramebufferSize(w, &pixelWidth, &pixelHeight);
+  return windowWidth > 0 && pixelWidth > 0 ? double(pixelWidth) / double(windowWidth) : 1.0;
+}
+
 void Viewer::onMouseButton(GLFWwindow* w, int button, int action, int mods) {
   auto* self = static_cast<Viewer*>(glfwGetWindowUserPointer(w));
   if (button < 0 || button > 2) return;
   if (action == GLFW_PRESS) {
     if (self->ui_->wantsMouse()) return;
     glfwGetCursorPos(w, &self->lastX_, &self->lastY_);
+    double scale = pixelsPerUnit(w);
+    self->lastX_ *= scale;
+    self->lastY_ *= scale;
     self->viewportAt(self->lastX_, self->lastY_);
     self->buttons_ |= 1 << button;
     self->dragMods_ = mods;
@@ -357,6 +391,9 @@ void Viewer::onMouseButton(GLFWwindow* w, int button, int action, int mods) {
 // tracks, Ctrl + left dollies. In film mode (\) left drag pans the film back.
 void Viewer::onCursor(GLFWwindow* w, double x, double y) {
   auto* self = static_cast<Viewer*>(glfwGetWindowUserPointer(w));
+  double scale = pixelsPerUnit(w);
+  x *= scale;
+  y *= scale;
   double dx = x - self->lastX_, dy = y - self->lastY_;
   self->lastX_ = x;
   self->lastY_ = y;
@@ -383,7 +420,7 @@ void Viewer::onScroll(GLFWwindow* w, double, double dy) {
   if (self->ui_->wantsMouse()) return;
   double x = 0, y = 0;
   glfwGetCursorPos(w, &x, &y);
-  Viewport& vp = *self->viewportAt(x, y);
+  Viewport& vp = *self->viewportAt(x * pixelsPerUnit(w), y);
   if (self->toggles_.filmMode) {
     vp.rig.zoomFilm(dy);
   } else {
@@ -434,10 +471,10 @@ void Viewer::applyScript(uint64_t frame) {
     } else if (a.action == "camera") {
       if (a.args[0] == "orbit") {
         leaveSceneCamera(vp);
-      } else if (size_t(number(0)) < scene_->cameras.size()) {
+      } else if (number(0) >= 0.0 && cameraResolves(int(number(0)))) {
         vp.rig.sceneCamera = int(number(0));
       } else {
-        message_ = "script line " + std::to_string(a.line) + ": no camera " + a.args[0];
+        message_ = "script line " + std::to_string(a.line) + ": no camera " + a.args[0] + " placed in the scene";
       }
     } else if (a.action == "play") {
       toggles_.playing = true;
@@ -513,7 +550,13 @@ void Viewer::drawUi(double frameSeconds) {
     if (ImGui::Selectable("orbit", vp.rig.sceneCamera < 0)) leaveSceneCamera(vp);
     for (size_t c = 0; c < scene_->cameras.size(); ++c) {
       std::string label = std::to_string(c) + " " + scene_->cameras[c].name;
-      if (ImGui::Selectable(label.c_str(), vp.rig.sceneCamera == int(c))) vp.rig.sceneCamera = int(c);
+      if (ImGui::Selectable(label.c_str(), vp.rig.sceneCamera == int(c))) {
+        if (cameraResolves(int(c))) {
+          vp.rig.sceneCamera = int(c);
+        } else {
+          message_ = "camera " + std::to_string(c) + " is not placed by any node";
+        }
+      }
     }
     ImGui::EndCombo();
   }
@@ -596,7 +639,7 @@ void Viewer::recordFrame(vk::Commands& commands, std::optional<uint32_t> swapIma
       gateAspect = scene_->cameras[size_t(vp.rig.sceneCamera)].aspectRatio;
     }
     double h0 = view.halfHeight * vp.rig.filmZoom;  // the half height at zoom 1
-    double gh = h0 * std::min(1.0, aspect / gateAspect), gw = gh * gateAspect;
+    double gh = h0, gw = h0 * gateAspect;  // the trace keeps the camera's vertical field of view
     auto px = [&](double slope) { return (0.5 + 0.5 * (slope - view.shift.x) / (view.halfHeight * aspect)) * vp.width; };
     auto py = [&](double slope) { return (0.5 - 0.5 * (slope - view.shift.y) / view.halfHeight) * vp.height; };
     push.gate = glm::vec4(float(px(-gw)), float(py(gh)), float(px(gw)), float(py(-gh)));
@@ -605,8 +648,10 @@ void Viewer::recordFrame(vk::Commands& commands, std::optional<uint32_t> swapIma
     push.heatMax = toggles_.heatMax;
     pushes.push_back(push);
   }
-  commands.barrier(VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT, VK_ACCESS_COLOR_ATTACHMENT_WRITE_BIT,
-                   VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_READ_BIT);
+  // The composites (raster) and the heat maps' node counts (trace) reach the display pass.
+  commands.barrier(VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT | VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
+                   VK_ACCESS_COLOR_ATTACHMENT_WRITE_BIT | VK_ACCESS_SHADER_WRITE_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
+                   VK_ACCESS_SHADER_READ_BIT);
   commands.beginPass("display");
   size_t p = 0;
   for (const Viewport& vp : viewports_) {
@@ -642,21 +687,10 @@ void Viewer::recordFrame(vk::Commands& commands, std::optional<uint32_t> swapIma
   }
   if (swapImage) {
     VkImage target = swapchain_->image(*swapImage);
-    auto transition = [&](VkImageLayout from, VkImageLayout to, VkAccessFlags srcAccess, VkAccessFlags dstAccess,
-                          VkPipelineStageFlags srcStage, VkPipelineStageFlags dstStage) {
-      VkImageMemoryBarrier b{VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER};
-      b.srcAccessMask = srcAccess;
-      b.dstAccessMask = dstAccess;
-      b.oldLayout = from;
-      b.newLayout = to;
-      b.srcQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
-      b.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
-      b.image = target;
-      b.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
-      vkCmdPipelineBarrier(cmd, srcStage, dstStage, 0, 0, nullptr, 0, nullptr, 1, &b);
-    };
-    transition(VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 0, VK_ACCESS_TRANSFER_WRITE_BIT,
-               VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT);
+    // The acquire semaphore is waited for at the transfer stage: the copy starts after it.
+    commands.imageBarrier(target, VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_LAYOUT_UNDEFINED,
+                          VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_PIPELINE_STAGE_TRANSFER_BIT, 0,
+                          VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT);
     VkExtent2D extent = swapchain_->extent();
     VkImageBlit blit{};
     blit.srcSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
@@ -666,8 +700,9 @@ void Viewer::recordFrame(vk::Commands& commands, std::optional<uint32_t> swapIma
     blit.dstOffsets[1] = blit.srcOffsets[1];
     vkCmdBlitImage(cmd, windowImage_.handle(), VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, target,
                    VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &blit, VK_FILTER_NEAREST);
-    transition(VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_IMAGE_LAYOUT_PRESENT_SRC_KHR, VK_ACCESS_TRANSFER_WRITE_BIT, 0,
-               VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT);
+    commands.imageBarrier(target, VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
+                          VK_IMAGE_LAYOUT_PRESENT_SRC_KHR, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT,
+                          VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, 0);
   }
   commands.imageLayout(windowImage_, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, VK_IMAGE_LAYOUT_GENERAL);
 }
@@ -742,7 +777,14 @@ int Viewer::run() {
     applyScript(frame);
     if (!pendingLoad_.empty()) {
       std::string path = std::exchange(pendingLoad_, {});
-      loadScene(path);
+      try {
+        useScene(std::make_unique<scene::Scene>(scene::loadGltf(path, options_.load)), -1);
+        message_.clear();
+        std::printf("opened %s: %u triangles\n", path.c_str(), renderer_->sceneGpu().triangleCount);
+      } catch (const std::exception& e) {
+        message_ = e.what();  // the current scene stays
+        std::fprintf(stderr, "snell-view: %s\n", e.what());
+      }
     }
     auto now = Clock::now();
     frameSeconds = std::chrono::duration<double>(now - last).count();
@@ -768,8 +810,8 @@ int Viewer::run() {
         std::this_thread::sleep_for(std::chrono::milliseconds(16));  // minimised: nothing to draw to
         continue;
       }
-      VkExtent2D extent = swapchain_->extent();
-      if (!swapchain_->valid() || extent.width != uint32_t(w) || extent.height != uint32_t(h)) {
+      VkExtent2D asked = swapchain_->requested();
+      if (!swapchain_->valid() || asked.width != uint32_t(w) || asked.height != uint32_t(h)) {
         if (!swapchain_->recreate(uint32_t(w), uint32_t(h))) continue;
       }
       width = swapchain_->extent().width;
@@ -807,13 +849,21 @@ int Viewer::run() {
     record.cpuMs = 1000.0 * frameSeconds;
     for (const vk::PassTime& p : lastPasses_) record.gpuMs[p.name] += p.milliseconds;
     records_.push_back(record);
-    if (screenshot) writeScreenshot();
+    if (screenshot) {
+      writeScreenshot();
+      shotWritten_ = true;
+    }
   }
   double seconds = std::chrono::duration<double>(Clock::now() - start).count();
   std::printf("%zu frames in %.2f s on %s%s\n", records_.size(), seconds, context_->facts().name.c_str(),
               swapchain_ ? (", swapchain recreated " + std::to_string(swapchain_->recreations() - 1) + " time(s)").c_str()
                          : ", offscreen");
   writeJson(seconds);
+  if (!options_.screenshot.empty() && !shotWritten_) {
+    std::fprintf(stderr, "snell-view: error: the last frame was not drawn (window minimised or its swapchain out of "
+                         "date), so %s was not written\n", options_.screenshot.c_str());
+    return 1;
+  }
   if (context_->validationMessageCount() > 0) {
     std::fprintf(stderr, "snell-view: the validation layer reported %llu message(s)\n",
                  static_cast<unsigned long long>(context_->validationMessageCount()));

@@ -65,6 +65,11 @@ class Commands {
                VkAccessFlags dstAccess);
   /// Moves a whole colour image between layouts with a full memory barrier.
   void imageLayout(const Image& image, VkImageLayout from, VkImageLayout to);
+  /// Moves an image snell does not own (a swapchain's) between layouts, with
+  /// exactly the dependency given.
+  void imageBarrier(VkImage image, VkImageAspectFlags aspect, VkImageLayout from, VkImageLayout to,
+                    VkPipelineStageFlags srcStage, VkAccessFlags srcAccess, VkPipelineStageFlags dstStage,
+                    VkAccessFlags dstAccess);
 
   void copyBuffer(const Buffer& from, const Buffer& to, VkDeviceSize bytes, VkDeviceSize fromOffset = 0,
                   VkDeviceSize toOffset = 0);
