@@ -113,6 +113,9 @@ class Viewer {
   vk::Image windowImage_;
   vk::Buffer placeholderAov_, screenshotBuffer_;
   bool freshImages_ = true;
+  bool updated_ = false;  ///< the renderer holds an update of pose_ at updatedOrigin_
+  double updatedTime_ = 0.0;
+  glm::dvec3 updatedOrigin_{0.0};
   VkSemaphore imageReady_ = VK_NULL_HANDLE;
   std::vector<ScriptAction> script_;
   size_t nextAction_ = 0;
@@ -251,6 +254,7 @@ void Viewer::useScene(std::unique_ptr<scene::Scene> scene, int camera) {
   time_ = time;
   sceneName_ = scene_->source.empty() ? "scene" : scene_->source;
   viewports_ = std::move(viewports);  // sized on the next frame
+  updated_ = false;
   active_ = 0;
   freshImages_ = true;
 }
@@ -613,8 +617,16 @@ void Viewer::recordFrame(vk::Commands& commands, std::optional<uint32_t> swapIma
     commands.imageLayout(windowImage_, VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_GENERAL);
     freshImages_ = false;
   }
-  const Viewport& first = viewports_[0];
-  renderer_->update(commands, pose_, viewOf(first).eye);
+  // Deform, refit and the top level only when the pose or the frame's origin
+  // (the first viewport's eye) moved: a paused, still view traces the trees
+  // the last update left.
+  glm::dvec3 origin = viewOf(viewports_[0]).eye;
+  if (!updated_ || updatedTime_ != pose_.time || updatedOrigin_ != origin) {
+    renderer_->update(commands, pose_, origin);
+    updated_ = true;
+    updatedTime_ = pose_.time;
+    updatedOrigin_ = origin;
+  }
   bool trace = toggles_.refraction || toggles_.heatMap;
   render::RasterOptions rasterOptions;
   rasterOptions.refraction = toggles_.refraction;
@@ -818,7 +830,7 @@ int Viewer::run() {
       height = swapchain_->extent().height;
     }
     layoutViewports(width, height);
-    pose_ = scene::evaluate(*scene_, time_);
+    if (pose_.time != time_) pose_ = scene::evaluate(*scene_, time_);
 
     ui_->newFrame(width, height, frameSeconds);
     if (toggles_.ui) drawUi(frameSeconds);

@@ -25,7 +25,8 @@ int runBenchBvh(const Args& args);
 int runBenchFrame(const Args& args);
 int runBenchStress(const Args& args);
 
-/// A context on the device snell picks; SNELL_VALIDATION=1 turns on the validation layer.
+/// A context on the device snell picks; SNELL_VALIDATION=1 turns on the
+/// validation layer, synchronization checks included.
 vk::ContextDesc contextDescFromEnvironment();
 
 /// Parses WxH (each 1..65536) or throws UsageError naming the option.

@@ -10,6 +10,7 @@ vk::ContextDesc contextDescFromEnvironment() {
   vk::ContextDesc desc;
   const char* validation = std::getenv("SNELL_VALIDATION");
   desc.validation = validation && std::string(validation) == "1";
+  desc.synchronizationValidation = desc.validation;  // as the tests' own context has it
   return desc;
 }
 

@@ -4,6 +4,7 @@
 #include "shared/bvh.h"
 #include "shared/deform.h"
 #include "shared/prefix_sum.h"
+#include "shared/present.h"
 #include "shared/radix_sort.h"
 #include "shared/raster.h"
 #include "shared/trace.h"
@@ -43,6 +44,7 @@ static_assert(sizeof(GpuTexture) == 16 && offsetof(GpuTexture, flags) == 12);
 static_assert(sizeof(GpuLight) == 64 && offsetof(GpuLight, cone) == 48);
 static_assert(sizeof(TraceAov) == 32 && offsetof(TraceAov, nodeVisits) == 20);
 static_assert(sizeof(GpuRay) == 32 && offsetof(GpuRay, direction) == 16);
+static_assert(sizeof(PresentPush) == 48 && offsetof(PresentPush, gate) == 16 && offsetof(PresentPush, flags) == 32);
 static_assert(sizeof(RasterPush) == 96 && offsetof(RasterPush, flags) == 80 && offsetof(RasterPush, lightCount) == 84);
 static_assert(sizeof(TracePush) == 112 && offsetof(TracePush, eye) == 64 && offsetof(TracePush, width) == 80 &&
               offsetof(TracePush, tilesX) == 100);

@@ -102,29 +102,22 @@ void RasterPass::record(vk::Commands& commands, const Renderer& renderer, const 
       int material = shape >= 0 ? model.shapes[size_t(shape)].material : -1;
       return material >= 0 && model.materials[size_t(material)].refractive();
     };
+    // Vertex-stage bindings first (slots 0 to kRasterBindingIndices): the depth pre-pass binds only those.
+    constexpr size_t kVertexBindings = gpu::kRasterBindingIndices + 1;
+    static_assert(gpu::kRasterBindingInstances == 0 && gpu::kRasterBindingMaterials == kVertexBindings);
+    const vk::BufferBinding resources[] = {{gpu::kRasterBindingInstances, &renderer.instances()},
+                                           {gpu::kRasterBindingPositions, &scene.positions},
+                                           {gpu::kRasterBindingNormals, &scene.normals},
+                                           {gpu::kRasterBindingTexcoords, &scene.texcoords},
+                                           {gpu::kRasterBindingIndices, &scene.indices},
+                                           {gpu::kRasterBindingMaterials, &scene.materials},
+                                           {gpu::kRasterBindingTextures, &scene.textures},
+                                           {gpu::kRasterBindingTexels, &scene.texels},
+                                           {gpu::kRasterBindingLights, &renderer.lights()},
+                                           {gpu::kRasterBindingTraceImage, nullptr, &traceImage}};
     auto drawItems = [&](const vk::GraphicsProgram& program, const gpu::RasterPush& p) {
-      if (&program == depth_.get()) {  // vertices only
-        program.bind(commands,
-                     {{gpu::kRasterBindingInstances, &renderer.instances()},
-                      {gpu::kRasterBindingPositions, &scene.positions},
-                      {gpu::kRasterBindingNormals, &scene.normals},
-                      {gpu::kRasterBindingTexcoords, &scene.texcoords},
-                      {gpu::kRasterBindingIndices, &scene.indices}},
-                     area);
-      } else {
-        program.bind(commands,
-                     {{gpu::kRasterBindingInstances, &renderer.instances()},
-                      {gpu::kRasterBindingPositions, &scene.positions},
-                      {gpu::kRasterBindingNormals, &scene.normals},
-                      {gpu::kRasterBindingTexcoords, &scene.texcoords},
-                      {gpu::kRasterBindingIndices, &scene.indices},
-                      {gpu::kRasterBindingMaterials, &scene.materials},
-                      {gpu::kRasterBindingTextures, &scene.textures},
-                      {gpu::kRasterBindingTexels, &scene.texels},
-                      {gpu::kRasterBindingLights, &renderer.lights()},
-                      {gpu::kRasterBindingTraceImage, nullptr, &traceImage}},
-                     area);
-      }
+      bool depthOnly = &program == depth_.get();
+      program.bind(commands, std::span(resources).first(depthOnly ? kVertexBindings : std::size(resources)), area);
       for (size_t item = 0; item < scene.itemGeometry.size(); ++item) {
         const GeometryRange& g = scene.geometries[scene.itemGeometry[item]];
         // Without refraction glass is left out and seen straight through, as IOR 1 would show it.

@@ -158,7 +158,9 @@ void Renderer::trace(vk::Commands& commands, const FrameSettings& settings, cons
   if (target.width() != settings.width || target.height() != settings.height) {
     throw vk::VulkanError("renderer: the target image is not the frame's size");
   }
-  commands.computeToCompute();  // the top level, and an earlier view's trace of the same image
+  // After the top level; and between two views' traces, which both bind the
+  // placeholder in the AOV slot the shader declares writable.
+  commands.computeToCompute();
   commands.beginPass("trace");
   const scene::View& v = settings.view;
   double aspect = double(settings.width) / double(settings.height);

@@ -130,7 +130,8 @@ void ComputeProgram::record(Commands& commands, std::initializer_list<BufferBind
                       " bindings; the call gave " + std::to_string(buffers.size()));
   }
   if (groups == 0) return;
-  VkDescriptorSet set = writeSet(commands, setLayout_, reflection_.bindings, buffers, name_);
+  VkDescriptorSet set =
+      writeSet(commands, setLayout_, reflection_.bindings, std::span(buffers.begin(), buffers.size()), name_);
 
   VkCommandBuffer cmd = commands.handle();
   vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline_);

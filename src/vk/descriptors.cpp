@@ -28,7 +28,7 @@ VkDescriptorSetLayout createSetLayout(Context& context, std::span<const Reflecte
 }
 
 VkDescriptorSet writeSet(Commands& commands, VkDescriptorSetLayout layout, std::span<const ReflectedBinding> bindings,
-                         std::initializer_list<BufferBinding> resources, const std::string& program) {
+                         std::span<const BufferBinding> resources, const std::string& program) {
   if (resources.size() != bindings.size()) {
     throw VulkanError("program '" + program + "' has " + std::to_string(bindings.size()) + " bindings; the call gave " +
                       std::to_string(resources.size()));

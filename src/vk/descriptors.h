@@ -9,7 +9,6 @@
 
 #include <vulkan/vulkan.h>
 
-#include <initializer_list>
 #include <span>
 #include <string>
 
@@ -31,6 +30,6 @@ VkDescriptorSetLayout createSetLayout(Context& context, std::span<const Reflecte
 /// binding at its resource. Throws naming `program` when the resources given
 /// do not match the bindings one to one.
 VkDescriptorSet writeSet(Commands& commands, VkDescriptorSetLayout layout, std::span<const ReflectedBinding> bindings,
-                         std::initializer_list<BufferBinding> resources, const std::string& program);
+                         std::span<const BufferBinding> resources, const std::string& program);
 
 }  // namespace snell::vk

@@ -152,7 +152,7 @@ GraphicsProgram::~GraphicsProgram() {
   });
 }
 
-void GraphicsProgram::bind(Commands& commands, std::initializer_list<BufferBinding> resources, VkRect2D area) const {
+void GraphicsProgram::bind(Commands& commands, std::span<const BufferBinding> resources, VkRect2D area) const {
   VkDescriptorSet set = writeSet(commands, setLayout_, bindings_, resources, name_);
   VkCommandBuffer cmd = commands.handle();
   vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, pipeline_);

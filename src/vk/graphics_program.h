@@ -13,7 +13,6 @@
 #include <vulkan/vulkan.h>
 
 #include <cstdint>
-#include <initializer_list>
 #include <span>
 #include <string>
 
@@ -46,9 +45,9 @@ class GraphicsProgram {
 
   const std::string& name() const { return name_; }
 
-  /// Binds the pipeline and its resources inside a rendering scope, with the
-  /// viewport and scissor covering `area`.
-  void bind(Commands& commands, std::initializer_list<BufferBinding> resources, VkRect2D area) const;
+  /// Binds the pipeline and its resources (one per binding the shaders
+  /// declare) inside a rendering scope, with the viewport and scissor covering `area`.
+  void bind(Commands& commands, std::span<const BufferBinding> resources, VkRect2D area) const;
   /// Draws `vertexCount` vertices from `firstVertex` as one instance numbered
   /// `instance` (gl_InstanceIndex), after bind().
   template <typename Push>
