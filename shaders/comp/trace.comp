@@ -118,30 +118,34 @@ void pushChildren(BvhNode node, ShearedRay r, float tMax, inout uint sp) {
 }
 
 // One instance's tree, with the ray in its object space (t is shared: the
-// direction is not renormalised). Uses the stack above `base`.
+// direction is not renormalised). Uses the stack above `base`. References
+// outside the group's own nodes and triangles (only a corrupted tree has
+// them) are skipped, so a bad tree costs visits, never a wild read.
 void traverseBlas(uint instance, vec3 origin, vec3 dir, uint skipPrim, float tMin, uint base, inout Hit hit) {
   GpuInstance inst = instances[instance];
-  uint root = blasGroups[inst.geometry].root;
-  if (root == kBvhNone) return;
+  BvhGroup group = blasGroups[inst.geometry];
+  if (group.root == kBvhNone) return;
+  uint end = group.first + group.count;
   vec3 o = vec3(dot(inst.worldToObject[0], vec4(origin, 1.0)), dot(inst.worldToObject[1], vec4(origin, 1.0)),
                 dot(inst.worldToObject[2], vec4(origin, 1.0)));
   vec3 d = vec3(dot(inst.worldToObject[0].xyz, dir), dot(inst.worldToObject[1].xyz, dir),
                 dot(inst.worldToObject[2].xyz, dir));
   ShearedRay r = shearRay(o, d);
   uint sp = base;
-  stack[sp++] = root;
+  stack[sp++] = group.root;
   while (sp > base && budget > 0u) {
     --budget;
     uint ref = stack[--sp];
     ++visits;
     if ((ref & kBvhLeafBit) != 0u) {
       uint tri = ref & ~kBvhLeafBit;
-      if (tri == skipPrim) continue;  // the face this ray leaves
+      if (tri == skipPrim || tri < group.first || tri >= end) continue;  // skipPrim: the face this ray leaves
       vec3 bary;
       float t = intersectTriangle(r, tri, hit.t, bary);
       if (t < hit.t && t > tMin) hit = Hit(t, instance, tri, bary);
       continue;
     }
+    if (ref < group.first || ref + 1u >= end) continue;
     pushChildren(blasNodes[ref], r, hit.t, sp);
   }
 }
@@ -149,11 +153,12 @@ void traverseBlas(uint instance, vec3 origin, vec3 dir, uint skipPrim, float tMi
 // tMin: hits this close to the origin are the surface the ray leaves.
 Hit traceClosest(vec3 origin, vec3 dir, uint skipInstance, uint skipPrim, float tMin) {
   Hit hit = Hit(kInf, kNoHit, kNoHit, vec3(0.0));
-  uint root = tlasGroups[0].root;
-  if (root == kBvhNone) return hit;
+  BvhGroup top = tlasGroups[0];
+  if (top.root == kBvhNone) return hit;
+  uint nodeEnd = top.count - 1u;
   ShearedRay r = shearRay(origin, dir);
   uint sp = 0u;
-  stack[sp++] = root;
+  stack[sp++] = top.root;
   // One budget for the whole segment: a corrupted bottom level cannot spend
   // it again in every instance the top level leads to.
   budget = kTraceMaxVisits;
@@ -163,9 +168,11 @@ Hit traceClosest(vec3 origin, vec3 dir, uint skipInstance, uint skipPrim, float 
     ++visits;
     if ((ref & kBvhLeafBit) != 0u) {
       uint instance = ref & ~kBvhLeafBit;
+      if (instance >= top.count) continue;
       traverseBlas(instance, origin, dir, instance == skipInstance ? skipPrim : kNoHit, tMin, sp, hit);
       continue;
     }
+    if (ref >= nodeEnd) continue;
     pushChildren(tlasNodes[ref], r, hit.t, sp);
   }
   return hit;

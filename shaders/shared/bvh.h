@@ -1,75 +1,134 @@
-// Layout shared by the BVH shaders (shaders/comp/bvh_*.comp), the trace pass
-// and src/render/bvh.cpp. One build makes a forest: each group of primitives
-// (a shape's triangles, or all instances for the top level) gets its own
-// binary tree, one primitive per leaf, built LBVH-style (Karras 2012).
+// Layout shared by the BVH shaders (shaders/comp/bvh/*.comp), the trace pass
+// and src/render/bvh.cpp.
+//
+// A forest is one set of buffers holding many binary trees, one per group of
+// primitives: each shape's triangles in the bottom level, all instances in
+// the top level. A leaf holds one primitive.
+//
+// Builds run H-PLOC (Benthin et al. 2024): Apetrei's bottom-up LBVH over the
+// Morton-sorted primitives, with PLOC clustering inside each range once it
+// holds more than half a window of clusters. A merge of clusters A and B gets
+// the node slot max(first sorted position in A, first in B) - 1: every binary
+// tree over a group's n leaves numbers its n - 1 nodes this way without
+// collision, so slots are deterministic, whatever order the GPU runs the
+// merges in, and a group owns exactly [first, first + count - 1).
 #ifndef SNELL_BVH_H
 #define SNELL_BVH_H
 #include "shared_types.h"
 
 SNELL_GPU_BEGIN
 
-// A child reference with this bit set is a leaf; the rest is the primitive id
-// (a global triangle index, or an instance index in the top level).
+// Child references: a node slot, or kBvhLeafBit | the primitive (a global
+// triangle index in the bottom level, an instance in the top level).
 SNELL_CONST kBvhLeafBit = 0x80000000u;
-SNELL_CONST kBvhNone = 0xffffffffu;  // no parent (a group's root), or no root (an empty group)
-// Morton codes use 10 bits per axis; a primitive's group sits above them in
-// the 64-bit sort key, so one sort orders every group and the Karras
-// hierarchy separates groups before it splits any of them.
+SNELL_CONST kBvhNone = 0xffffffffu;  // no parent (a group's root), no root (an empty group), no cluster
+SNELL_CONST kBvhMaxPrimitives = 0x7fffffffu;
+// Morton codes use 10 bits per axis; the build entry of a primitive sits above
+// them in the sort key, so one sort orders every group of a build.
 SNELL_CONST kBvhMortonBits = 30;
-// Longest leaf-to-root walk a refit will take; a corrupted parent chain ends there.
+// Longest leaf-to-root walk a refit will take, and the most levels a build
+// climbs; a corrupted tree ends there instead of looping.
 SNELL_CONST kBvhMaxDepth = 256;
+// H-PLOC: clusters one workgroup merges at a time, half of them kept per range
+// (the paper's 32, and its search radius of 8).
+SNELL_CONST kBvhWindow = 32;
+SNELL_CONST kBvhSearchRadius = 8;
+// SAH statistics are fixed point: kBvhSahScale units per the root area of the
+// group's last build, so sums are exact and independent of atomic order.
+SNELL_CONST kBvhSahScale = 65536;
+SNELL_CONST kBvhSahTermCap = 1048576;  // one node counts at most 16 build roots
 
 // Binding slots of set 0 (each pass binds the ones it declares).
-SNELL_CONST kBvhBindingPrimBoxes = 0;   // float[6 * count]: lo xyz, hi xyz per primitive
-SNELL_CONST kBvhBindingPrimGroups = 1;  // uint[count]: the group of each primitive
-SNELL_CONST kBvhBindingGroups = 2;      // BvhGroup[groupCount]
-SNELL_CONST kBvhBindingKeys = 3;        // uvec2[count]: 64-bit sort keys (lo, hi)
-SNELL_CONST kBvhBindingLeafPrims = 4;   // uint[count]: primitive at each sorted leaf position
-SNELL_CONST kBvhBindingNodes = 5;       // BvhNode[count - 1]: internal nodes
-SNELL_CONST kBvhBindingLeafParents = 6; // uint[count]: parent node of each primitive's leaf
-SNELL_CONST kBvhBindingCounters = 7;    // uint[count - 1]: arrivals per node, zeroed before each fit
-// Primitive boxes from triangles (bvh_triangle_boxes.comp) or instances (bvh_instance_boxes.comp).
-SNELL_CONST kBvhBindingPositions = 8;   // float[3 * vertexCount]
-SNELL_CONST kBvhBindingIndices = 9;     // uint[3 * triangleCount], absolute vertex indices
-SNELL_CONST kBvhBindingInstances = 10;  // GpuInstance[instanceCount]
-SNELL_CONST kBvhBindingBlasGroups = 11; // BvhGroup[geometryCount] of the bottom level
-// Treelet restructuring (bvh_restructure.comp): uvec2[count - 1], each internal
-// node's subtree cost (float bits) and leaf count. The build binds the keys
-// buffer here: the keys are spent once the hierarchy exists.
-SNELL_CONST kBvhBindingNodeStats = 12;
-SNELL_CONST kBvhBindingDropped = 13;    // uint: triangles boxed empty because a vertex was not finite
+SNELL_CONST kBvhBindingPrimBoxes = 0;     // float[6 * count]: lo xyz, hi xyz per primitive of a build, packed
+SNELL_CONST kBvhBindingBuildEntries = 1;  // BvhBuildEntry[entryCount]
+SNELL_CONST kBvhBindingRefitEntries = 2;  // BvhRefitEntry[entryCount]
+SNELL_CONST kBvhBindingKeys = 3;          // uint[count] or uvec2[count]: sort keys (lo, hi)
+SNELL_CONST kBvhBindingValues = 4;        // uint[count]: primitive ids, sorted with the keys
+SNELL_CONST kBvhBindingParentIds = 5;     // uint[count]: H-PLOC's meeting points, kBvhNone before a build
+SNELL_CONST kBvhBindingClusters = 6;      // BvhCluster[count]: each clustered range's clusters, from its first position
+SNELL_CONST kBvhBindingNodes = 7;         // BvhNode[]
+SNELL_CONST kBvhBindingGroups = 10;       // BvhGroup[groupCount]
+SNELL_CONST kBvhBindingStats = 11;        // uvec2[groupCount]: fixed-point SAH sum of the last refit (lo, hi)
+SNELL_CONST kBvhBindingDropped = 12;      // uint: triangles boxed empty because a vertex was not finite
+SNELL_CONST kBvhBindingPositions = 13;    // float[3 * vertexCount]
+SNELL_CONST kBvhBindingIndices = 14;      // uint[3 * triangleCount], absolute vertex indices
+SNELL_CONST kBvhBindingInstances = 15;    // GpuInstance[instanceCount]
+SNELL_CONST kBvhBindingBlasGroups = 16;   // BvhGroup[] of the bottom level
+SNELL_CONST kBvhBindingCounters = 17;     // uint[nodes]: arrivals of the restructuring pass
+SNELL_CONST kBvhBindingNodeStats = 18;    // uvec2[nodes]: subtree cost and leaf count (restructuring)
 
 SNELL_CONST kBvhSpecWorkgroupSize = 0;
+SNELL_CONST kBvhSpecSlots = 1;  // H-PLOC: window slots per invocation, window / smallest subgroup
+SNELL_CONST kBvhSpecTeams = 2;  // H-PLOC: subgroups per workgroup at the smallest subgroup size
+
+SNELL_CONST kBvhFlagInstances = 1u;  // leaves are instances (top level), else triangles
+SNELL_CONST kBvhFlagKeys32 = 2u;     // sort keys are 32-bit
 
 // 64 bytes, total: 64 bytes
 struct BvhNode {
   float box[12];   // 48: child 0 lo xyz, hi xyz; child 1 lo xyz, hi xyz
-  uint child[2];   // 8: internal node index, or kBvhLeafBit | primitive
+  uint child[2];   // 8: node index, or a leaf reference
   uint parent;     // 4: kBvhNone at a group's root
-  uint pad0;       // 4
+  uint arrivals;   // 4: refit arrivals; even between refits (a build zeroes it)
 };
 
 // 64 bytes, total: 64 bytes
 struct BvhGroup {
-  uint centroidLo[3];  // 12: order-preserving float keys, atomicMin
-  uint centroidHi[3];  // 12: the same keys inverted, atomicMin (so both reset to ~0)
-  uint root;           // 4: internal node index, kBvhLeafBit | primitive, or kBvhNone
-  uint first;          // 4: first primitive (and first sorted leaf) of the group
-  float boxLo[3];      // 12: the root's box, written by every fit
-  float boxHi[3];      // 12
-  uint count;          // 4: primitives in the group
+  float boxLo[3];    // 12: the root's box, written by every build and refit
+  float boxHi[3];    // 12
+  uint root;         // 4: node slot, leaf reference, or kBvhNone
+  uint first;        // 4: first primitive, and first node slot
+  uint count;        // 4: primitives (count - 1 node slots)
+  float buildArea;   // 4: surface area of the root box at the group's last build
+  uint pad0;         // 4
+  uint pad1;         // 4
+  uint pad2;         // 4
+  uint pad3;         // 4
+  uint pad4;         // 4
+  uint pad5;         // 4
+};
+
+// One group of a build, its primitives packed after those of earlier entries.
+// 48 bytes, total: 48 bytes
+struct BvhBuildEntry {
+  uint group;          // 4
+  uint first;          // 4: the group's first primitive
+  uint count;          // 4
+  uint base;           // 4: its first primitive in the build's packed arrays
+  uint centroidLo[3];  // 12: order-preserving float keys, atomicMin (~0 before the build)
+  uint centroidHi[3];  // 12: the same keys inverted, atomicMin
   uint pad0;           // 4
+  uint pad1;           // 4
+};
+
+// One group of a refit: its node slots (or its one leaf) take threads [threadBase, + max(count - 1, 1)).
+// 16 bytes, total: 16 bytes
+struct BvhRefitEntry {
+  uint group;       // 4
+  uint first;       // 4
+  uint count;       // 4
+  uint threadBase;  // 4
+};
+
+// A cluster H-PLOC hands from one level to the next: a subtree and its box.
+// 32 bytes, total: 32 bytes
+struct BvhCluster {
+  uint ref;      // 4: node slot or leaf reference; kBvhNone ends a range's list
+  uint first;    // 4: its first sorted position (which names the slot of the node it merges into)
+  float lo[3];   // 12
+  float hi[3];   // 12
 };
 
 // 16 bytes, total: 16 bytes
 struct BvhPush {
-  uint count;       // 4: primitives (or leaves) this dispatch covers
-  uint first;       // 4: the first of them
-  uint groupCount;  // 4
-  uint total;       // 4: primitives in the whole forest
+  uint count;       // 4: threads of this dispatch
+  uint entryCount;  // 4
+  uint flags;       // 4: kBvhFlag*
+  uint total;       // 4: node slots of the forest (bounds checks)
 };
 
-// One placed shape: a bottom-level tree and its transform, camera-relative.
+// One placed shape: a bottom-level tree and its transform, relative to the
+// frame's origin.
 // 112 bytes, total: 112 bytes
 struct GpuInstance {
   vec4 objectToWorld[3];  // 48: rows of a 3x4 matrix

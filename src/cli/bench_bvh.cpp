@@ -1,5 +1,5 @@
-// `snell bench bvh`: how good the GPU's LBVH trees are, as SAH cost against a
-// CPU binned-SAH build of the very same triangles (src/ref), per mesh.
+// `snell bench bvh`: how good the GPU's trees are, as SAH cost against a CPU
+// binned-SAH build of the very same triangles (src/ref), per mesh.
 #include "cli/cli.h"
 
 #include "ref/sah_bvh.h"
@@ -23,64 +23,72 @@ constexpr const char* kHelp = R"(usage: snell bench bvh [SCENE.glb ...] [--json 
 
 Builds every bottom-level tree of each scene on the GPU (the procedural eye
 first, then the files given) and prices it with the surface area heuristic
-(Ct = 1 per internal node, Ci = 1 per triangle, one triangle per leaf), next to
-a CPU binned-SAH tree (32 bins) over the same triangles. ratio = GPU / CPU:
-1.0 is as good as binned SAH, higher is worse. "GPU SAH" is the tree the
-renderer uses (LBVH plus treelet restructuring); "LBVH" is the same build
-without restructuring.
+(Ct = 1 per internal node, Ci = 1 per triangle, one triangle per leaf), next
+to a CPU binned-SAH tree (32 bins) over the same triangles. ratio = GPU / CPU: 1.0 is as good
+as binned SAH, higher is worse. "GPU SAH" is the tree the renderer uses
+(H-PLOC); "+restructure" is the same build followed by three rounds of
+treelet restructuring.
 )";
 
 struct Row {
   std::string scene, mesh;
   uint32_t triangles = 0;
-  double gpuCost = 0, lbvhCost = 0, cpuCost = 0;
+  double gpuCost = 0, restructuredCost = 0, cpuCost = 0;
   double ratio() const { return cpuCost > 0 ? gpuCost / cpuCost : 1.0; }
-  double lbvhRatio() const { return cpuCost > 0 ? lbvhCost / cpuCost : 1.0; }
+  double restructuredRatio() const { return cpuCost > 0 ? restructuredCost / cpuCost : 1.0; }
 };
-
-// SAH cost of group g's tree, priced by the same formula as the CPU tree.
-double treeCost(const render::BvhSnapshot& snapshot, uint32_t g) {
-  render::BvhSnapshot::TreeBoxes tree = snapshot.treeBoxes(g);
-  return ref::sahCost(tree.internal, tree.leaves);
-}
 
 void measure(vk::Context& context, const scene::Scene& scene, const std::string& label, std::vector<Row>& rows) {
   scene::Pose pose = scene::evaluate(scene, 0.0);
   render::Renderer renderer(context, scene, pose);
-  // One small frame builds the trees from the deformed positions.
+  // One small frame deforms the shapes into the buffers the trees are built from.
   render::FrameSettings settings{8, 8, scene::resolveView(scene, pose, {}), {}, gpu::kDefaultMaxInterfaces};
   render::renderFrame(context, renderer, pose, settings);
-  render::BvhSnapshot snapshot = renderer.builder().download(renderer.blas());
-  // The same triangles again without restructuring: what the treelets bought.
-  vk::Commands commands(context, "lbvh only");
-  commands.begin();
-  renderer.builder().recordBuild(commands, renderer.blas(), 0);
-  commands.submitAndWait();
-  render::BvhSnapshot lbvh = renderer.builder().download(renderer.blas());
   const render::SceneGpu& gpuScene = renderer.sceneGpu();
+  std::vector<uint32_t> sizes;
+  for (const render::GeometryRange& g : gpuScene.geometries) sizes.push_back(g.triangleCount);
+  render::BvhBuilder builder(context);
+  vk::UploadArena arena(context, "bench bvh uploads");
+  auto buildWith = [&](uint32_t rounds) {
+    render::Bvh bvh = builder.makeBvh(sizes, render::BvhLeaves::Triangles, label);
+    vk::Commands commands(context, "bench bvh build");
+    commands.begin();
+    builder.recordBuild(commands, bvh, {&gpuScene.positions, &gpuScene.indices, nullptr, nullptr}, {}, arena, rounds);
+    commands.submitAndWait();
+    arena.reset();
+    return builder.download(bvh);
+  };
+  render::BvhSnapshot plain = buildWith(0), restructured = buildWith(3);
   std::vector<float> positions(size_t(gpuScene.vertexCount) * 3);
   std::vector<uint32_t> indices(size_t(gpuScene.triangleCount) * 3);
   vk::download(context, gpuScene.positions, positions.data(), positions.size() * 4);
   vk::download(context, gpuScene.indices, indices.data(), indices.size() * 4);
+  auto triangleBox = [&](uint32_t t) {
+    ref::Aabb b;
+    for (int k = 0; k < 3; ++k) {
+      const float* p = &positions[3 * size_t(indices[3 * size_t(t) + size_t(k)])];
+      b.extend(glm::dvec3(p[0], p[1], p[2]));
+    }
+    return b;
+  };
+  auto cost = [&](const render::BvhSnapshot& s, uint32_t g) {
+    render::BvhSnapshot::TreeBoxes tree = s.treeBoxes(g);
+    return ref::sahCost(tree.internal, tree.leaves);
+  };
 
   for (size_t g = 0; g < gpuScene.geometries.size(); ++g) {
     const render::GeometryRange& range = gpuScene.geometries[g];
     if (range.triangleCount < 2) continue;
     std::vector<ref::Aabb> triangles;
     for (uint32_t t = range.firstTriangle; t < range.firstTriangle + range.triangleCount; ++t) {
-      ref::Aabb b;
-      for (int k = 0; k < 3; ++k) {
-        const float* p = &positions[3 * size_t(indices[3 * size_t(t) + size_t(k)])];
-        b.extend(glm::dvec3(p[0], p[1], p[2]));
-      }
-      triangles.push_back(b);
+      triangles.push_back(triangleBox(t));
     }
     Row row;
     row.scene = label;
     row.mesh = scene.shapes[size_t(range.shape)].name;
     row.triangles = range.triangleCount;
-    row.gpuCost = treeCost(snapshot, static_cast<uint32_t>(g));
-    row.lbvhCost = treeCost(lbvh, static_cast<uint32_t>(g));
+    row.gpuCost = cost(plain, static_cast<uint32_t>(g));
+    row.restructuredCost = cost(restructured, static_cast<uint32_t>(g));
     row.cpuCost = ref::binnedSahCost(triangles);
     rows.push_back(row);
   }
@@ -120,12 +128,12 @@ int runBenchBvh(const Args& args) {
     measure(*context, scene::loadGltf(f, load), std::filesystem::path(f).stem().string(), rows);
   }
 
-  std::printf("%-28s %-28s %9s %10s %10s %10s %7s %10s\n", "scene", "mesh", "triangles", "LBVH", "GPU SAH",
-              "CPU SAH", "ratio", "LBVH ratio");
+  std::printf("%-28s %-28s %9s %10s %12s %10s %7s %12s\n", "scene", "mesh", "triangles", "GPU SAH", "+restructure",
+              "CPU SAH", "ratio", "restr. ratio");
   double worst = 0;
   for (const Row& r : rows) {
-    std::printf("%-28.28s %-28.28s %9u %10.2f %10.2f %10.2f %7.3f %10.3f\n", r.scene.c_str(), r.mesh.c_str(),
-                r.triangles, r.lbvhCost, r.gpuCost, r.cpuCost, r.ratio(), r.lbvhRatio());
+    std::printf("%-28.28s %-28.28s %9u %10.2f %12.2f %10.2f %7.3f %12.3f\n", r.scene.c_str(), r.mesh.c_str(),
+                r.triangles, r.gpuCost, r.restructuredCost, r.cpuCost, r.ratio(), r.restructuredRatio());
     worst = std::max(worst, r.ratio());
   }
   std::printf("worst ratio %.3f\n", worst);
@@ -135,8 +143,9 @@ int runBenchBvh(const Args& args) {
     for (size_t i = 0; i < rows.size(); ++i) {
       const Row& r = rows[i];
       out << "    {\"scene\": \"" << r.scene << "\", \"mesh\": \"" << r.mesh << "\", \"triangles\": " << r.triangles
-          << ", \"gpu_sah\": " << r.gpuCost << ", \"lbvh_sah\": " << r.lbvhCost << ", \"cpu_binned_sah\": " << r.cpuCost
-          << ", \"ratio\": " << r.ratio() << ", \"lbvh_ratio\": " << r.lbvhRatio()
+          << ", \"gpu_sah\": " << r.gpuCost << ", \"restructured_sah\": " << r.restructuredCost
+          << ", \"cpu_binned_sah\": " << r.cpuCost << ", \"ratio\": " << r.ratio()
+          << ", \"restructured_ratio\": " << r.restructuredRatio()
           << "}" << (i + 1 < rows.size() ? "," : "") << "\n";
     }
     out << "  ],\n  \"worst_ratio\": " << worst << "\n}\n";

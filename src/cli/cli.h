@@ -24,6 +24,7 @@ int runRender(const Args& args);
 int runBenchBvh(const Args& args);
 int runBenchFrame(const Args& args);
 int runBenchStress(const Args& args);
+int runBenchScale(const Args& args);
 
 /// A context on the device snell picks; SNELL_VALIDATION=1 turns on the
 /// validation layer, synchronization checks included.

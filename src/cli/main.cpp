@@ -24,6 +24,7 @@ commands:
   bench bvh [scenes]    GPU BVH quality (SAH cost) against a CPU binned-SAH build
   bench frame [options] per-pass GPU time of a frame of the eye
   bench stress          GPU against the CPU reference on the numerical stability grid
+  bench scale [options] BVH build and refit times from 1e4 to 1e7 triangles
   help                  show this text
 
 environment:
@@ -34,10 +35,11 @@ environment:
 
 int runBench(const Args& args) {
   if (args.empty() || args[0] == "--help" || args[0] == "-h") {
-    std::printf("usage: snell bench sort|bvh|frame|stress [options]\n\nbenchmarks:\n  sort   GPU radix sort, pairs per second\n"
+    std::printf("usage: snell bench sort|bvh|frame|stress|scale [options]\n\nbenchmarks:\n  sort   GPU radix sort, pairs per second\n"
                 "  bvh    SAH cost of the GPU trees against a CPU binned-SAH build\n"
                 "  frame  per-pass GPU time of the eye's frame\n"
-                "  stress GPU against the CPU reference on the numerical stability grid\n");
+                "  stress GPU against the CPU reference on the numerical stability grid\n"
+                "  scale  BVH build and refit times from 1e4 to 1e7 triangles\n");
     return args.empty() ? 2 : 0;
   }
   Args rest(args.begin() + 1, args.end());
@@ -45,7 +47,8 @@ int runBench(const Args& args) {
   if (args[0] == "bvh") return runBenchBvh(rest);
   if (args[0] == "frame") return runBenchFrame(rest);
   if (args[0] == "stress") return runBenchStress(rest);
-  throw UsageError{"unknown benchmark '" + args[0] + "' (try: sort, bvh, frame, stress)"};
+  if (args[0] == "scale") return runBenchScale(rest);
+  throw UsageError{"unknown benchmark '" + args[0] + "' (try: sort, bvh, frame, stress, scale)"};
 }
 
 }  // namespace

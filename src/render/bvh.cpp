@@ -3,13 +3,11 @@
 
 #include "vk/error.h"
 
-#include "bvh_centroid_bounds.spv.h"
-#include "bvh_fit.spv.h"
-#include "bvh_hierarchy.spv.h"
-#include "bvh_instance_boxes.spv.h"
+#include "bvh_build_boxes.spv.h"
+#include "bvh_hploc.spv.h"
 #include "bvh_morton.spv.h"
+#include "bvh_refit.spv.h"
 #include "bvh_restructure.spv.h"
-#include "bvh_triangle_boxes.spv.h"
 
 #include <algorithm>
 #include <bit>
@@ -21,218 +19,315 @@ namespace snell::render {
 
 namespace {
 
-constexpr uint32_t kWorkgroupSize = 64;
-
-std::unique_ptr<vk::ComputeProgram> program(vk::Context& context, const char* name, std::span<const uint32_t> spirv) {
-  return std::make_unique<vk::ComputeProgram>(
-      context, vk::ComputeProgramDesc{name, spirv, {{gpu::kBvhSpecWorkgroupSize, kWorkgroupSize}}, false});
-}
+constexpr VkBufferUsageFlags kStorage =
+    VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT;
 
 vk::Buffer deviceBuffer(vk::Context& context, VkDeviceSize bytes, const std::string& name) {
-  return vk::Buffer(context, {std::max<VkDeviceSize>(bytes, 16),
-                              VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT |
-                                  VK_BUFFER_USAGE_TRANSFER_DST_BIT,
-                              vk::MemoryDomain::Device, name});
+  return vk::Buffer(context, {std::max<VkDeviceSize>(bytes, 16), kStorage, vk::MemoryDomain::Device, name});
+}
+
+uint32_t flagsOf(const Bvh& bvh) { return bvh.leaves == BvhLeaves::Instances ? gpu::kBvhFlagInstances : 0u; }
+
+// One subgroup per workgroup for the passes that hand boxes from one
+// invocation to another through device atomics: lavapipe (Mesa 22.3) lost
+// boxes handed between subgroups of one workgroup that way, though the same
+// exchange between workgroups, or within a subgroup, held (tests/bvh_test.cpp).
+uint32_t handOffWorkgroup(const vk::Context& context) {
+  uint32_t subgroup = context.caps().maxSubgroupSize;
+  return context.facts().type == VK_PHYSICAL_DEVICE_TYPE_CPU ? subgroup : std::max(subgroup, 64u);
 }
 
 }  // namespace
 
-uint32_t Bvh::firstPrimitive(uint32_t group) const {
-  return std::accumulate(groupSizes.begin(), groupSizes.begin() + group, 0u);
+uint64_t Bvh::treeBytes() const {
+  uint64_t bytes = 0;
+  for (const vk::Buffer* b : {&nodes, &groups, &stats, &buildEntries, &refitEntries}) {
+    bytes += b->size();
+  }
+  return bytes;
 }
 
-BvhBuilder::BvhBuilder(vk::Context& context) : context_(context), sort_(context, KeyWidth::Bits64) {
-  triangleBoxes_ = program(context, "bvh triangle boxes", kSpvBvhTriangleBoxes);
-  instanceBoxes_ = program(context, "bvh instance boxes", kSpvBvhInstanceBoxes);
-  centroidBounds_ = program(context, "bvh centroid bounds", kSpvBvhCentroidBounds);
-  morton_ = program(context, "bvh morton", kSpvBvhMorton);
-  hierarchy_ = program(context, "bvh hierarchy", kSpvBvhHierarchy);
-  // One subgroup per workgroup: lavapipe (Mesa 22.3) dropped boxes handed
-  // between subgroups of one workgroup through the arrival counters, though
-  // the same exchange between workgroups, or within a subgroup, held.
-  fit_ = std::make_unique<vk::ComputeProgram>(
-      context, vk::ComputeProgramDesc{"bvh fit", kSpvBvhFit,
-                                      {{gpu::kBvhSpecWorkgroupSize, context.caps().maxSubgroupSize}}, false});
-  // The same walk as the fit, so the same workgroup shape.
-  restructure_ = std::make_unique<vk::ComputeProgram>(
-      context, vk::ComputeProgramDesc{"bvh restructure", kSpvBvhRestructure,
-                                      {{gpu::kBvhSpecWorkgroupSize, context.caps().maxSubgroupSize}}, false});
+struct BvhBuilder::Scratch {
+  uint64_t primitives = 0;
+  vk::Buffer primBoxes, keys, values, parentIds, clusters, counters, nodeStats;
+  RadixSort::Scratch sort32, sort64;
+};
+
+BvhBuilder::BvhBuilder(vk::Context& context)
+    : context_(context), sort32_(context, KeyWidth::Bits32), sort64_(context, KeyWidth::Bits64) {
+  auto program = [&](const char* name, std::span<const uint32_t> spirv, std::vector<vk::SpecConstant> spec) {
+    return std::make_unique<vk::ComputeProgram>(context, vk::ComputeProgramDesc{name, spirv, std::move(spec), false});
+  };
+  boxes_ = program("bvh build boxes", kSpvBvhBuildBoxes, {{gpu::kBvhSpecWorkgroupSize, 64}});
+  morton_ = program("bvh morton", kSpvBvhMorton, {{gpu::kBvhSpecWorkgroupSize, 64}});
+  // H-PLOC's teams are subgroups, each clustering one window; several per
+  // workgroup for occupancy, but one where lavapipe needs it (above).
+  const vk::DeviceCaps& caps = context.caps();
+  uint32_t hplocWidth = context.facts().type == VK_PHYSICAL_DEVICE_TYPE_CPU ? caps.maxSubgroupSize
+                                                                            : std::max(caps.maxSubgroupSize, 128u);
+  hploc_ = std::make_unique<vk::ComputeProgram>(
+      context, vk::ComputeProgramDesc{"bvh hploc",
+                                      kSpvBvhHploc,
+                                      {{gpu::kBvhSpecWorkgroupSize, hplocWidth},
+                                       {gpu::kBvhSpecSlots, (gpu::kBvhWindow + caps.minSubgroupSize - 1) / caps.minSubgroupSize},
+                                       {gpu::kBvhSpecTeams, hplocWidth / caps.minSubgroupSize}},
+                                      true});
+  refit_ = program("bvh refit", kSpvBvhRefit, {{gpu::kBvhSpecWorkgroupSize, handOffWorkgroup(context)}});
+  restructure_ = program("bvh restructure", kSpvBvhRestructure, {{gpu::kBvhSpecWorkgroupSize, handOffWorkgroup(context)}});
+  placeholder_ = deviceBuffer(context, 16, "bvh placeholder");
 }
 
 BvhBuilder::~BvhBuilder() = default;
 
-Bvh BvhBuilder::makeBvh(const std::vector<uint32_t>& groupSizes, const std::string& name) const {
+Bvh BvhBuilder::makeBvh(const std::vector<uint32_t>& groupSizes, BvhLeaves leaves, const std::string& name) const {
   Bvh bvh;
+  bvh.leaves = leaves;
+  bvh.name = name;
   bvh.groupSizes = groupSizes;
-  uint64_t total = std::accumulate(groupSizes.begin(), groupSizes.end(), uint64_t(0));
-  if (total >= gpu::kBvhLeafBit || total > sort_.maxCount()) {
-    throw vk::VulkanError(name + ": " + std::to_string(total) + " primitives are more than one BVH can hold on this device (" +
-                          std::to_string(std::min<uint64_t>(gpu::kBvhLeafBit - 1, sort_.maxCount())) + ")");
+  uint64_t primitives = 0;
+  for (uint32_t size : groupSizes) {
+    bvh.first.push_back(static_cast<uint32_t>(primitives));
+    primitives += size;
   }
-  bvh.primitiveCount = static_cast<uint32_t>(total);
-  uint64_t n = std::max<uint64_t>(total, 1);
-  bvh.primBoxes = deviceBuffer(context_, n * 24, name + " primitive boxes");
-  bvh.keys = deviceBuffer(context_, n * 8, name + " keys");
-  bvh.leafPrims = deviceBuffer(context_, n * 4, name + " leaf primitives");
-  bvh.leafParents = deviceBuffer(context_, n * 4, name + " leaf parents");
-  bvh.nodes = deviceBuffer(context_, n * sizeof(gpu::BvhNode), name + " nodes");
-  bvh.counters = deviceBuffer(context_, n * 4, name + " counters");
+  uint64_t limit = std::min<uint64_t>(gpu::kBvhMaxPrimitives - 1, sort64_.maxCount());
+  if (primitives > limit) {
+    throw vk::VulkanError(name + ": " + std::to_string(primitives) +
+                          " primitives are more than one BVH can hold on this device (" + std::to_string(limit) + ")");
+  }
+  bvh.primitiveCount = static_cast<uint32_t>(primitives);
+  size_t groupCount = std::max<size_t>(groupSizes.size(), 1);
+  bvh.nodes = deviceBuffer(context_, primitives * sizeof(gpu::BvhNode), name + " nodes");
+  bvh.groups = deviceBuffer(context_, groupCount * sizeof(gpu::BvhGroup), name + " groups");
+  bvh.stats = deviceBuffer(context_, groupCount * 8, name + " SAH statistics");
   bvh.dropped = deviceBuffer(context_, 4, name + " dropped triangles");
-  bvh.sortScratch = sort_.makeScratch(n);
+  bvh.buildEntries = deviceBuffer(context_, groupCount * sizeof(gpu::BvhBuildEntry), name + " build list");
+  bvh.refitEntries = deviceBuffer(context_, groupCount * sizeof(gpu::BvhRefitEntry), name + " refit list");
 
-  std::vector<uint32_t> primGroups;
-  std::vector<gpu::BvhGroup> groups(std::max<size_t>(groupSizes.size(), 1));
-  uint32_t first = 0;
+  std::vector<gpu::BvhGroup> groups(groupCount);
   for (size_t g = 0; g < groups.size(); ++g) {
     gpu::BvhGroup& group = groups[g];
-    std::fill(std::begin(group.centroidLo), std::end(group.centroidLo), 0xffffffffu);
-    std::fill(std::begin(group.centroidHi), std::end(group.centroidHi), 0xffffffffu);
-    group.root = gpu::kBvhNone;
-    group.first = first;
-    group.count = g < groupSizes.size() ? groupSizes[g] : 0;
     std::fill(std::begin(group.boxLo), std::end(group.boxLo), INFINITY);
     std::fill(std::begin(group.boxHi), std::end(group.boxHi), -INFINITY);
-    primGroups.insert(primGroups.end(), group.count, static_cast<uint32_t>(g));
-    first += group.count;
+    group.root = gpu::kBvhNone;
+    if (g < groupSizes.size()) {
+      group.first = bvh.first[g];
+      group.count = groupSizes[g];
+    }
   }
-  VkDeviceSize groupBytes = groups.size() * sizeof(gpu::BvhGroup);
-  bvh.groups = deviceBuffer(context_, groupBytes, name + " groups");
-  bvh.groupsInitial = vk::Buffer(context_, {groupBytes, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, vk::MemoryDomain::Upload,
-                                            name + " groups (initial)"});
-  std::memcpy(bvh.groupsInitial.mapped().data(), groups.data(), groupBytes);
-  bvh.primGroups = deviceBuffer(context_, primGroups.size() * 4, name + " primitive groups");
-  if (!primGroups.empty()) vk::upload(context_, bvh.primGroups, primGroups.data(), primGroups.size() * 4);
-
+  vk::upload(context_, bvh.groups, groups.data(), groups.size() * sizeof(gpu::BvhGroup));
   vk::Commands commands(context_, name + " setup");
   commands.begin();
-  // Nodes above the group roots are never fitted; zeroed, they read the same every time.
+  // Slots of unbuilt groups read the same every time; arrival counts start even.
   commands.fillBuffer(bvh.nodes, 0);
   commands.fillBuffer(bvh.dropped, 0);
-  commands.copyBuffer(bvh.groupsInitial, bvh.groups, groupBytes);
+  commands.fillBuffer(bvh.stats, 0);
   commands.transferToCompute();
   commands.submitAndWait();
   return bvh;
 }
 
-void BvhBuilder::recordTriangleBoxes(vk::Commands& commands, const Bvh& bvh, const vk::Buffer& positions,
-                                     const vk::Buffer& indices, uint32_t first, uint32_t count) const {
-  gpu::BvhPush push{count, first, bvh.groupCount(), bvh.primitiveCount};
-  triangleBoxes_->dispatchThreads(commands,
-                                  {{gpu::kBvhBindingPositions, &positions},
-                                   {gpu::kBvhBindingIndices, &indices},
-                                   {gpu::kBvhBindingPrimBoxes, &bvh.primBoxes},
-                                   {gpu::kBvhBindingDropped, &bvh.dropped}},
-                                  push, count);
+void BvhBuilder::ensureScratch(vk::Commands& commands, uint64_t primitives) {
+  if (scratch_ && scratch_->primitives >= primitives) return;
+  // An earlier build recorded into the same commands may still use the old scratch.
+  if (scratch_) commands.keepAlive(scratch_);
+  auto s = std::make_shared<Scratch>();
+  s->primitives = std::max<uint64_t>(primitives, scratch_ ? scratch_->primitives : 0);
+  s->primBoxes = deviceBuffer(context_, s->primitives * 24, "bvh build primitive boxes");
+  s->keys = deviceBuffer(context_, s->primitives * 8, "bvh build keys");
+  s->values = deviceBuffer(context_, s->primitives * 4, "bvh build values");
+  s->parentIds = deviceBuffer(context_, s->primitives * 4, "bvh build meeting points");
+  s->clusters = deviceBuffer(context_, s->primitives * sizeof(gpu::BvhCluster), "bvh build clusters");
+  scratch_ = std::move(s);
 }
 
-void BvhBuilder::recordInstanceBoxes(vk::Commands& commands, const Bvh& bvh, const vk::Buffer& instances,
-                                     const Bvh& blas) const {
-  gpu::BvhPush push{bvh.primitiveCount, 0, bvh.groupCount(), bvh.primitiveCount};
-  instanceBoxes_->dispatchThreads(commands,
-                                  {{gpu::kBvhBindingInstances, &instances},
-                                   {gpu::kBvhBindingBlasGroups, &blas.groups},
-                                   {gpu::kBvhBindingPrimBoxes, &bvh.primBoxes}},
-                                  push, bvh.primitiveCount);
+void BvhBuilder::releaseScratch() { scratch_.reset(); }
+
+uint64_t BvhBuilder::scratchBytes() const {
+  if (!scratch_) return 0;
+  uint64_t bytes = 0;
+  const Scratch& s = *scratch_;
+  for (const vk::Buffer* b : {&s.primBoxes, &s.keys, &s.values, &s.parentIds, &s.clusters, &s.counters, &s.nodeStats,
+                              &s.sort32.keys, &s.sort32.values, &s.sort32.histogram, &s.sort64.keys, &s.sort64.values,
+                              &s.sort64.histogram}) {
+    bytes += b->size();
+  }
+  return bytes;
 }
 
-void BvhBuilder::recordBuild(vk::Commands& commands, const Bvh& bvh, uint32_t restructureRounds) const {
-  uint32_t n = bvh.primitiveCount;
-  VkDeviceSize groupBytes = std::max<size_t>(bvh.groupSizes.size(), 1) * sizeof(gpu::BvhGroup);
-  commands.copyBuffer(bvh.groupsInitial, bvh.groups, groupBytes);
+void BvhBuilder::recordBuild(vk::Commands& commands, Bvh& bvh, const BvhInputs& inputs,
+                             std::span<const uint32_t> groups, vk::UploadArena& arena, uint32_t restructureRounds) {
+  std::vector<uint32_t> all;
+  if (groups.empty()) {
+    all.resize(bvh.groupCount());
+    std::iota(all.begin(), all.end(), 0u);
+    groups = all;
+  }
+  std::vector<gpu::BvhBuildEntry> entries;
+  uint64_t positions = 0;
+  for (uint32_t g : groups) {
+    uint32_t size = bvh.groupSizes.at(g);
+    if (size == 0) continue;
+    gpu::BvhBuildEntry e{};
+    e.group = g;
+    e.first = bvh.first[g];
+    e.count = size;
+    e.base = static_cast<uint32_t>(positions);
+    std::fill(std::begin(e.centroidLo), std::end(e.centroidLo), 0xffffffffu);
+    std::fill(std::begin(e.centroidHi), std::end(e.centroidHi), 0xffffffffu);
+    entries.push_back(e);
+    positions += size;
+  }
+  if (entries.empty()) return;
+  ensureScratch(commands, positions);
+  Scratch& s = *scratch_;
+  uint32_t entryBits = static_cast<uint32_t>(std::bit_width(entries.size() - 1));
+  uint32_t keyBits = gpu::kBvhMortonBits + entryBits;
+  bool keys32 = keyBits <= 32;
+  const RadixSort& sort = keys32 ? sort32_ : sort64_;
+  RadixSort::Scratch& sortScratch = keys32 ? s.sort32 : s.sort64;
+  if (sortScratch.capacity < positions) sortScratch = sort.makeScratch(s.primitives);
+
+  arena.copy(commands, entries, bvh.buildEntries);
+  commands.fillBuffer(s.parentIds, gpu::kBvhNone, 0, positions * 4);
   commands.transferToCompute();
-  if (n == 0) return;
-  gpu::BvhPush push{n, 0, bvh.groupCount(), n};
-  centroidBounds_->dispatchThreads(commands,
-                                   {{gpu::kBvhBindingPrimBoxes, &bvh.primBoxes},
-                                    {gpu::kBvhBindingPrimGroups, &bvh.primGroups},
-                                    {gpu::kBvhBindingGroups, &bvh.groups}},
-                                   push, n);
+  uint32_t flags = flagsOf(bvh) | (keys32 ? gpu::kBvhFlagKeys32 : 0u);
+  uint32_t entryCount = static_cast<uint32_t>(entries.size());
+  bool instances = bvh.leaves == BvhLeaves::Instances;
+  gpu::BvhPush push{static_cast<uint32_t>(positions), entryCount, flags, bvh.primitiveCount};
+  boxes_->dispatchThreads(commands,
+                          {{gpu::kBvhBindingBuildEntries, &bvh.buildEntries},
+                           {gpu::kBvhBindingPositions, instances ? &placeholder_ : inputs.positions},
+                           {gpu::kBvhBindingIndices, instances ? &placeholder_ : inputs.indices},
+                           {gpu::kBvhBindingInstances, instances ? inputs.instances : &placeholder_},
+                           {gpu::kBvhBindingBlasGroups, instances ? &inputs.blas->groups : &placeholder_},
+                           {gpu::kBvhBindingPrimBoxes, &s.primBoxes},
+                           {gpu::kBvhBindingDropped, &bvh.dropped}},
+                          push, positions);
   commands.computeToCompute();
   morton_->dispatchThreads(commands,
-                           {{gpu::kBvhBindingPrimBoxes, &bvh.primBoxes},
-                            {gpu::kBvhBindingPrimGroups, &bvh.primGroups},
-                            {gpu::kBvhBindingGroups, &bvh.groups},
-                            {gpu::kBvhBindingKeys, &bvh.keys},
-                            {gpu::kBvhBindingLeafPrims, &bvh.leafPrims}},
-                           push, n);
+                           {{gpu::kBvhBindingBuildEntries, &bvh.buildEntries},
+                            {gpu::kBvhBindingPrimBoxes, &s.primBoxes},
+                            {gpu::kBvhBindingKeys, &s.keys},
+                            {gpu::kBvhBindingValues, &s.values}},
+                           push, positions);
   commands.computeToCompute();
-  uint32_t groupBits = static_cast<uint32_t>(std::bit_width(std::max<uint32_t>(bvh.groupCount(), 1) - 1));
-  sort_.record(commands, bvh.keys, bvh.leafPrims, n, bvh.sortScratch, gpu::kBvhMortonBits + groupBits);
-  hierarchy_->dispatchThreads(commands,
-                              {{gpu::kBvhBindingKeys, &bvh.keys},
-                               {gpu::kBvhBindingLeafPrims, &bvh.leafPrims},
-                               {gpu::kBvhBindingNodes, &bvh.nodes},
-                               {gpu::kBvhBindingLeafParents, &bvh.leafParents},
-                               {gpu::kBvhBindingGroups, &bvh.groups}},
-                              push, std::max<uint32_t>(n - 1, 1));
+  sort.record(commands, s.keys, s.values, positions, sortScratch, keyBits);
+  hploc_->dispatchThreads(commands,
+                          {{gpu::kBvhBindingBuildEntries, &bvh.buildEntries},
+                           {gpu::kBvhBindingKeys, &s.keys},
+                           {gpu::kBvhBindingValues, &s.values},
+                           {gpu::kBvhBindingPrimBoxes, &s.primBoxes},
+                           {gpu::kBvhBindingParentIds, &s.parentIds},
+                           {gpu::kBvhBindingClusters, &s.clusters},
+                           {gpu::kBvhBindingNodes, &bvh.nodes},
+                           {gpu::kBvhBindingGroups, &bvh.groups}},
+                          push, positions);
   commands.computeToCompute();
-  recordFit(commands, bvh, 0, n);
-  for (uint32_t round = 0; round < restructureRounds && n > 2; ++round) recordRestructure(commands, bvh);
+  for (uint32_t round = 0; round < restructureRounds; ++round) {
+    recordRestructure(commands, bvh, entryCount, static_cast<uint32_t>(positions));
+  }
+  commands.computeToTransfer();
 }
 
-void BvhBuilder::recordRestructure(vk::Commands& commands, const Bvh& bvh) const {
-  uint32_t n = bvh.primitiveCount;
-  gpu::BvhPush push{n, 0, bvh.groupCount(), n};
-  commands.fillBuffer(bvh.counters, 0);
+void BvhBuilder::recordRestructure(vk::Commands& commands, Bvh& bvh, uint32_t entryCount, uint32_t primitives) {
+  Scratch& s = *scratch_;
+  if (s.counters.size() < uint64_t(bvh.primitiveCount) * 4) {
+    commands.keepAlive(std::make_shared<vk::Buffer>(std::move(s.counters)));  // an earlier round may use them
+    commands.keepAlive(std::make_shared<vk::Buffer>(std::move(s.nodeStats)));
+    s.counters = deviceBuffer(context_, uint64_t(bvh.primitiveCount) * 4, "bvh restructure arrivals");
+    s.nodeStats = deviceBuffer(context_, uint64_t(bvh.primitiveCount) * 8, "bvh restructure subtree costs");
+  }
+  gpu::BvhPush push{primitives, entryCount, flagsOf(bvh), bvh.primitiveCount};
+  commands.fillBuffer(s.counters, 0);
   commands.transferToCompute();
   restructure_->dispatchThreads(commands,
-                                {{gpu::kBvhBindingPrimBoxes, &bvh.primBoxes},
-                                 {gpu::kBvhBindingLeafPrims, &bvh.leafPrims},
-                                 {gpu::kBvhBindingLeafParents, &bvh.leafParents},
+                                {{gpu::kBvhBindingBuildEntries, &bvh.buildEntries},
                                  {gpu::kBvhBindingNodes, &bvh.nodes},
-                                 {gpu::kBvhBindingCounters, &bvh.counters},
-                                 {gpu::kBvhBindingNodeStats, &bvh.keys}},
-                                push, n);
+                                 {gpu::kBvhBindingCounters, &s.counters},
+                                 {gpu::kBvhBindingNodeStats, &s.nodeStats}},
+                                push, primitives);
   commands.computeToCompute();
   commands.computeToTransfer();
 }
 
-void BvhBuilder::recordRefit(vk::Commands& commands, const Bvh& bvh, uint32_t group) const {
-  recordFit(commands, bvh, bvh.firstPrimitive(group), bvh.groupSizes.at(group));
-}
-
-void BvhBuilder::recordFit(vk::Commands& commands, const Bvh& bvh, uint32_t first, uint32_t count) const {
-  if (count == 0) return;
-  gpu::BvhPush push{count, first, bvh.groupCount(), bvh.primitiveCount};
-  commands.fillBuffer(bvh.counters, 0);
+void BvhBuilder::recordRefit(vk::Commands& commands, Bvh& bvh, const BvhInputs& inputs,
+                             std::span<const uint32_t> groups, vk::UploadArena& arena) const {
+  std::vector<uint32_t> all;
+  if (groups.empty()) {
+    all.resize(bvh.groupCount());
+    std::iota(all.begin(), all.end(), 0u);
+    groups = all;
+  }
+  std::vector<gpu::BvhRefitEntry> entries;
+  uint64_t threads = 0;
+  for (uint32_t g : groups) {
+    uint32_t size = bvh.groupSizes.at(g);
+    if (size == 0) continue;
+    entries.push_back({g, bvh.first[g], size, static_cast<uint32_t>(threads)});
+    threads += std::max(size - 1, 1u);  // one per node slot, or the lone leaf
+  }
+  if (entries.empty()) return;
+  arena.copy(commands, entries, bvh.refitEntries);
+  commands.fillBuffer(bvh.stats, 0);
   commands.transferToCompute();
-  fit_->dispatchThreads(commands,
-                        {{gpu::kBvhBindingPrimBoxes, &bvh.primBoxes},
-                         {gpu::kBvhBindingPrimGroups, &bvh.primGroups},
-                         {gpu::kBvhBindingLeafPrims, &bvh.leafPrims},
-                         {gpu::kBvhBindingLeafParents, &bvh.leafParents},
-                         {gpu::kBvhBindingNodes, &bvh.nodes},
-                         {gpu::kBvhBindingCounters, &bvh.counters},
-                         {gpu::kBvhBindingGroups, &bvh.groups}},
-                        push, count);
+  bool instances = bvh.leaves == BvhLeaves::Instances;
+  gpu::BvhPush push{static_cast<uint32_t>(threads), static_cast<uint32_t>(entries.size()), flagsOf(bvh),
+                    bvh.primitiveCount};
+  refit_->dispatchThreads(commands,
+                          {{gpu::kBvhBindingRefitEntries, &bvh.refitEntries},
+                           {gpu::kBvhBindingPositions, instances ? &placeholder_ : inputs.positions},
+                           {gpu::kBvhBindingIndices, instances ? &placeholder_ : inputs.indices},
+                           {gpu::kBvhBindingInstances, instances ? inputs.instances : &placeholder_},
+                           {gpu::kBvhBindingBlasGroups, instances ? &inputs.blas->groups : &placeholder_},
+                           {gpu::kBvhBindingNodes, &bvh.nodes},
+                           {gpu::kBvhBindingGroups, &bvh.groups},
+                           {gpu::kBvhBindingStats, &bvh.stats},
+                           {gpu::kBvhBindingDropped, &bvh.dropped}},
+                          push, threads);
   commands.computeToCompute();
   commands.computeToTransfer();
 }
 
 BvhSnapshot BvhBuilder::download(const Bvh& bvh) const {
   BvhSnapshot s;
-  uint32_t n = bvh.primitiveCount;
-  s.nodes.resize(n > 1 ? n - 1 : 0);
+  s.nodes.resize(bvh.primitiveCount);
   s.groups.resize(std::max<size_t>(bvh.groupSizes.size(), 1));
-  s.leafPrims.resize(n);
-  s.leafParents.resize(n);
+  std::vector<glm::uvec2> stats(s.groups.size());
   vk::download(context_, bvh.nodes, s.nodes.data(), s.nodes.size() * sizeof(gpu::BvhNode));
   vk::download(context_, bvh.groups, s.groups.data(), s.groups.size() * sizeof(gpu::BvhGroup));
-  vk::download(context_, bvh.leafPrims, s.leafPrims.data(), n * 4);
-  vk::download(context_, bvh.leafParents, s.leafParents.data(), n * 4);
+  vk::download(context_, bvh.stats, stats.data(), stats.size() * 8);
+  for (const glm::uvec2& v : stats) s.sah.push_back(uint64_t(v.x) | (uint64_t(v.y) << 32));
   return s;
+}
+
+double BvhBuilder::sahCost(uint64_t fixedPointSum, const gpu::BvhGroup& group) {
+  double dx = double(group.boxHi[0]) - group.boxLo[0], dy = double(group.boxHi[1]) - group.boxLo[1],
+         dz = double(group.boxHi[2]) - group.boxLo[2];
+  dx = std::max(dx, 0.0);
+  dy = std::max(dy, 0.0);
+  dz = std::max(dz, 0.0);
+  double area = 2.0 * (dx * dy + dy * dz + dz * dx);
+  if (!(area > 0.0)) return 0.0;
+  return double(fixedPointSum) / gpu::kBvhSahScale * std::max<double>(group.buildArea, 1e-30) / area;
 }
 
 BvhSnapshot::TreeBoxes BvhSnapshot::treeBoxes(uint32_t group) const {
   const gpu::BvhGroup& g = groups.at(group);
   TreeBoxes boxes;
-  boxes.internal.push_back({g.boxLo[0], g.boxLo[1], g.boxLo[2], g.boxHi[0], g.boxHi[1], g.boxHi[2]});
-  std::vector<uint32_t> stack;
-  if (!(g.root & gpu::kBvhLeafBit) && g.root != gpu::kBvhNone) stack.push_back(g.root);
+  if (g.root == gpu::kBvhNone) return boxes;
+  BoxFloats root{g.boxLo[0], g.boxLo[1], g.boxLo[2], g.boxHi[0], g.boxHi[1], g.boxHi[2]};
+  boxes.internal.push_back(root);
+  if (g.root & gpu::kBvhLeafBit) {
+    boxes.leaves.push_back(root);
+    return boxes;
+  }
+  std::vector<uint32_t> stack{g.root};
   // Bounded by the node count, so a corrupted tree cannot loop forever.
   while (!stack.empty() && boxes.internal.size() <= nodes.size()) {
-    const gpu::BvhNode& node = nodes.at(stack.back());
+    uint32_t n = stack.back();
     stack.pop_back();
+    if (n >= nodes.size()) break;
+    const gpu::BvhNode& node = nodes[n];
     for (int c = 0; c < 2; ++c) {
       BoxFloats b;
       std::copy_n(&node.box[6 * c], 6, b.begin());

@@ -1,13 +1,17 @@
-// GPU bounding volume hierarchies, LBVH-style (Karras 2012), all in compute.
-// One Bvh is a forest: its primitives are split into contiguous groups and
-// each group gets its own binary tree, one primitive per leaf. The bottom
-// level is one forest whose groups are shapes (triangles in shape space); the
-// top level is a forest of one group whose primitives are instances.
+// GPU bounding volume hierarchies, all in compute, with a fixed number of
+// dispatches whatever the number of trees. One Bvh is a forest: its
+// primitives are split into contiguous groups and each group gets its own
+// binary tree, one primitive per leaf. The bottom level is one forest whose
+// groups are shapes (triangles in shape space); the top level is a forest of
+// one group whose leaves are instances.
 //
-// build: per-primitive boxes -> centroid bounds -> Morton keys -> radix sort ->
-// hierarchy -> boxes bottom-up. refit: per-primitive boxes -> boxes bottom-up,
-// for the groups whose positions changed. Both are deterministic: the sort is
-// stable and every box is a min/max, whatever order the GPU runs them in.
+// build (any subset of groups): primitive boxes and centroid bounds ->
+// Morton keys -> radix sort -> H-PLOC (shaders/comp/bvh/bvh_hploc.comp), and
+// optionally rounds of treelet restructuring. refit (any subset): one
+// dispatch from the leaves up, which also prices each tree by the surface
+// area heuristic, so a caller can rebuild trees that deformation has spoiled.
+// Both are deterministic: the same input gives the same nodes in the same
+// slots, bit for bit, whatever order the GPU runs them in (shared/bvh.h).
 #pragma once
 
 #include "render/radix_sort.h"
@@ -16,30 +20,44 @@
 #include "vk/commands.h"
 #include "vk/compute_program.h"
 #include "vk/context.h"
+#include "vk/upload_arena.h"
 
 #include <array>
 #include <cstdint>
 #include <memory>
+#include <span>
+#include <string>
 #include <vector>
 
 namespace snell::render {
 
-/// The buffers of one forest. Primitive boxes are written by the caller's
-/// box pass (BvhBuilder::recordTriangleBoxes / recordInstanceBoxes).
+enum class BvhLeaves {
+  Triangles,  ///< bottom level
+  Instances,  ///< top level
+};
+
+/// One forest's trees, which live as long as it does. Group g owns
+/// primitives [first[g], + groupSizes[g]) and node slots [first[g], + groupSizes[g] - 1).
 struct Bvh {
+  BvhLeaves leaves = BvhLeaves::Triangles;
+  std::string name;
+  std::vector<uint32_t> groupSizes, first;
   uint32_t primitiveCount = 0;
-  std::vector<uint32_t> groupSizes;
-  vk::Buffer primBoxes, primGroups, groups, groupsInitial, keys, leafPrims, nodes, leafParents, counters;
+  vk::Buffer nodes;    ///< gpu::BvhNode per primitive (one slot per group unused)
+  vk::Buffer groups;   ///< gpu::BvhGroup per group
+  vk::Buffer stats;    ///< uvec2 per group: fixed-point SAH of its last refit
   vk::Buffer dropped;  ///< uint: non-finite triangles the box passes met since the caller last zeroed it
-  RadixSort::Scratch sortScratch;
+  vk::Buffer buildEntries, refitEntries;  ///< this forest's lists, copied in per build or refit
+
   uint32_t groupCount() const { return static_cast<uint32_t>(groupSizes.size()); }
-  uint32_t firstPrimitive(uint32_t group) const;
+  /// Memory the trees keep between frames: nodes, groups, statistics, lists.
+  uint64_t treeBytes() const;
 };
 
 /// A box as six floats: lo xyz, hi xyz.
 using BoxFloats = std::array<float, 6>;
 
-/// A tree brought back to the host, for tests and the quality benchmark.
+/// A forest brought back to the host, for tests and the quality benchmark.
 struct BvhSnapshot {
   /// Group g's boxes: the root's first, then every internal node's, and every
   /// leaf's, as the parents' child slots hold them (what the SAH prices).
@@ -50,15 +68,21 @@ struct BvhSnapshot {
 
   std::vector<gpu::BvhNode> nodes;
   std::vector<gpu::BvhGroup> groups;
-  std::vector<uint32_t> leafPrims;
-  std::vector<uint32_t> leafParents;  // by primitive
+  std::vector<uint64_t> sah;  ///< per group: fixed-point SAH sum of the last refit
 };
 
-/// Rounds of treelet restructuring after the LBVH (bvh_restructure.comp):
-/// each round costs one bottom-up pass. Three, as in the paper; on lavapipe,
-/// treelets of 7 took TransmissionRoughnessTest's SAH ratio from 1.69 (LBVH)
-/// to 1.21 in two rounds and 1.16 in three.
-inline constexpr uint32_t kDefaultRestructureRounds = 3;
+/// What the leaves are boxed from: triangles (positions, indices), or instances
+/// of a bottom level (gpu::GpuInstance[] and that forest).
+struct BvhInputs {
+  const vk::Buffer* positions = nullptr;
+  const vk::Buffer* indices = nullptr;
+  const vk::Buffer* instances = nullptr;
+  const Bvh* blas = nullptr;
+};
+
+/// Rounds of treelet restructuring after H-PLOC (bvh_restructure.comp): each
+/// round costs one bottom-up pass. Off by default: see bench/results for when it pays.
+inline constexpr uint32_t kDefaultRestructureRounds = 0;
 
 class BvhBuilder {
  public:
@@ -66,31 +90,39 @@ class BvhBuilder {
   ~BvhBuilder();
 
   /// Allocates a forest whose group g holds primitives [sum of earlier sizes, + groupSizes[g]).
-  Bvh makeBvh(const std::vector<uint32_t>& groupSizes, const std::string& name) const;
+  Bvh makeBvh(const std::vector<uint32_t>& groupSizes, BvhLeaves leaves, const std::string& name) const;
 
-  /// Boxes of triangles [first, first + count) of the forest (absolute indices into `positions`).
-  void recordTriangleBoxes(vk::Commands& commands, const Bvh& bvh, const vk::Buffer& positions,
-                           const vk::Buffer& indices, uint32_t first, uint32_t count) const;
-  /// World boxes of `bvh`'s primitives as instances (gpu::GpuInstance) of `blas`'s groups.
-  void recordInstanceBoxes(vk::Commands& commands, const Bvh& bvh, const vk::Buffer& instances,
-                           const Bvh& blas) const;
-  /// Builds every group's tree from the primitive boxes (made visible to compute before):
-  /// the LBVH, then `restructureRounds` rounds of treelet restructuring.
-  void recordBuild(vk::Commands& commands, const Bvh& bvh,
-                   uint32_t restructureRounds = kDefaultRestructureRounds) const;
-  /// Recomputes the boxes of group `group`'s tree; topology is kept.
-  void recordRefit(vk::Commands& commands, const Bvh& bvh, uint32_t group) const;
+  /// Records a build of the listed groups (every group when `groups` is
+  /// empty; empty groups are skipped). The inputs must be visible to compute;
+  /// the trees are visible to compute and transfer after.
+  void recordBuild(vk::Commands& commands, Bvh& bvh, const BvhInputs& inputs, std::span<const uint32_t> groups,
+                   vk::UploadArena& arena, uint32_t restructureRounds = kDefaultRestructureRounds);
+  /// Records a refit of the listed groups (every group when empty): new boxes,
+  /// the same topology, and each tree's SAH in Bvh::stats.
+  void recordRefit(vk::Commands& commands, Bvh& bvh, const BvhInputs& inputs, std::span<const uint32_t> groups,
+                   vk::UploadArena& arena) const;
 
   /// Reads a forest back (waits for the GPU).
   BvhSnapshot download(const Bvh& bvh) const;
 
+  /// Frees the build scratch (sort buffers, primitive boxes): builds allocate it again.
+  void releaseScratch();
+  uint64_t scratchBytes() const;
+
+  /// The normalised SAH cost (a multiple of the root's area) of the
+  /// fixed-point sum a refit wrote for `group`, whose root box it reads.
+  static double sahCost(uint64_t fixedPointSum, const gpu::BvhGroup& group);
+
  private:
-  void recordFit(vk::Commands& commands, const Bvh& bvh, uint32_t first, uint32_t count) const;
-  void recordRestructure(vk::Commands& commands, const Bvh& bvh) const;
+  struct Scratch;
+  void ensureScratch(vk::Commands& commands, uint64_t primitives);
+  void recordRestructure(vk::Commands& commands, Bvh& bvh, uint32_t entryCount, uint32_t primitives);
 
   vk::Context& context_;
-  RadixSort sort_;
-  std::unique_ptr<vk::ComputeProgram> triangleBoxes_, instanceBoxes_, centroidBounds_, morton_, hierarchy_, fit_, restructure_;
+  RadixSort sort32_, sort64_;
+  std::shared_ptr<Scratch> scratch_;
+  vk::Buffer placeholder_;
+  std::unique_ptr<vk::ComputeProgram> boxes_, morton_, hploc_, refit_, restructure_;
 };
 
 }  // namespace snell::render

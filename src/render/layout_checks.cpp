@@ -32,9 +32,14 @@ static_assert(offsetof(DeformPush, jointCount) == 8);
 static_assert(sizeof(glm::uvec4) == 16 && sizeof(glm::vec4) == 16 && sizeof(glm::mat4) == 64);
 static_assert(offsetof(DeformPush, outputFirst) == 12);
 
-static_assert(sizeof(BvhNode) == 64 && offsetof(BvhNode, child) == 48 && offsetof(BvhNode, parent) == 56);
-static_assert(sizeof(BvhGroup) == 64 && offsetof(BvhGroup, root) == 24 && offsetof(BvhGroup, first) == 28);
-static_assert(offsetof(BvhGroup, boxLo) == 32 && offsetof(BvhGroup, boxHi) == 44 && offsetof(BvhGroup, count) == 56);
+static_assert(sizeof(BvhNode) == 64 && offsetof(BvhNode, child) == 48 && offsetof(BvhNode, parent) == 56 &&
+              offsetof(BvhNode, arrivals) == 60);
+static_assert(sizeof(BvhGroup) == 64 && offsetof(BvhGroup, boxHi) == 12 && offsetof(BvhGroup, root) == 24 &&
+              offsetof(BvhGroup, first) == 28 && offsetof(BvhGroup, count) == 32 && offsetof(BvhGroup, buildArea) == 36);
+static_assert(sizeof(BvhBuildEntry) == 48 && offsetof(BvhBuildEntry, base) == 12 &&
+              offsetof(BvhBuildEntry, centroidLo) == 16 && offsetof(BvhBuildEntry, centroidHi) == 28);
+static_assert(sizeof(BvhCluster) == 32 && offsetof(BvhCluster, lo) == 8 && offsetof(BvhCluster, hi) == 20);
+static_assert(sizeof(BvhRefitEntry) == 16 && offsetof(BvhRefitEntry, threadBase) == 12);
 static_assert(sizeof(BvhPush) == 16 && offsetof(BvhPush, total) == 12);
 static_assert(sizeof(GpuInstance) == 112 && offsetof(GpuInstance, worldToObject) == 48 &&
               offsetof(GpuInstance, geometry) == 96 && offsetof(GpuInstance, material) == 100);

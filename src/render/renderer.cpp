@@ -27,7 +27,11 @@ void rows(const glm::dmat4& m, glm::vec4 out[3]) {
 }  // namespace
 
 Renderer::Renderer(vk::Context& context, const scene::Scene& scene, const scene::Pose& layout)
-    : context_(context), sceneModel_(scene), scene_(uploadScene(context, scene, layout)), builder_(context) {
+    : context_(context),
+      sceneModel_(scene),
+      scene_(uploadScene(context, scene, layout)),
+      builder_(context),
+      arena_(context, "frame uploads") {
   deform_ = std::make_unique<DeformPass>(context, scene, layout, [&](int item) {
     for (const GeometryRange& g : scene_.geometries) {
       if (g.item == item) return DeformSlot{&scene_.positions, &scene_.normals, g.firstVertex};
@@ -35,8 +39,8 @@ Renderer::Renderer(vk::Context& context, const scene::Scene& scene, const scene:
     throw std::logic_error("deforming item without a geometry");
   });
   std::string name = scene.source.empty() ? std::string("scene") : scene.source;
-  blas_ = builder_.makeBvh(triangleCounts(scene_), name + " bottom level");
-  tlas_ = builder_.makeBvh({static_cast<uint32_t>(layout.items.size())}, name + " top level");
+  blas_ = builder_.makeBvh(triangleCounts(scene_), BvhLeaves::Triangles, name + " bottom level");
+  tlas_ = builder_.makeBvh({static_cast<uint32_t>(layout.items.size())}, BvhLeaves::Instances, name + " top level");
   instances_ = vk::Buffer(context, {std::max<size_t>(layout.items.size(), 1) * sizeof(gpu::GpuInstance),
                                     VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, vk::MemoryDomain::Upload, name + " instances"});
   size_t lightNodes = 0;
@@ -52,15 +56,8 @@ Renderer::Renderer(vk::Context& context, const scene::Scene& scene, const scene:
 Renderer::~Renderer() = default;
 
 uint64_t Renderer::memoryBytes() const {
-  uint64_t bytes = scene_.bytes + instances_.size() + lights_.size();
-  for (const Bvh* b : {&blas_, &tlas_}) {
-    for (const vk::Buffer* buf : {&b->primBoxes, &b->primGroups, &b->groups, &b->keys, &b->leafPrims, &b->nodes,
-                                  &b->leafParents, &b->counters, &b->sortScratch.keys, &b->sortScratch.values,
-                                  &b->sortScratch.histogram}) {
-      bytes += buf->size();
-    }
-  }
-  return bytes;
+  return scene_.bytes + instances_.size() + lights_.size() + blas_.treeBytes() + tlas_.treeBytes() +
+         builder_.scratchBytes();
 }
 
 void Renderer::record(vk::Commands& commands, const scene::Pose& pose, const FrameSettings& settings,
@@ -112,6 +109,7 @@ void Renderer::update(vk::Commands& commands, const scene::Pose& pose, const glm
   }
   lightCount_ = lightCount;
 
+  arena_.reset();
   // Counts the triangles this frame's box pass finds non-finite (RenderedFrame::droppedTriangles).
   commands.fillBuffer(blas_.dropped, 0);
   commands.transferToCompute();
@@ -120,34 +118,26 @@ void Renderer::update(vk::Commands& commands, const scene::Pose& pose, const glm
   deform_->record(commands, pose, eye);
   commands.endPass();
 
+  BvhInputs triangles{&scene_.positions, &scene_.indices, nullptr, nullptr};
   if (!blasBuilt_) {
     commands.beginPass("blas build");
-    builder_.recordTriangleBoxes(commands, blas_, scene_.positions, scene_.indices, 0, scene_.triangleCount);
-    commands.computeToCompute();
-    builder_.recordBuild(commands, blas_);
+    builder_.recordBuild(commands, blas_, triangles, {}, arena_);
     commands.endPass();
     blasBuilt_ = true;
   } else {
-    commands.beginPass("blas refit");
-    bool any = false;
+    std::vector<uint32_t> deforming;
     for (size_t g = 0; g < scene_.geometries.size(); ++g) {
-      const GeometryRange& range = scene_.geometries[g];
-      if (range.item < 0 || range.triangleCount == 0) continue;
-      builder_.recordTriangleBoxes(commands, blas_, scene_.positions, scene_.indices, range.firstTriangle,
-                                   range.triangleCount);
-      any = true;
+      if (scene_.geometries[g].item >= 0) deforming.push_back(static_cast<uint32_t>(g));
     }
-    if (any) commands.computeToCompute();
-    for (size_t g = 0; g < scene_.geometries.size(); ++g) {
-      if (scene_.geometries[g].item >= 0) builder_.recordRefit(commands, blas_, static_cast<uint32_t>(g));
+    if (!deforming.empty()) {
+      commands.beginPass("blas refit");
+      builder_.recordRefit(commands, blas_, triangles, deforming, arena_);
+      commands.endPass();
     }
-    commands.endPass();
   }
 
   commands.beginPass("tlas");
-  builder_.recordInstanceBoxes(commands, tlas_, instances_, blas_);
-  commands.computeToCompute();
-  builder_.recordBuild(commands, tlas_, 0);  // a handful of instances, rebuilt every frame: LBVH only
+  builder_.recordBuild(commands, tlas_, {nullptr, nullptr, &instances_, &blas_}, {}, arena_);
   commands.endPass();
   updated_ = true;
 }

@@ -14,6 +14,7 @@
 #include "vk/commands.h"
 #include "vk/compute_program.h"
 #include "vk/context.h"
+#include "vk/upload_arena.h"
 
 #include <glm/glm.hpp>
 
@@ -70,7 +71,7 @@ class Renderer {
   const glm::dvec3& origin() const { return origin_; }
   const Bvh& blas() const { return blas_; }
   const Bvh& tlas() const { return tlas_; }
-  const BvhBuilder& builder() const { return builder_; }
+  BvhBuilder& builder() { return builder_; }
   /// GPU memory of geometry, BVHs and per-frame buffers (not the output image).
   uint64_t memoryBytes() const;
 
@@ -86,6 +87,7 @@ class Renderer {
   glm::dvec3 origin_{0.0};
   uint32_t lightCount_ = 0;
   vk::Buffer instances_, lights_, placeholder_;
+  vk::UploadArena arena_;
   std::unique_ptr<vk::ComputeProgram> trace_;
 };
 

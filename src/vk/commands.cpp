@@ -61,6 +61,7 @@ void Commands::begin() {
   if (serial_) wait();
   if (recording_) throw VulkanError("Commands '" + name_ + "': begin() while already recording");
   VkDevice device = context_->device();
+  keptAlive_.clear();
   VK_CHECK(vkResetCommandPool(device, pool_, 0));
   for (VkDescriptorPool p : descriptorPools_) VK_CHECK(vkResetDescriptorPool(device, p, 0));
   currentPool_ = 0;
@@ -190,6 +191,15 @@ void Commands::copyBuffer(const Buffer& from, const Buffer& to, VkDeviceSize byt
 void Commands::fillBuffer(const Buffer& buffer, uint32_t word) {
   if (buffer.size() == 0) return;
   vkCmdFillBuffer(buffer_, buffer.handle(), 0, buffer.size() & ~VkDeviceSize(3), word);
+}
+
+void Commands::fillBuffer(const Buffer& buffer, uint32_t word, VkDeviceSize offset, VkDeviceSize bytes) {
+  if (bytes == 0) return;
+  if (offset % 4 || bytes % 4 || offset + bytes > buffer.size()) {
+    throw VulkanError("fill of " + std::to_string(bytes) + " bytes at " + std::to_string(offset) + " of '" +
+                      buffer.name() + "' is misaligned or runs past its end");
+  }
+  vkCmdFillBuffer(buffer_, buffer.handle(), offset, bytes, word);
 }
 
 void Commands::beginPass(const std::string& name) {

@@ -8,6 +8,7 @@
 #include <vulkan/vulkan.h>
 
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -74,6 +75,8 @@ class Commands {
   void copyBuffer(const Buffer& from, const Buffer& to, VkDeviceSize bytes, VkDeviceSize fromOffset = 0,
                   VkDeviceSize toOffset = 0);
   void fillBuffer(const Buffer& buffer, uint32_t word);
+  /// Fills `bytes` (a multiple of 4) from `offset` with `word`.
+  void fillBuffer(const Buffer& buffer, uint32_t word, VkDeviceSize offset, VkDeviceSize bytes);
 
   /// Starts timing a pass once every earlier command has finished; passes do
   /// not nest; at most 128 per submission. No-op where the queue has no timestamps.
@@ -84,6 +87,9 @@ class Commands {
 
   /// A descriptor set that lives until this object is next begun.
   VkDescriptorSet allocateSet(VkDescriptorSetLayout layout);
+  /// Keeps `object` alive until this object is next begun: for resources a
+  /// recorded command uses whose owner lets go of them before the submit.
+  void keepAlive(std::shared_ptr<void> object) { keptAlive_.push_back(std::move(object)); }
 
  private:
   void readTimestamps();
@@ -103,6 +109,7 @@ class Commands {
   std::vector<std::string> passNames_;
   bool passOpen_ = false;
   std::vector<PassTime> times_;
+  std::vector<std::shared_ptr<void>> keptAlive_;
 };
 
 /// Copies bytes into a buffer: directly when it is mapped, else through a staging

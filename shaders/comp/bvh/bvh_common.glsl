@@ -1,5 +1,6 @@
-// Helpers every BVH pass shares: boxes as six floats, and float keys whose
-// unsigned order is the float order (so atomicMin can reduce floats).
+// Helpers every BVH pass shares: boxes as six floats, surface areas, float
+// keys whose unsigned order is the float order (so atomicMin can reduce
+// floats), and the mapping from a thread to the build or refit entry it serves.
 #include "../../shared/bvh.h"
 
 layout(local_size_x_id = kBvhSpecWorkgroupSize) in;
@@ -29,4 +30,14 @@ bool finite3(vec3 v) {
 void emptyBox(out vec3 lo, out vec3 hi) {
   lo = vec3(kInf);
   hi = vec3(-kInf);
+}
+
+float boxArea(vec3 lo, vec3 hi) {
+  vec3 d = max(hi - lo, vec3(0.0));
+  return 2.0 * (d.x * d.y + d.y * d.z + d.z * d.x);
+}
+
+// A fixed-point SAH term (kBvhSahScale units of the build's root area).
+uint sahTerm(float area, float unitScale) {
+  return uint(min(area * unitScale + 0.5, float(kBvhSahTermCap)));
 }

@@ -1,15 +1,14 @@
-// Build step 2: a 64-bit sort key per primitive, its group above a 30-bit
-// Morton code of its centroid within the group's centroid bounds. Primitives
-// with empty boxes sort last in their group.
+// Build step 2: a sort key per primitive, its build entry above a 30-bit
+// Morton code of its centroid within the entry's centroid bounds, and the
+// primitive as the value. Primitives with empty boxes sort last in their group.
 #version 460
 #extension GL_GOOGLE_include_directive : require
 #include "bvh_common.glsl"
 
+layout(std430, binding = kBvhBindingBuildEntries) readonly buffer Entries { BvhBuildEntry entries[]; };
 layout(std430, binding = kBvhBindingPrimBoxes) readonly buffer PrimBoxes { float primBoxes[]; };
-layout(std430, binding = kBvhBindingPrimGroups) readonly buffer PrimGroups { uint primGroups[]; };
-layout(std430, binding = kBvhBindingGroups) readonly buffer Groups { BvhGroup groups[]; };
-layout(std430, binding = kBvhBindingKeys) writeonly buffer Keys { uvec2 keys[]; };
-layout(std430, binding = kBvhBindingLeafPrims) writeonly buffer LeafPrims { uint leafPrims[]; };
+layout(std430, binding = kBvhBindingKeys) writeonly buffer Keys { uint keys[]; };
+layout(std430, binding = kBvhBindingValues) writeonly buffer Values { uint values[]; };
 
 // Spreads the low 10 bits of v so two zero bits separate each.
 uint spreadBits(uint v) {
@@ -21,22 +20,41 @@ uint spreadBits(uint v) {
   return v;
 }
 
+uint entryOf(uint t) {
+  uint lo = 0u, hi = pc.entryCount;
+  while (hi - lo > 1u) {
+    uint mid = (lo + hi) / 2u;
+    if (entries[mid].base <= t) lo = mid;
+    else hi = mid;
+  }
+  return lo;
+}
+
 void main() {
-  uint i = threadIndex();
-  if (i >= pc.count) return;
-  uint g = pc.groupCount > 1u ? primGroups[i] : 0u;
-  vec3 lo = vec3(primBoxes[6u * i], primBoxes[6u * i + 1u], primBoxes[6u * i + 2u]);
-  vec3 hi = vec3(primBoxes[6u * i + 3u], primBoxes[6u * i + 4u], primBoxes[6u * i + 5u]);
+  uint t = threadIndex();
+  if (t >= pc.count) return;
+  uint e = entryOf(t);
+  vec3 lo = vec3(primBoxes[6u * t], primBoxes[6u * t + 1u], primBoxes[6u * t + 2u]);
+  vec3 hi = vec3(primBoxes[6u * t + 3u], primBoxes[6u * t + 4u], primBoxes[6u * t + 5u]);
   uint morton = (1u << kBvhMortonBits) - 1u;
   if (all(lessThanEqual(lo, hi))) {
-    BvhGroup grp = groups[g];
-    vec3 cLo = vec3(orderedFloat(grp.centroidLo[0]), orderedFloat(grp.centroidLo[1]), orderedFloat(grp.centroidLo[2]));
-    vec3 cHi = vec3(orderedFloat(~grp.centroidHi[0]), orderedFloat(~grp.centroidHi[1]), orderedFloat(~grp.centroidHi[2]));
+    BvhBuildEntry entry = entries[e];
+    vec3 cLo = vec3(orderedFloat(entry.centroidLo[0]), orderedFloat(entry.centroidLo[1]), orderedFloat(entry.centroidLo[2]));
+    vec3 cHi = vec3(orderedFloat(~entry.centroidHi[0]), orderedFloat(~entry.centroidHi[1]), orderedFloat(~entry.centroidHi[2]));
+    // One scale for all three axes (the bounds' largest extent): a flat or
+    // thin group keeps its Morton order along the axes it spans, where
+    // stretching each axis to 10 bits would let a sliver's noise lead.
     vec3 extent = cHi - cLo;
-    vec3 unit = clamp((0.5 * (lo + hi) - cLo) / max(extent, vec3(1e-30)), 0.0, 1.0);
+    float size = max(max(extent.x, extent.y), max(extent.z, 1e-30));
+    vec3 unit = clamp((0.5 * (lo + hi) - cLo) / size, 0.0, 1.0);
     uvec3 q = uvec3(min(unit * 1024.0, vec3(1023.0)));
     morton = (spreadBits(q.x) << 2) | (spreadBits(q.y) << 1) | spreadBits(q.z);
   }
-  keys[i] = uvec2(morton | (g << kBvhMortonBits), g >> (32u - kBvhMortonBits));
-  leafPrims[i] = i;
+  if ((pc.flags & kBvhFlagKeys32) != 0u) {
+    keys[t] = morton | (e << kBvhMortonBits);
+  } else {
+    keys[2u * t] = morton | (e << kBvhMortonBits);
+    keys[2u * t + 1u] = e >> (32u - kBvhMortonBits);
+  }
+  values[t] = entries[e].first + (t - entries[e].base);
 }

@@ -1,8 +1,8 @@
-// Build step 6, run a few rounds after the first fit: treelet restructuring
+// Optional build step 5, run a few rounds after H-PLOC: treelet restructuring
 // (Karras & Aila 2013, "Fast parallel construction of high-quality bounding
-// volume hierarchies"). The LBVH splits where Morton codes differ, not where
-// the surface area heuristic would; this pass walks the tree bottom-up as the
-// fit does and, at every node with enough leaves below it, grows a treelet of
+// volume hierarchies"). H-PLOC only clusters within a window along the Morton
+// order; this pass walks the tree bottom-up as the refit does and, at every
+// node with enough leaves below it, grows a treelet of
 // up to kTreeletLeaves subtrees (always opening the largest), finds the
 // cheapest binary tree over them by dynamic programming over their subsets,
 // and rewires the treelet's own internal nodes into that tree. One invocation
@@ -13,15 +13,13 @@
 // Cost of a subtree (one primitive per leaf, Ct = Ci = 1, the measure of
 // src/ref/sah_bvh.h times the root's area): a leaf costs its box's area, an
 // internal node its area plus its children's costs. Boxes of the rewired
-// nodes are unions of the same leaf boxes the fit used, so they stay exact.
+// nodes are unions of the same leaf boxes the build used, so they stay exact.
 #version 460
 #extension GL_GOOGLE_include_directive : require
 #extension GL_KHR_memory_scope_semantics : require
 #include "bvh_common.glsl"
 
-layout(std430, binding = kBvhBindingPrimBoxes) readonly buffer PrimBoxes { float primBoxes[]; };
-layout(std430, binding = kBvhBindingLeafPrims) readonly buffer LeafPrims { uint leafPrims[]; };
-layout(std430, binding = kBvhBindingLeafParents) coherent buffer LeafParents { uint leafParents[]; };
+layout(std430, binding = kBvhBindingBuildEntries) readonly buffer Entries { BvhBuildEntry entries[]; };
 layout(std430, binding = kBvhBindingNodes) coherent buffer Nodes { BvhNode nodes[]; };
 layout(std430, binding = kBvhBindingCounters) coherent buffer Counters { uint counters[]; };
 // Per internal node: its subtree's cost (float bits) and leaf count.
@@ -36,11 +34,6 @@ const uint kSubsets = 1u << kTreeletLeaves;
 const uint kTreeletInternal = kTreeletLeaves - 1u;
 // A treelet is only rebuilt when that saves more than rounding could fake.
 const float kMinGain = 1e-5;
-
-float area(vec3 lo, vec3 hi) {
-  vec3 d = max(hi - lo, vec3(0.0));
-  return 2.0 * (d.x * d.y + d.y * d.z + d.z * d.x);
-}
 
 void slotBox(uint node, uint slot, out vec3 lo, out vec3 hi) {
   uint o = slot * 6u;
@@ -59,7 +52,7 @@ float subsetCost[kSubsets];
 uint subsetSplit[kSubsets];
 
 float refCost(uint ref, vec3 lo, vec3 hi) {
-  return (ref & kBvhLeafBit) != 0u ? area(lo, hi) : uintBitsToFloat(nodeStats[ref].x);
+  return (ref & kBvhLeafBit) != 0u ? boxArea(lo, hi) : uintBitsToFloat(nodeStats[ref].x);
 }
 
 uint refLeaves(uint ref) {
@@ -75,23 +68,23 @@ uint formTreelet(uint root, out float currentCost) {
     slotBox(root, c, leafLo[c], leafHi[c]);
   }
   vec3 rootLo = min(leafLo[0], leafLo[1]), rootHi = max(leafHi[0], leafHi[1]);
-  currentCost = area(rootLo, rootHi);
+  currentCost = boxArea(rootLo, rootHi);
   uint leaves = 2u;
   while (leaves < kTreeletLeaves) {
     // Open the largest internal subtree: that is where a better split pays most.
     uint best = kBvhNone;
-    float bestArea = -1.0;
+    float bestBoxArea = -1.0;
     for (uint j = 0u; j < leaves; ++j) {
-      float a = area(leafLo[j], leafHi[j]);
-      if ((leafRef[j] & kBvhLeafBit) == 0u && a > bestArea) {
+      float a = boxArea(leafLo[j], leafHi[j]);
+      if ((leafRef[j] & kBvhLeafBit) == 0u && a > bestBoxArea) {
         best = j;
-        bestArea = a;
+        bestBoxArea = a;
       }
     }
     if (best == kBvhNone) break;
     uint opened = leafRef[best];
     internalNode[internals++] = opened;
-    currentCost += bestArea;
+    currentCost += bestBoxArea;
     leafRef[best] = nodes[opened].child[0];
     slotBox(opened, 0u, leafLo[best], leafHi[best]);
     leafRef[leaves] = nodes[opened].child[1];
@@ -128,14 +121,13 @@ void optimise(uint leaves) {
         bestPart = part;
       }
     }
-    subsetCost[s] = area(subsetLo[s], subsetHi[s]) + best;
+    subsetCost[s] = boxArea(subsetLo[s], subsetHi[s]) + best;
     subsetSplit[s] = bestPart;
   }
 }
 
 void setParent(uint ref, uint parent) {
-  if ((ref & kBvhLeafBit) != 0u) leafParents[ref & ~kBvhLeafBit] = parent;
-  else nodes[ref].parent = parent;
+  if ((ref & kBvhLeafBit) == 0u) nodes[ref].parent = parent;
 }
 
 // Rewires the treelet's internal nodes into the tree optimise() chose.
@@ -191,24 +183,44 @@ void settle(uint node) {
     vec3 lo0, hi0, lo1, hi1;
     slotBox(node, 0u, lo0, hi0);
     slotBox(node, 1u, lo1, hi1);
-    currentCost = area(min(lo0, lo1), max(hi0, hi1)) + refCost(nodes[node].child[0], lo0, hi0) +
+    currentCost = boxArea(min(lo0, lo1), max(hi0, hi1)) + refCost(nodes[node].child[0], lo0, hi0) +
                   refCost(nodes[node].child[1], lo1, hi1);
   }
   nodeStats[node] = uvec2(floatBitsToUint(currentCost), leavesBelow);
 }
 
+uint entryOf(uint t) {
+  uint lo = 0u, hi = pc.entryCount;
+  while (hi - lo > 1u) {
+    uint mid = (lo + hi) / 2u;
+    if (entries[mid].base <= t) lo = mid;
+    else hi = mid;
+  }
+  return lo;
+}
+
+// Whether `node`'s subtrees are both settled after this arrival. Release
+// what this invocation settled below, acquire what the sibling's did.
+bool arrive(uint node) {
+  return atomicAdd(counters[node], 1u, gl_ScopeDevice, gl_StorageSemanticsBuffer, gl_SemanticsAcquireRelease) == 1u;
+}
+
+// One invocation per node slot of the build; the walk starts at the nodes
+// that hold a leaf, as the refit's does.
 void main() {
-  uint i = threadIndex();
-  if (i >= pc.count) return;
-  uint prim = leafPrims[pc.first + i];
-  uint node = leafParents[prim];
-  uint internalCount = pc.total - 1u;
-  for (uint step = 0u; step < kBvhMaxDepth; ++step) {
-    if (node == kBvhNone || node >= internalCount) break;
-    // Release what this invocation settled below, acquire what the sibling's did.
-    uint arrived = atomicAdd(counters[node], 1u, gl_ScopeDevice, gl_StorageSemanticsBuffer, gl_SemanticsAcquireRelease);
-    if (arrived == 0u) break;
+  uint t = threadIndex();
+  if (t >= pc.count) return;
+  BvhBuildEntry entry = entries[entryOf(t)];
+  uint local = t - entry.base;
+  if (local + 1u >= entry.count) return;  // a group of n leaves has n - 1 nodes
+  uint node = entry.first + local;
+  bool leaf0 = (nodes[node].child[0] & kBvhLeafBit) != 0u, leaf1 = (nodes[node].child[1] & kBvhLeafBit) != 0u;
+  if (!leaf0 && !leaf1) return;
+  bool settled = (leaf0 && leaf1) || arrive(node);
+  for (uint step = 0u; settled && step < kBvhMaxDepth; ++step) {
     settle(node);
     node = nodes[node].parent;
+    if (node == kBvhNone || node >= pc.total) break;
+    settled = arrive(node);
   }
 }
