@@ -34,25 +34,29 @@ Errors deformAndCompare(vk::Context& context, const scene::Scene& scene, int sam
   Errors errors;
   double duration = scene::animationDuration(scene);
   vk::Commands commands(context, "deform test");
+  vk::UploadArena arena(context, "deform test uploads");
   for (int k = 0; k < samples; ++k) {
     // Spread over [0, duration] but not on round numbers, which tend to be keys.
     double t = duration * (k + 0.37 * (k % 2)) / std::max(samples - 1, 1);
     scene::Pose pose = scene::evaluate(scene, std::min(t, duration));
     commands.begin();
-    pass.record(commands, pose);
+    arena.reset();
+    pass.record(commands, pose, arena);
     commands.submitAndWait();
     for (const render::DeformOutput& out : pass.outputs()) {
       const scene::DrawItem& item = pose.items[size_t(out.item)];
       std::vector<glm::dvec3> cpuPositions, cpuNormals;
       scene::deformOnCpu(item, cpuPositions, cpuNormals);
       std::vector<float> gpuPositions(cpuPositions.size() * 3), gpuNormals(cpuNormals.size() * 3);
-      vk::download(context, *out.slot.positions, gpuPositions.data(), gpuPositions.size() * 4);
-      vk::download(context, *out.slot.normals, gpuNormals.data(), gpuNormals.size() * 4);
+      VkDeviceSize offset = VkDeviceSize(out.slot.firstVertex) * 12;
+      vk::download(context, *out.slot.positions, gpuPositions.data(), gpuPositions.size() * 4, offset);
+      vk::download(context, *out.slot.normals, gpuNormals.data(), gpuNormals.size() * 4, offset);
       glm::dvec3 lo(INFINITY), hi(-INFINITY);
       for (const glm::dvec3& p : cpuPositions) lo = glm::min(lo, p), hi = glm::max(hi, p);
       double extent = std::max(glm::length(hi - lo), 1e-30);
       for (size_t v = 0; v < cpuPositions.size(); ++v) {
-        glm::dvec3 gp(gpuPositions[3 * v], gpuPositions[3 * v + 1], gpuPositions[3 * v + 2]);
+        // Skinned positions come out relative to the item's anchor.
+        glm::dvec3 gp = out.anchor + glm::dvec3(gpuPositions[3 * v], gpuPositions[3 * v + 1], gpuPositions[3 * v + 2]);
         glm::dvec3 gn(gpuNormals[3 * v], gpuNormals[3 * v + 1], gpuNormals[3 * v + 2]);
         errors.position = std::max(errors.position, glm::length(gp - cpuPositions[v]) / extent);
         if (glm::length(cpuNormals[v]) > 0.5) errors.normal = std::max(errors.normal, 1.0 - glm::dot(gn, cpuNormals[v]));
@@ -132,8 +136,9 @@ TEST_F(DeformPassTest, RefusesAPoseOfAnotherScene) {
   scene::Scene stat = scene::loadGltf(model("SimpleSparseAccessor/glTF/SimpleSparseAccessor.gltf"));
   render::DeformPass pass(context(), skin, scene::evaluate(skin, 0.0));
   vk::Commands commands(context(), "wrong pose");
+  vk::UploadArena arena(context(), "wrong pose uploads");
   commands.begin();
-  EXPECT_THROW(pass.record(commands, scene::evaluate(stat, 0.0)), vk::VulkanError);
+  EXPECT_THROW(pass.record(commands, scene::evaluate(stat, 0.0), arena), vk::VulkanError);
   commands.submitAndWait();
 }
 

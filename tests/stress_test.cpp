@@ -78,7 +78,7 @@ TEST_F(GpuTest, ACorruptedBvhEndsEveryRayWithinTheVisitBudget) {
   uint32_t cleanMost = 0;
   for (const gpu::TraceAov& a : clean.aov) cleanMost = std::max(cleanMost, a.nodeVisits);
 
-  render::BvhSnapshot tree = renderer.builder().download(renderer.blas());
+  render::BvhSnapshot tree = renderer.builder()->download(*renderer.blas());
   ASSERT_GT(tree.nodes.size(), 8u);
   uint32_t root = tree.groups[0].root;
   for (size_t n = 0; n < tree.nodes.size(); ++n) {
@@ -90,7 +90,8 @@ TEST_F(GpuTest, ACorruptedBvhEndsEveryRayWithinTheVisitBudget) {
       for (int k = 6; k < 12; ++k) node.box[k] = k < 9 ? -1e30f : 1e30f;  // and always entered
     }
   }
-  vk::upload(context(), renderer.blas().nodes, tree.nodes.data(), tree.nodes.size() * sizeof(gpu::BvhNode));
+  vk::upload(context(), renderer.blas()->nodes, tree.nodes.data(), tree.nodes.size() * sizeof(gpu::BvhNode));
+  renderer.invalidateViews();  // nothing the renderer knows of changed
 
   render::RenderedFrame frame = render::renderFrame(context(), renderer, pose, settings, true);
   uint32_t most = 0;

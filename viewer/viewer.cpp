@@ -41,12 +41,11 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-// What one viewport owns: its camera and the images its passes write.
+// One viewport: its camera and where it sits in the window. The renderer
+// owns its images (view index = viewport index among those shown).
 struct Viewport {
   CameraRig rig;
   uint32_t x = 0, width = 0, height = 0;
-  vk::Image trace, composite, depth;
-  vk::Buffer aov;
 };
 
 struct Toggles {
@@ -58,6 +57,7 @@ struct Toggles {
 struct FrameRecord {
   double cpuMs = 0;
   std::map<std::string, double> gpuMs;  ///< per pass name, summed over viewports
+  render::FrameStats stats;
 };
 
 double median(std::vector<double> v) {
@@ -79,7 +79,9 @@ class Viewer {
   void layoutViewports(uint32_t width, uint32_t height);
   void applyScript(uint64_t frame);
   void drawUi(double frameSeconds);
-  void recordFrame(vk::Commands& commands, std::optional<uint32_t> swapImage, bool screenshot);
+  render::FrameRequest frameRequest(std::optional<uint32_t> swapImage, bool screenshot);
+  void recordDisplay(vk::Commands& commands, std::optional<uint32_t> swapImage, bool screenshot);
+  void noteFrame(const render::FrameResult& result, double cpuMs);
   scene::View viewOf(const Viewport& vp) const;
   void frameScene();
   void writeScreenshot();
@@ -101,7 +103,6 @@ class Viewer {
   std::unique_ptr<Swapchain> swapchain_;
   std::unique_ptr<UiOverlay> ui_;
   std::unique_ptr<vk::ComputeProgram> present_;
-  std::unique_ptr<render::RasterPass> raster_;
   std::unique_ptr<scene::Scene> scene_;
   std::unique_ptr<render::Renderer> renderer_;
   scene::Pose pose_;
@@ -113,9 +114,6 @@ class Viewer {
   vk::Image windowImage_;
   vk::Buffer placeholderAov_, screenshotBuffer_;
   bool freshImages_ = true;
-  bool updated_ = false;  ///< the renderer holds an update of pose_ at updatedOrigin_
-  double updatedTime_ = 0.0;
-  glm::dvec3 updatedOrigin_{0.0};
   VkSemaphore imageReady_ = VK_NULL_HANDLE;
   std::vector<ScriptAction> script_;
   size_t nextAction_ = 0;
@@ -128,6 +126,9 @@ class Viewer {
   int dragMods_ = 0;
   std::vector<FrameRecord> records_;
   std::vector<vk::PassTime> lastPasses_;
+  render::FrameStats lastStats_;
+  uint64_t pendingFrame_ = 0;  ///< the renderer's frame submitted last, not yet waited for
+  double pendingCpuMs_ = 0;
   double fps_ = 0;
 };
 
@@ -174,7 +175,6 @@ Viewer::Viewer(const ViewerOptions& options) : options_(options) {
   }
   ui_ = std::make_unique<UiOverlay>(*context_, window_);
   present_ = std::make_unique<vk::ComputeProgram>(*context_, vk::ComputeProgramDesc{"display", kSpvPresent, {}, false});
-  raster_ = std::make_unique<render::RasterPass>(*context_);
   placeholderAov_ = vk::Buffer(*context_, {sizeof(gpu::TraceAov), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
                                            vk::MemoryDomain::Device, "no heat map"});
   useScene(std::move(initial), options.camera);
@@ -245,6 +245,7 @@ void Viewer::useScene(std::unique_ptr<scene::Scene> scene, int camera) {
   auto renderer = std::make_unique<render::Renderer>(*context_, *scene, pose);
 
   if (renderer_) vkDeviceWaitIdle(context_->device());
+  pendingFrame_ = 0;  // its numbers belong to the renderer that goes
   renderer_ = std::move(renderer);  // the old renderer goes before the scene it refers to
   scene_ = std::move(scene);
   pose_ = std::move(pose);
@@ -254,7 +255,6 @@ void Viewer::useScene(std::unique_ptr<scene::Scene> scene, int camera) {
   time_ = time;
   sceneName_ = scene_->source.empty() ? "scene" : scene_->source;
   viewports_ = std::move(viewports);  // sized on the next frame
-  updated_ = false;
   active_ = 0;
   freshImages_ = true;
 }
@@ -279,23 +279,7 @@ void Viewer::layoutViewports(uint32_t width, uint32_t height) {
     vp.x = x;
     vp.width = w;
     vp.height = height;
-    if (w == 0) {
-      vp.trace = {};
-      vp.composite = {};
-      vp.depth = {};
-      vp.aov = {};
-      continue;
-    }
-    render::checkImageSize(*context_, w, height);
-    std::string name = "viewport " + std::to_string(i);
-    vp.trace = vk::Image(*context_, {w, height, VK_FORMAT_R16G16B16A16_SFLOAT, VK_IMAGE_USAGE_STORAGE_BIT, name + " trace"});
-    vp.composite = vk::Image(*context_, {w, height, render::kCompositeFormat,
-                                         VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_STORAGE_BIT, name + " composite"});
-    vp.depth = vk::Image(*context_, {w, height, render::kDepthFormat, VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT,
-                                     name + " depth"});
-    vp.aov = vk::Buffer(*context_, {uint64_t(w) * height * sizeof(gpu::TraceAov), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
-                                    vk::MemoryDomain::Device, name + " heat map"});
-    freshImages_ = true;
+    if (w) render::checkImageSize(*context_, w, height);
   }
   if (windowImage_.width() != width || windowImage_.height() != height) {
     ui_->forgetTargets();
@@ -541,8 +525,15 @@ void Viewer::drawUi(double frameSeconds) {
     ImGui::Text("%7.3f ms", gpuTotal);
     ImGui::EndTable();
   }
+  // What the last finished frame did and skipped.
+  const render::FrameStats& st = lastStats_;
+  ImGui::Text("deformed %u, skipped %u; trees refit %u, rebuilt %u, skipped %u", st.itemsDeformed,
+              st.itemsDeformSkipped, st.treesRefit, st.treesBuilt, st.treesSkipped);
+  ImGui::Text("top level %s; views drawn %u, kept %u; %llu pixels traced; %u dispatches",
+              st.topLevelBuilt ? "built" : st.topLevelRefit ? "refit" : "kept", st.viewsRendered, st.viewsSkipped,
+              static_cast<unsigned long long>(st.pixelsTraced), st.dispatches);
   uint64_t imageBytes = uint64_t(windowImage_.width()) * windowImage_.height() * 4;
-  for (const Viewport& vp : viewports_) imageBytes += uint64_t(vp.width) * vp.height * (8 + 8 + 4 + 32);
+  for (const Viewport& vp : viewports_) imageBytes += uint64_t(vp.width) * vp.height * (8 + 8 + 4 + 4 + 4);
   ImGui::Text("%u triangles, %.1f MiB of GPU memory", renderer_->sceneGpu().triangleCount,
               double(renderer_->memoryBytes() + imageBytes) / 1048576.0);
   ImGui::Text("%s", context_->facts().name.c_str());
@@ -606,41 +597,43 @@ void Viewer::drawUi(double frameSeconds) {
   ImGui::End();
 }
 
-void Viewer::recordFrame(vk::Commands& commands, std::optional<uint32_t> swapImage, bool screenshot) {
+// The frame the renderer runs: one composite view per viewport shown, then
+// the display pass, the overlay and the copy to the swapchain (or screenshot).
+render::FrameRequest Viewer::frameRequest(std::optional<uint32_t> swapImage, bool screenshot) {
+  render::FrameRequest request;
+  request.pose = &pose_;
+  for (const Viewport& vp : viewports_) {
+    if (!vp.width) continue;
+    render::ViewRequest view;
+    view.settings = {vp.width, vp.height, viewOf(vp), {0.02f, 0.02f, 0.025f}, gpu::kDefaultMaxInterfaces};
+    view.output = render::ViewOutput::Composite;
+    view.raster.refraction = toggles_.refraction;
+    view.raster.wireframe = toggles_.wireframe;
+    render::fitDepthRange(view.settings.view, boundsLo_, boundsHi_, view.raster);
+    // The heat map counts nodes for every pixel, so it traces them all.
+    view.masked = !toggles_.heatMap;
+    view.aov = toggles_.heatMap;
+    request.views.push_back(view);
+  }
+  request.record = [this, swapImage, screenshot](vk::Commands& commands) { recordDisplay(commands, swapImage, screenshot); };
+  if (swapImage) {
+    request.waitSemaphore = imageReady_;
+    request.waitStage = VK_PIPELINE_STAGE_TRANSFER_BIT;  // the copy to the swapchain image starts after the acquire
+    request.signalSemaphore = swapchain_->renderDone(*swapImage);
+  }
+  return request;
+}
+
+void Viewer::recordDisplay(vk::Commands& commands, std::optional<uint32_t> swapImage, bool screenshot) {
   if (freshImages_) {
-    for (const Viewport& vp : viewports_) {
-      if (!vp.width) continue;
-      for (const vk::Image* image : {&vp.trace, &vp.composite, &vp.depth}) {
-        commands.imageLayout(*image, VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_GENERAL);
-      }
-    }
     commands.imageLayout(windowImage_, VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_GENERAL);
     freshImages_ = false;
   }
-  // Deform, refit and the top level only when the pose or the frame's origin
-  // (the first viewport's eye) moved: a paused, still view traces the trees
-  // the last update left.
-  glm::dvec3 origin = viewOf(viewports_[0]).eye;
-  if (!updated_ || updatedTime_ != pose_.time || updatedOrigin_ != origin) {
-    renderer_->update(commands, pose_, origin);
-    updated_ = true;
-    updatedTime_ = pose_.time;
-    updatedOrigin_ = origin;
-  }
-  bool trace = toggles_.refraction || toggles_.heatMap;
-  render::RasterOptions rasterOptions;
-  rasterOptions.refraction = toggles_.refraction;
-  rasterOptions.wireframe = toggles_.wireframe;
   std::vector<gpu::PresentPush> pushes;
   for (size_t i = 0; i < viewports_.size(); ++i) {
     const Viewport& vp = viewports_[i];
     if (!vp.width) continue;
     scene::View view = viewOf(vp);
-    render::FrameSettings settings{vp.width, vp.height, view, {0.02f, 0.02f, 0.025f}, gpu::kDefaultMaxInterfaces};
-    if (trace) renderer_->trace(commands, settings, vp.trace, toggles_.heatMap ? &vp.aov : nullptr);
-    render::fitDepthRange(view, boundsLo_, boundsHi_, rasterOptions);
-    raster_->record(commands, *renderer_, settings, vp.trace, vp.composite, vp.depth, rasterOptions);
-
     gpu::PresentPush push{};
     push.area = glm::uvec4(vp.x, 0, vp.width, vp.height);
     // The film gate: the camera's frame at zoom 1 (its glTF aspect ratio, else
@@ -668,11 +661,13 @@ void Viewer::recordFrame(vk::Commands& commands, std::optional<uint32_t> swapIma
   size_t p = 0;
   for (const Viewport& vp : viewports_) {
     if (!vp.width) continue;
+    const render::ViewImages& images = renderer_->viewImages(p);
     present_->dispatchThreads(commands,
-                              {{gpu::kPresentBindingComposite, nullptr, &vp.composite},
-                               {gpu::kPresentBindingAov, toggles_.heatMap ? &vp.aov : &placeholderAov_},
+                              {{gpu::kPresentBindingComposite, nullptr, &images.composite},
+                               {gpu::kPresentBindingAov, toggles_.heatMap ? &images.aov : &placeholderAov_},
                                {gpu::kPresentBindingOutput, nullptr, &windowImage_}},
-                              pushes[p++], uint64_t(vp.width) * vp.height);
+                              pushes[p], uint64_t(vp.width) * vp.height);
+    ++p;
   }
   commands.endPass();
   if (toggles_.ui) {
@@ -734,10 +729,19 @@ void Viewer::writeScreenshot() {
 void Viewer::writeJson(double seconds) const {
   std::vector<double> cpu;
   std::map<std::string, std::vector<double>> gpu;
-  std::vector<double> gpuTotal;
+  std::vector<double> gpuTotal, pixels, dispatches;
+  uint64_t deformed = 0, refit = 0, rebuilt = 0, viewsDrawn = 0, viewsKept = 0;
   // The first frames build the tree and warm caches: the medians skip them.
   size_t skip = std::min<size_t>(records_.size() / 10, 10);
   for (size_t i = skip; i < records_.size(); ++i) {
+    const render::FrameStats& st = records_[i].stats;
+    pixels.push_back(double(st.pixelsTraced));
+    dispatches.push_back(st.dispatches);
+    deformed += st.itemsDeformed;
+    refit += st.treesRefit;
+    rebuilt += st.treesBuilt;
+    viewsDrawn += st.viewsRendered;
+    viewsKept += st.viewsSkipped;
     cpu.push_back(records_[i].cpuMs);
     double total = 0;
     for (const auto& [name, ms] : records_[i].gpuMs) {
@@ -749,6 +753,11 @@ void Viewer::writeJson(double seconds) const {
   std::printf("\n%-12s %10s\n", "pass", "median ms");
   for (const auto& [name, v] : gpu) std::printf("%-12s %10.3f\n", name.c_str(), median(v));
   std::printf("%-12s %10.3f\n%-12s %10.3f\n", "GPU total", median(gpuTotal), "frame (CPU)", median(cpu));
+  std::printf("over %zu frames: %llu items deformed, %llu trees refit, %llu rebuilt, views drawn %llu, kept %llu; "
+              "median %.0f pixels traced, %.0f dispatches a frame\n",
+              cpu.size(), static_cast<unsigned long long>(deformed), static_cast<unsigned long long>(refit),
+              static_cast<unsigned long long>(rebuilt), static_cast<unsigned long long>(viewsDrawn),
+              static_cast<unsigned long long>(viewsKept), median(pixels), median(dispatches));
   if (options_.json.empty()) return;
   std::string text = "{\n  \"device\": \"" + context_->facts().name + "\",\n  \"scene\": \"" + sceneName_ +
                      "\",\n  \"width\": " + std::to_string(windowImage_.width()) +
@@ -760,7 +769,12 @@ void Viewer::writeJson(double seconds) const {
                      ",\n  \"frames_in_medians\": " + std::to_string(cpu.size()) +
                      ",\n  \"wall_seconds\": " + std::to_string(seconds) +
                      ",\n  \"median_frame_ms\": " + std::to_string(median(cpu)) +
-                     ",\n  \"median_gpu_total_ms\": " + std::to_string(median(gpuTotal)) + ",\n  \"median_pass_ms\": {";
+                     ",\n  \"median_gpu_total_ms\": " + std::to_string(median(gpuTotal)) +
+                     ",\n  \"items_deformed\": " + std::to_string(deformed) + ",\n  \"trees_refit\": " +
+                     std::to_string(refit) + ",\n  \"trees_rebuilt\": " + std::to_string(rebuilt) +
+                     ",\n  \"views_drawn\": " + std::to_string(viewsDrawn) + ",\n  \"views_kept\": " +
+                     std::to_string(viewsKept) + ",\n  \"median_pixels_traced\": " + std::to_string(median(pixels)) +
+                     ",\n  \"median_dispatches\": " + std::to_string(median(dispatches)) + ",\n  \"median_pass_ms\": {";
   bool firstPass = true;
   for (const auto& [name, v] : gpu) {
     text += std::string(firstPass ? "\n" : ",\n") + "    \"" + name + "\": " + std::to_string(median(v));
@@ -777,8 +791,17 @@ void Viewer::writeJson(double seconds) const {
   std::printf("wrote %s\n", options_.json.c_str());
 }
 
+void Viewer::noteFrame(const render::FrameResult& result, double cpuMs) {
+  lastPasses_ = result.passes;
+  lastStats_ = result.stats;
+  FrameRecord record;
+  record.cpuMs = cpuMs;
+  record.stats = result.stats;
+  for (const vk::PassTime& p : lastPasses_) record.gpuMs[p.name] += p.milliseconds;
+  records_.push_back(record);
+}
+
 int Viewer::run() {
-  vk::Commands commands(*context_, "viewer frame");
   auto start = Clock::now(), last = start;
   double frameSeconds = 0.0;
   for (uint64_t frame = 0; !quit_ && (options_.frames == 0 || frame < options_.frames); ++frame) {
@@ -846,26 +869,22 @@ int Viewer::run() {
     }
     bool last_frame = options_.frames != 0 && frame + 1 == options_.frames;
     bool screenshot = last_frame && !options_.screenshot.empty();
-    commands.begin();
-    recordFrame(commands, image, screenshot);
-    if (image) {
-      commands.submit(imageReady_, VK_PIPELINE_STAGE_TRANSFER_BIT, swapchain_->renderDone(*image));
-      if (!swapchain_->present(*image)) swapchain_->recreate(width, height);
-    } else {
-      commands.submit();
-    }
-    // One frame in flight: the host writes the next frame's instances and lights.
-    commands.wait();
-    lastPasses_ = commands.passTimes();
-    FrameRecord record;
-    record.cpuMs = 1000.0 * frameSeconds;
-    for (const vk::PassTime& p : lastPasses_) record.gpuMs[p.name] += p.milliseconds;
-    records_.push_back(record);
+    uint64_t submitted = renderer_->submit(frameRequest(image, screenshot));
+    if (image && !swapchain_->present(*image)) swapchain_->recreate(width, height);
+    // Two frames in flight: the GPU runs this one while the host waits only
+    // for the one before, whose timings the overlay shows.
+    if (pendingFrame_) noteFrame(renderer_->wait(pendingFrame_), pendingCpuMs_);
+    pendingFrame_ = submitted;
+    pendingCpuMs_ = 1000.0 * frameSeconds;
     if (screenshot) {
+      noteFrame(renderer_->wait(submitted), pendingCpuMs_);
+      pendingFrame_ = 0;
       writeScreenshot();
       shotWritten_ = true;
     }
   }
+  if (pendingFrame_) noteFrame(renderer_->wait(pendingFrame_), pendingCpuMs_);
+  pendingFrame_ = 0;
   double seconds = std::chrono::duration<double>(Clock::now() - start).count();
   std::printf("%zu frames in %.2f s on %s%s\n", records_.size(), seconds, context_->facts().name.c_str(),
               swapchain_ ? (", swapchain recreated " + std::to_string(swapchain_->recreations() - 1) + " time(s)").c_str()

@@ -1,5 +1,6 @@
-// The deform pass: morph targets, then linear blend skinning, per vertex.
-// Writes the deformed positions and normals that the BVH and raster passes read.
+// The deform pass: morph targets, then linear blend skinning, per vertex, for
+// every item listed this frame in one dispatch. Writes the deformed positions
+// and normals that the BVH and raster passes read.
 #version 460
 #extension GL_GOOGLE_include_directive : require
 #include "../shared/deform.h"
@@ -16,32 +17,39 @@ layout(std430, binding = kDeformBindingSkinWeights) readonly buffer SkinWeights 
 layout(std430, binding = kDeformBindingJointMatrices) readonly buffer JointMatrices { mat4 jointMatrices[]; };
 layout(std430, binding = kDeformBindingPositions) writeonly buffer Positions { float positions[]; };
 layout(std430, binding = kDeformBindingNormals) writeonly buffer Normals { float normals[]; };
+layout(std430, binding = kDeformBindingJobs) readonly buffer Jobs { DeformJob jobs[]; };
 
-vec3 load3(uint v, bool normal) {
-  uint i = 3u * v;
-  return normal ? vec3(restNormals[i], restNormals[i + 1u], restNormals[i + 2u])
-                : vec3(restPositions[i], restPositions[i + 1u], restPositions[i + 2u]);
+uint jobOf(uint t) {
+  uint lo = 0u, hi = pc.jobCount;
+  while (hi - lo > 1u) {
+    uint mid = (lo + hi) / 2u;
+    if (jobs[mid].threadBase <= t) lo = mid;
+    else hi = mid;
+  }
+  return lo;
 }
 
 void main() {
-  uint block = gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x;
-  uint v = block * gl_WorkGroupSize.x + gl_LocalInvocationID.x;
-  if (v >= pc.vertexCount) return;
+  uint t = (gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x) * gl_WorkGroupSize.x + gl_LocalInvocationID.x;
+  if (t >= pc.count) return;
+  DeformJob job = jobs[jobOf(t)];
+  uint v = t - job.threadBase;
 
-  vec3 p = load3(v, false);
-  vec3 n = load3(v, true);
-  for (uint t = 0u; t < pc.targetCount; ++t) {  // bounded by the push constant
-    float w = morphWeights[t];
+  uint r = 3u * (job.restFirst + v);
+  vec3 p = vec3(restPositions[r], restPositions[r + 1u], restPositions[r + 2u]);
+  vec3 n = vec3(restNormals[r], restNormals[r + 1u], restNormals[r + 2u]);
+  for (uint k = 0u; k < job.targetCount; ++k) {  // bounded by the job
+    float w = morphWeights[job.weightFirst + k];
     if (w == 0.0) continue;
-    uint i = 6u * (t * pc.vertexCount + v);
+    uint i = job.morphFirst + 6u * (k * job.vertexCount + v);
     p += w * vec3(morphDeltas[i], morphDeltas[i + 1u], morphDeltas[i + 2u]);
     n += w * vec3(morphDeltas[i + 3u], morphDeltas[i + 4u], morphDeltas[i + 5u]);
   }
-  if (pc.jointCount > 0u) {
+  if (job.jointCount > 0u) {
     // The loader checked joint indices against the skin; the clamp keeps a
-    // corrupted buffer from reading outside the matrices anyway.
-    uvec4 j = min(joints[v], uvec4(pc.jointCount - 1u));
-    vec4 w = skinWeights[v];
+    // corrupted buffer from reading outside the item's matrices anyway.
+    uvec4 j = job.jointFirst + min(joints[job.skinFirst + v], uvec4(job.jointCount - 1u));
+    vec4 w = skinWeights[job.skinFirst + v];
     mat4 m = w.x * jointMatrices[j.x] + w.y * jointMatrices[j.y] + w.z * jointMatrices[j.z] + w.w * jointMatrices[j.w];
     p = (m * vec4(p, 1.0)).xyz;
     // Cofactor (det * inverse-transpose), sign-corrected as in src/scene/evaluate.cpp.
@@ -51,7 +59,7 @@ void main() {
   }
   float len = length(n);
   n = len > 0.0 ? n / len : n;
-  uint o = 3u * (pc.outputFirst + v);
+  uint o = 3u * (job.outputFirst + v);
   positions[o] = p.x;
   positions[o + 1u] = p.y;
   positions[o + 2u] = p.z;

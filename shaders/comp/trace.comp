@@ -27,6 +27,10 @@ layout(std430, binding = kTraceBindingLights) readonly buffer Lights { GpuLight 
 layout(binding = kTraceBindingImage, rgba16f) uniform writeonly image2D outImage;
 layout(std430, binding = kTraceBindingAov) writeonly buffer Aovs { TraceAov aovs[]; };
 layout(std430, binding = kTraceBindingRays) readonly buffer Rays { GpuRay rays[]; };
+layout(std430, binding = kTraceBindingPixels) readonly buffer Pixels {
+  TracePixelListHeader list;
+  uint listed[];
+};
 
 const float kInf = 1.0 / 0.0;  // folded to +infinity at compile time
 const uint kStackSize = 64u;
@@ -229,8 +233,16 @@ vec3 offsetRay(vec3 p, vec3 n) {
 
 void main() {
   uint tile = gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x;
-  uvec2 pixel = uvec2(tile % pc.tilesX, tile / pc.tilesX) * kTraceTile +
-                uvec2(gl_LocalInvocationID.x % kTraceTile, gl_LocalInvocationID.x / kTraceTile);
+  uvec2 pixel;
+  if ((pc.flags & kTraceFlagPixelList) != 0u) {
+    // The masked trace: one invocation per listed pixel (listed tile by tile, so neighbours stay together).
+    uint i = tile * gl_WorkGroupSize.x + gl_LocalInvocationID.x;
+    if (i >= list.count) return;
+    pixel = uvec2(listed[i] & 0xffffu, listed[i] >> 16);
+  } else {
+    pixel = uvec2(tile % pc.tilesX, tile / pc.tilesX) * kTraceTile +
+            uvec2(gl_LocalInvocationID.x % kTraceTile, gl_LocalInvocationID.x / kTraceTile);
+  }
   if (pixel.x >= pc.width || pixel.y >= pc.height) return;
 
   float sx = (2.0 * (float(pixel.x) + 0.5) / float(pc.width) - 1.0) * pc.right.w + pc.shiftX;

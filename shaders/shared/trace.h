@@ -128,6 +128,7 @@ SNELL_CONST kNoHit = 0xffffffffu;
 SNELL_CONST kTraceFlagAov = 1u;
 SNELL_CONST kTraceFlagOrthographic = 2u;
 SNELL_CONST kTraceFlagRayList = 4u;  // primary rays from kTraceBindingRays, not the camera
+SNELL_CONST kTraceFlagPixelList = 8u;  // only the pixels kTraceBindingPixels lists (the masked trace)
 SNELL_CONST kTraceTile = 8;  // pixels per side of one workgroup's tile
 // Nodes one ray segment may visit before it gives up: a corrupted tree ends here.
 SNELL_CONST kTraceMaxVisits = 1u << 20;
@@ -149,6 +150,32 @@ SNELL_CONST kTraceBindingLights = 12;     // GpuLight[]
 SNELL_CONST kTraceBindingImage = 13;      // rgba16f storage image
 SNELL_CONST kTraceBindingAov = 14;        // TraceAov[width * height]
 SNELL_CONST kTraceBindingRays = 15;       // GpuRay[width * height], with kTraceFlagRayList
+SNELL_CONST kTraceBindingPixels = 16;     // TracePixelList, with kTraceFlagPixelList
+SNELL_CONST kTraceBindingMask = 17;       // r32ui image: non-zero where a transmissive face is visible (compaction)
+
+// The masked trace's pixel list (shaders/comp/trace_compact.comp writes it,
+// the trace reads it): a header, then one packed pixel (x | y << 16) per entry.
+// The header's dispatch fields are a VkDispatchIndirectCommand for the trace.
+// 32 bytes, total: 32 bytes
+struct TracePixelListHeader {
+  uint count;       // 4: pixels listed
+  uint groupsDone;  // 4: compaction workgroups finished (the last one writes the dispatch)
+  uint dispatchX;   // 4: trace workgroups, split over y beyond the device's x limit
+  uint dispatchY;   // 4
+  uint dispatchZ;   // 4
+  uint pad0;        // 4
+  uint pad1;        // 4
+  uint pad2;        // 4
+};
+SNELL_CONST kTracePixelListDispatchOffset = 8;  // bytes into the list: the indirect arguments
+
+// 16 bytes, total: 16 bytes
+struct TraceCompactPush {
+  uint width;        // 4
+  uint height;       // 4
+  uint tilesX;       // 4: kTraceTile-wide tiles per row
+  uint maxGroupsX;   // 4: the device's workgroup-count limit along x
+};
 
 // A primary ray from a list, camera-relative like everything the trace sees.
 // 32 bytes, total: 32 bytes

@@ -1,5 +1,6 @@
 // `snell bench frame`: GPU time of each pass of a frame (deform, bottom-level
-// build or refit, top level, trace) while the eye animates, medians over many frames.
+// build or refit, top level, raster, trace) while the scene animates, medians
+// over many frames, and what each frame did and skipped.
 #include "cli/cli.h"
 
 #include "render/renderer.h"
@@ -8,9 +9,9 @@
 #include "scene/procedural_eye.h"
 #include "scene/scene_summary.h"
 #include "scene/view.h"
-#include "vk/commands.h"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <map>
@@ -23,14 +24,23 @@ constexpr const char* kHelp = R"(usage: snell bench frame [SCENE.glb] [options]
 
 Renders animated frames of the procedural eye (or SCENE) and reports each
 pass's GPU time: the median, min and max over the measured frames. The first
-frame builds the bottom level ("blas build"); later frames refit what deformed.
+frame builds the trees ("blas build"); later frames refit what deformed and
+rebuild trees the surface area heuristic finds spoiled.
+
+"refraction" sums the passes refraction costs: deform, the trees and the
+trace (with --viewport the trace covers only the pixels whose visible face is
+transmissive); the raster passes draw the viewport with or without it.
 
 options:
-  --size WxH        image size (default 1920x1080)
-  --frames N        frames measured (default 30)
-  --warmup N        frames rendered first and not measured (default 5)
+  --size WxH          image size (default 1920x1080)
+  --frames N          frames measured (default 30)
+  --warmup N          frames rendered first and not measured (default 5)
   --eye-resolution N  segments of the procedural eye (default 64)
-  --json FILE       write the results as JSON too
+  --crowd N           N characters' eye pairs instead of one eye
+  --viewport          the viewport composite: raster pass, transmissive pixels traced
+  --no-mask           with --viewport: trace every pixel
+  --no-refraction     with --viewport: glass left out, nothing traced
+  --json FILE         write the results as JSON too
 )";
 
 double median(std::vector<double> v) {
@@ -39,10 +49,26 @@ double median(std::vector<double> v) {
   return v.size() % 2 ? v[v.size() / 2] : 0.5 * (v[v.size() / 2 - 1] + v[v.size() / 2]);
 }
 
+bool refractionPass(const std::string& name) {
+  return name == "deform" || name == "blas refit" || name == "blas build" || name == "tlas" || name == "trace";
+}
+
+std::string jsonEscape(const std::string& s) {
+  std::string out;
+  for (char c : s) {
+    if (c == '"' || c == '\\') out += '\\';
+    if (static_cast<unsigned char>(c) < 0x20) continue;
+    out += c;
+  }
+  return out;
+}
+
 }  // namespace
 
 int runBenchFrame(const Args& args) {
-  uint32_t width = 1920, height = 1080, frames = 30, warmup = 5, eyeResolution = 64;
+  uint32_t width = 1920, height = 1080, frames = 30, warmup = 5;
+  scene::EyeOptions eye;
+  bool viewport = false, masked = true, refraction = true;
   std::string json, file;
   for (size_t i = 0; i < args.size(); ++i) {
     const std::string& a = args[i];
@@ -54,6 +80,12 @@ int runBenchFrame(const Args& args) {
       file = a;
       continue;
     }
+    if (a == "--viewport" || a == "--no-mask" || a == "--no-refraction") {
+      viewport = viewport || a == "--viewport";
+      masked = masked && a != "--no-mask";
+      refraction = refraction && a != "--no-refraction";
+      continue;
+    }
     if (i + 1 >= args.size()) throw UsageError{"bench frame: " + a + " needs a value (or is unknown)"};
     const std::string& v = args[++i];
     if (a == "--size") {
@@ -63,63 +95,108 @@ int runBenchFrame(const Args& args) {
     } else if (a == "--warmup") {
       warmup = uint32_t(parseCount(a, v));
     } else if (a == "--eye-resolution") {
-      eyeResolution = uint32_t(parseCount(a, v));
+      eye.resolution = uint32_t(parseCount(a, v));
+    } else if (a == "--crowd") {
+      eye.crowd = uint32_t(parseCount(a, v));
     } else if (a == "--json") {
       json = v;
     } else {
       throw UsageError{"bench frame: unknown option " + a};
     }
   }
-  scene::EyeOptions eye;
-  eye.resolution = eyeResolution;
+  try {
+    scene::checkEyeOptions(eye);
+  } catch (const std::invalid_argument& e) {
+    throw UsageError{std::string("bench frame: ") + e.what()};
+  }
   scene::Scene scene = file.empty() ? scene::makeEye(eye) : scene::loadGltf(file);
-  std::string label = file.empty() ? "eye (resolution " + std::to_string(eyeResolution) + ")" : file;
+  std::string label = file;
+  if (file.empty()) {
+    label = eye.crowd ? "eye crowd of " + std::to_string(eye.crowd) : std::string("eye");
+    label += " (resolution " + std::to_string(eye.resolution) + ")";
+  }
   auto context = vk::Context::create(contextDescFromEnvironment());
   render::checkImageSize(*context, width, height);
   scene::SceneSummary summary = scene::summarize(scene);
-  std::printf("device: %s\nscene: %s, %llu triangles, %ux%u\n", context->facts().name.c_str(), label.c_str(),
-              static_cast<unsigned long long>(summary.triangles), width, height);
+  std::string mode = !viewport ? "trace" : !refraction ? "viewport, no refraction" : masked ? "viewport, masked trace"
+                                                                                            : "viewport, full trace";
+  std::printf("device: %s\nscene: %s, %llu triangles, %ux%u, %s\n", context->facts().name.c_str(), label.c_str(),
+              static_cast<unsigned long long>(summary.triangles), width, height, mode.c_str());
 
   double duration = std::max(scene::animationDuration(scene), 1e-3);
   scene::Pose layout = scene::evaluate(scene, 0.0);
   render::Renderer renderer(*context, scene, layout);
-  vk::Image image(*context, {width, height, VK_FORMAT_R16G16B16A16_SFLOAT, VK_IMAGE_USAGE_STORAGE_BIT, "bench image"});
-  vk::Commands commands(*context, "bench frame");
+  // Depth range from the first pose's bounds, grown: bounds deform on the CPU, too slow per frame for a crowd.
+  glm::dvec3 lo, hi;
+  scene::sceneBounds(scene, layout, lo, hi);
+  glm::dvec3 pad = 0.25 * (hi - lo);
+  lo -= pad;
+  hi += pad;
   std::map<std::string, std::vector<double>> times;
   std::vector<std::string> order;
+  std::vector<double> totals, refractionTotals;
+  std::map<std::string, std::vector<double>> counters;
+  std::vector<std::string> counterOrder = {"items deformed", "trees refit", "trees rebuilt", "triangles refit",
+                                           "pixels traced", "dispatches", "draws"};
   for (uint32_t f = 0; f < warmup + frames; ++f) {
     double t = std::fmod(double(f) / 24.0, duration);
     scene::Pose pose = scene::evaluate(scene, t);
-    scene::View view = scene::resolveView(scene, pose, {});
-    commands.begin();
-    if (f == 0) commands.imageLayout(image, VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_GENERAL);
-    renderer.record(commands, pose, {width, height, view, {0.02f, 0.02f, 0.025f}, gpu::kDefaultMaxInterfaces}, image);
-    commands.submitAndWait();
-    // The build happens once, on the first frame: report it even though it is warm-up.
-    for (const vk::PassTime& p : commands.passTimes()) {
-      if (f < warmup && p.name != "blas build") continue;
+    render::ViewRequest view;
+    view.settings = {width, height, scene::resolveView(scene, pose, {}), {0.02f, 0.02f, 0.025f},
+                     gpu::kDefaultMaxInterfaces};
+    if (viewport) {
+      view.output = render::ViewOutput::Composite;
+      view.masked = masked;
+      view.raster.refraction = refraction;
+      render::fitDepthRange(view.settings.view, lo, hi, view.raster);
+    }
+    render::FrameRequest request;
+    request.pose = &pose;
+    request.views.push_back(view);
+    const render::FrameResult& result = renderer.wait(renderer.submit(request));
+    // The first build happens once, on the first frame: report it even though it is warm-up.
+    bool measured = f >= warmup;
+    double total = 0, refractionTotal = 0;
+    for (const vk::PassTime& p : result.passes) {
+      if (!measured && !(f == 0 && p.name == "blas build")) continue;
       if (!times.count(p.name)) order.push_back(p.name);
       times[p.name].push_back(p.milliseconds);
+      if (p.name == "blas build" && f == 0) continue;
+      total += p.milliseconds;
+      if (refractionPass(p.name)) refractionTotal += p.milliseconds;
     }
+    if (!measured) continue;
+    totals.push_back(total);
+    refractionTotals.push_back(refractionTotal);
+    const render::FrameStats& s = result.stats;
+    counters["items deformed"].push_back(s.itemsDeformed);
+    counters["trees refit"].push_back(s.treesRefit);
+    counters["trees rebuilt"].push_back(s.treesBuilt);
+    counters["triangles refit"].push_back(double(s.trianglesRefit));
+    counters["pixels traced"].push_back(double(s.pixelsTraced));
+    counters["dispatches"].push_back(s.dispatches);
+    counters["draws"].push_back(s.draws);
   }
 
-  std::printf("%-12s %10s %10s %10s %7s\n", "pass", "median ms", "min ms", "max ms", "frames");
-  double total = 0;
+  std::printf("%-16s %10s %10s %10s %7s\n", "pass", "median ms", "min ms", "max ms", "frames");
   for (const std::string& name : order) {
     const std::vector<double>& v = times[name];
-    double m = median(v);
-    if (name != "blas build") total += m;
-    std::printf("%-12s %10.4f %10.4f %10.4f %7zu\n", name.c_str(), m, *std::min_element(v.begin(), v.end()),
+    std::printf("%-16s %10.4f %10.4f %10.4f %7zu\n", name.c_str(), median(v), *std::min_element(v.begin(), v.end()),
                 *std::max_element(v.begin(), v.end()), v.size());
   }
-  std::printf("%-12s %10.4f   (per animated frame: deform + refit + tlas + trace)\n", "frame", total);
-  std::printf("GPU memory (geometry, BVHs, per-frame buffers): %.2f MiB; image %.2f MiB\n",
-              double(renderer.memoryBytes()) / 1048576.0, double(width) * height * 8 / 1048576.0);
+  std::printf("%-16s %10.4f   (median of each animated frame's passes)\n", "frame", median(totals));
+  std::printf("%-16s %10.4f   (deform + trees + trace), %.2f%% of a 60 Hz frame\n", "refraction",
+              median(refractionTotals), 100.0 * median(refractionTotals) / (1000.0 / 60.0));
+  std::printf("per frame (medians):");
+  for (const std::string& c : counterOrder) std::printf(" %s %.0f,", c.c_str(), median(counters[c]));
+  std::printf("\nGPU memory (geometry, deformation, trees, per-frame tables): %.2f MiB, trees %.1f bytes per triangle\n",
+              double(renderer.memoryBytes()) / 1048576.0, renderer.treeBytesPerTriangle());
   if (!json.empty()) {
     std::ofstream out(json);
-    out << "{\n  \"device\": \"" << context->facts().name << "\",\n  \"scene\": \"" << label << "\",\n  \"triangles\": "
-        << summary.triangles << ",\n  \"width\": " << width << ",\n  \"height\": " << height
-        << ",\n  \"memory_bytes\": " << renderer.memoryBytes() << ",\n  \"passes\": [\n";
+    out << "{\n  \"device\": \"" << jsonEscape(context->facts().name) << "\",\n  \"scene\": \"" << jsonEscape(label)
+        << "\",\n  \"mode\": \"" << mode << "\",\n  \"triangles\": " << summary.triangles << ",\n  \"width\": " << width
+        << ",\n  \"height\": " << height << ",\n  \"memory_bytes\": " << renderer.memoryBytes()
+        << ",\n  \"tree_bytes_per_triangle\": " << renderer.treeBytesPerTriangle() << ",\n  \"passes\": [\n";
     for (size_t i = 0; i < order.size(); ++i) {
       const std::vector<double>& v = times[order[i]];
       out << "    {\"pass\": \"" << order[i] << "\", \"median_ms\": " << median(v)
@@ -127,7 +204,12 @@ int runBenchFrame(const Args& args) {
           << ", \"max_ms\": " << *std::max_element(v.begin(), v.end()) << ", \"frames\": " << v.size() << "}"
           << (i + 1 < order.size() ? "," : "") << "\n";
     }
-    out << "  ],\n  \"frame_median_ms\": " << total << "\n}\n";
+    out << "  ],\n  \"frame_median_ms\": " << median(totals) << ",\n  \"refraction_median_ms\": "
+        << median(refractionTotals) << ",\n  \"counters_median\": {";
+    for (size_t i = 0; i < counterOrder.size(); ++i) {
+      out << (i ? ", " : "") << "\"" << counterOrder[i] << "\": " << median(counters[counterOrder[i]]);
+    }
+    out << "}\n}\n";
     if (!out) throw std::runtime_error(json + ": could not write");
   }
   return 0;

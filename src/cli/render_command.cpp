@@ -244,7 +244,7 @@ int runRender(const Args& args) {
       glm::dvec3 lo, hi;
       scene::sceneBounds(scene, pose, lo, hi);
       render::fitDepthRange(view, lo, hi, o.raster);
-      image.rgba = render::renderComposite(*context, *renderer, pose, settings, o.raster).rgba;
+      image.rgba = render::renderComposite(*context, *renderer, pose, settings, o.raster, false, true).rgba;
     } else {
       render::FrameSettings settings{o.width, o.height, view, o.background, o.maxInterfaces};
       image.rgba = render::renderFrame(*context, *renderer, pose, settings).rgba;

@@ -98,7 +98,7 @@ Bvh BvhBuilder::makeBvh(const std::vector<uint32_t>& groupSizes, BvhLeaves leave
   size_t groupCount = std::max<size_t>(groupSizes.size(), 1);
   bvh.nodes = deviceBuffer(context_, primitives * sizeof(gpu::BvhNode), name + " nodes");
   bvh.groups = deviceBuffer(context_, groupCount * sizeof(gpu::BvhGroup), name + " groups");
-  bvh.stats = deviceBuffer(context_, groupCount * 8, name + " SAH statistics");
+  bvh.stats = deviceBuffer(context_, groupCount * 16, name + " SAH statistics");
   bvh.dropped = deviceBuffer(context_, 4, name + " dropped triangles");
   bvh.buildEntries = deviceBuffer(context_, groupCount * sizeof(gpu::BvhBuildEntry), name + " build list");
   bvh.refitEntries = deviceBuffer(context_, groupCount * sizeof(gpu::BvhRefitEntry), name + " refit list");
@@ -292,23 +292,19 @@ BvhSnapshot BvhBuilder::download(const Bvh& bvh) const {
   BvhSnapshot s;
   s.nodes.resize(bvh.primitiveCount);
   s.groups.resize(std::max<size_t>(bvh.groupSizes.size(), 1));
-  std::vector<glm::uvec2> stats(s.groups.size());
+  std::vector<glm::uvec4> stats(s.groups.size());
   vk::download(context_, bvh.nodes, s.nodes.data(), s.nodes.size() * sizeof(gpu::BvhNode));
   vk::download(context_, bvh.groups, s.groups.data(), s.groups.size() * sizeof(gpu::BvhGroup));
-  vk::download(context_, bvh.stats, stats.data(), stats.size() * 8);
-  for (const glm::uvec2& v : stats) s.sah.push_back(uint64_t(v.x) | (uint64_t(v.y) << 32));
+  vk::download(context_, bvh.stats, stats.data(), stats.size() * 16);
+  for (const glm::uvec4& v : stats) s.sah.push_back(sahCost(v));
   return s;
 }
 
-double BvhBuilder::sahCost(uint64_t fixedPointSum, const gpu::BvhGroup& group) {
-  double dx = double(group.boxHi[0]) - group.boxLo[0], dy = double(group.boxHi[1]) - group.boxLo[1],
-         dz = double(group.boxHi[2]) - group.boxLo[2];
-  dx = std::max(dx, 0.0);
-  dy = std::max(dy, 0.0);
-  dz = std::max(dz, 0.0);
-  double area = 2.0 * (dx * dy + dy * dz + dz * dx);
-  if (!(area > 0.0)) return 0.0;
-  return double(fixedPointSum) / gpu::kBvhSahScale * std::max<double>(group.buildArea, 1e-30) / area;
+double BvhBuilder::sahCost(const glm::uvec4& stats) {
+  double sum = double(uint64_t(stats.x) | (uint64_t(stats.y) << 32)) / gpu::kBvhSahScale;
+  float rootArea = std::bit_cast<float>(stats.z), buildArea = std::bit_cast<float>(stats.w);
+  if (!(rootArea > 0.0f)) return 0.0;
+  return sum * std::max(double(buildArea), 1e-30) / double(rootArea);
 }
 
 BvhSnapshot::TreeBoxes BvhSnapshot::treeBoxes(uint32_t group) const {

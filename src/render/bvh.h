@@ -45,7 +45,7 @@ struct Bvh {
   uint32_t primitiveCount = 0;
   vk::Buffer nodes;    ///< gpu::BvhNode per primitive (one slot per group unused)
   vk::Buffer groups;   ///< gpu::BvhGroup per group
-  vk::Buffer stats;    ///< uvec2 per group: fixed-point SAH of its last refit
+  vk::Buffer stats;    ///< uvec4 per group: its last refit's SAH (BvhBuilder::sahCost reads it)
   vk::Buffer dropped;  ///< uint: non-finite triangles the box passes met since the caller last zeroed it
   vk::Buffer buildEntries, refitEntries;  ///< this forest's lists, copied in per build or refit
 
@@ -68,7 +68,7 @@ struct BvhSnapshot {
 
   std::vector<gpu::BvhNode> nodes;
   std::vector<gpu::BvhGroup> groups;
-  std::vector<uint64_t> sah;  ///< per group: fixed-point SAH sum of the last refit
+  std::vector<double> sah;  ///< per group: SAH cost its last refit measured (a multiple of the root's area)
 };
 
 /// What the leaves are boxed from: triangles (positions, indices), or instances
@@ -109,9 +109,9 @@ class BvhBuilder {
   void releaseScratch();
   uint64_t scratchBytes() const;
 
-  /// The normalised SAH cost (a multiple of the root's area) of the
-  /// fixed-point sum a refit wrote for `group`, whose root box it reads.
-  static double sahCost(uint64_t fixedPointSum, const gpu::BvhGroup& group);
+  /// The SAH cost (a multiple of the root's area) a refit measured, from its
+  /// entry in Bvh::stats: 0 for a group it did not refit.
+  static double sahCost(const glm::uvec4& stats);
 
  private:
   struct Scratch;

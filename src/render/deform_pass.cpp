@@ -6,7 +6,10 @@
 
 #include "deform.spv.h"
 
+#include <glm/gtc/matrix_transform.hpp>
+
 #include <cstring>
+#include <numeric>
 
 namespace snell::render {
 
@@ -18,40 +21,9 @@ constexpr VkBufferUsageFlags kStorage =
 
 template <typename T>
 vk::Buffer uploaded(vk::Context& context, const std::vector<T>& data, const std::string& name) {
-  vk::Buffer buffer(context, {data.size() * sizeof(T), kStorage, vk::MemoryDomain::Device, name});
-  vk::upload(context, buffer, data.data(), data.size() * sizeof(T));
+  vk::Buffer buffer(context, {std::max<VkDeviceSize>(data.size() * sizeof(T), 16), kStorage, vk::MemoryDomain::Device, name});
+  if (!data.empty()) vk::upload(context, buffer, data.data(), data.size() * sizeof(T));
   return buffer;
-}
-
-std::vector<float> flatten(const std::vector<glm::vec3>& v) {
-  std::vector<float> out(v.size() * 3);
-  std::memcpy(out.data(), v.data(), out.size() * sizeof(float));
-  return out;
-}
-
-std::unique_ptr<DeformInputs> uploadShape(vk::Context& context, const scene::Shape& shape) {
-  auto inputs = std::make_unique<DeformInputs>();
-  inputs->vertexCount = static_cast<uint32_t>(shape.vertexCount());
-  inputs->targetCount = static_cast<uint32_t>(shape.targets.size());
-  inputs->positions = uploaded(context, flatten(shape.positions), shape.name + " rest positions");
-  inputs->normals = uploaded(context, flatten(shape.normals), shape.name + " rest normals");
-  if (!shape.targets.empty()) {
-    std::vector<float> deltas(size_t(6) * shape.targets.size() * shape.vertexCount(), 0.0f);
-    for (size_t t = 0; t < shape.targets.size(); ++t) {
-      const scene::MorphTarget& target = shape.targets[t];
-      for (size_t v = 0; v < shape.vertexCount(); ++v) {
-        float* d = &deltas[6 * (t * shape.vertexCount() + v)];
-        if (!target.positions.empty()) std::memcpy(d, &target.positions[v], 12);
-        if (!target.normals.empty()) std::memcpy(d + 3, &target.normals[v], 12);
-      }
-    }
-    inputs->morphDeltas = uploaded(context, deltas, shape.name + " morph deltas");
-  }
-  if (shape.skinned()) {
-    inputs->joints = uploaded(context, shape.joints, shape.name + " joints");
-    inputs->skinWeights = uploaded(context, shape.weights, shape.name + " skin weights");
-  }
-  return inputs;
 }
 
 }  // namespace
@@ -61,71 +33,155 @@ DeformPass::DeformPass(vk::Context& context, const scene::Scene& scene, const sc
     : context_(context), scene_(scene) {
   program_ = std::make_unique<vk::ComputeProgram>(
       context, vk::ComputeProgramDesc{"deform", kSpvDeform, {{gpu::kDeformSpecWorkgroupSize, kWorkgroupSize}}, false});
-  empty_ = vk::Buffer(context, {16, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, vk::MemoryDomain::Device, "deform placeholder"});
-  inputs_.resize(scene.shapes.size());
+  shapes_.resize(scene.shapes.size());
+  std::vector<float> restPositions, restNormals, morphDeltas;
+  std::vector<glm::uvec4> joints;
+  std::vector<glm::vec4> skinWeights;
+  uint32_t ownVertices = 0, weightCapacity = 0, jointCapacity = 0;
   for (size_t i = 0; i < layout.items.size(); ++i) {
     const scene::DrawItem& item = layout.items[i];
     if (!item.deforms()) continue;
     const scene::Shape& shape = scene.shapes[size_t(item.shape)];
-    if (!inputs_[size_t(item.shape)]) inputs_[size_t(item.shape)] = uploadShape(context, shape);
+    ShapeData& data = shapes_[size_t(item.shape)];
+    if (!data.uploaded) {
+      // Each deforming shape's rest pose once, however many items draw it.
+      data.uploaded = true;
+      data.vertexCount = static_cast<uint32_t>(shape.vertexCount());
+      data.targetCount = static_cast<uint32_t>(shape.targets.size());
+      data.restFirst = static_cast<uint32_t>(restPositions.size() / 3);
+      data.morphFirst = static_cast<uint32_t>(morphDeltas.size());
+      data.skinFirst = static_cast<uint32_t>(joints.size());
+      for (size_t v = 0; v < shape.vertexCount(); ++v) {
+        const glm::vec3& p = shape.positions[v];
+        glm::vec3 n = v < shape.normals.size() ? shape.normals[v] : glm::vec3(0.0f);
+        restPositions.insert(restPositions.end(), {p.x, p.y, p.z});
+        restNormals.insert(restNormals.end(), {n.x, n.y, n.z});
+      }
+      for (const scene::MorphTarget& target : shape.targets) {
+        for (size_t v = 0; v < shape.vertexCount(); ++v) {
+          glm::vec3 dp = target.positions.empty() ? glm::vec3(0.0f) : target.positions[v];
+          glm::vec3 dn = target.normals.empty() ? glm::vec3(0.0f) : target.normals[v];
+          morphDeltas.insert(morphDeltas.end(), {dp.x, dp.y, dp.z, dn.x, dn.y, dn.z});
+        }
+      }
+      if (shape.skinned()) {
+        joints.insert(joints.end(), shape.joints.begin(), shape.joints.end());
+        skinWeights.insert(skinWeights.end(), shape.weights.begin(), shape.weights.end());
+      }
+    }
     DeformOutput out;
     out.item = static_cast<int>(i);
     out.shape = item.shape;
     out.jointCount = static_cast<uint32_t>(item.jointMatrices.size());
-    std::string name = shape.name + " (item " + std::to_string(i) + ")";
-    VkDeviceSize floats3 = shape.vertexCount() * 12;
-    out.morphWeights = vk::Buffer(context, {std::max<size_t>(shape.targets.size(), 1) * 4, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
-                                            vk::MemoryDomain::Upload, name + " morph weights"});
-    out.jointMatrices = vk::Buffer(context, {std::max<size_t>(out.jointCount, 1) * sizeof(glm::mat4),
-                                             VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, vk::MemoryDomain::Upload,
-                                             name + " joint matrices"});
     if (slots) {
       out.slot = slots(static_cast<int>(i));
     } else {
-      out.ownPositions = vk::Buffer(context, {floats3, kStorage, vk::MemoryDomain::Device, name + " deformed positions"});
-      out.ownNormals = vk::Buffer(context, {floats3, kStorage, vk::MemoryDomain::Device, name + " deformed normals"});
+      out.slot.firstVertex = ownVertices;
+      ownVertices += data.vertexCount;
     }
-    outputs_.push_back(std::move(out));
+    weightCapacity += data.targetCount;
+    jointCapacity += out.jointCount;
+    outputs_.push_back(out);
   }
-  // Pointers into outputs_ are taken once it no longer grows.
-  for (DeformOutput& out : outputs_) {
-    if (!out.slot.positions) out.slot = {&out.ownPositions, &out.ownNormals, 0};
+  std::string name = scene.source.empty() ? std::string("scene") : scene.source;
+  restPositions_ = uploaded(context, restPositions, name + " rest positions");
+  restNormals_ = uploaded(context, restNormals, name + " rest normals");
+  morphDeltas_ = uploaded(context, morphDeltas, name + " morph deltas");
+  joints_ = uploaded(context, joints, name + " skin joints");
+  skinWeights_ = uploaded(context, skinWeights, name + " skin weights");
+  auto device = [&](VkDeviceSize bytes, const std::string& what) {
+    return vk::Buffer(context, {std::max<VkDeviceSize>(bytes, 16), kStorage, vk::MemoryDomain::Device, name + " " + what});
+  };
+  jobs_ = device(outputs_.size() * sizeof(gpu::DeformJob), "deform jobs");
+  weights_ = device(weightCapacity * 4ull, "morph weights");
+  jointMatrices_ = device(jointCapacity * sizeof(glm::mat4), "joint matrices");
+  if (!slots) {
+    ownPositions_ = device(ownVertices * 12ull, "deformed positions");
+    ownNormals_ = device(ownVertices * 12ull, "deformed normals");
+    for (DeformOutput& out : outputs_) out.slot.positions = &ownPositions_, out.slot.normals = &ownNormals_;
+  }
+  for (const DeformOutput& out : outputs_) {
+    if (out.slot.positions != outputs_.front().slot.positions || out.slot.normals != outputs_.front().slot.normals) {
+      throw vk::VulkanError("deform pass: every item must write into the same vertex buffers");
+    }
   }
 }
 
-void DeformPass::record(vk::Commands& commands, const scene::Pose& pose, const glm::dvec3& origin) {
-  const glm::dmat4 rebase = glm::translate(glm::dmat4(1.0), -origin);
-  for (DeformOutput& out : outputs_) {
+glm::dvec3 DeformPass::anchorOf(const scene::DrawItem& item) {
+  if (!item.skinned || item.jointMatrices.empty()) return glm::dvec3(0.0);
+  return glm::dvec3(item.jointMatrices.front()[3]);
+}
+
+void DeformPass::record(vk::Commands& commands, const scene::Pose& pose, vk::UploadArena& arena,
+                        std::span<const uint32_t> which) {
+  std::vector<uint32_t> all;
+  if (which.empty()) {
+    all.resize(outputs_.size());
+    std::iota(all.begin(), all.end(), 0u);
+    which = all;
+  }
+  std::vector<gpu::DeformJob> jobs;
+  std::vector<float> weights;
+  std::vector<glm::mat4> matrices;
+  uint32_t threads = 0;
+  for (uint32_t o : which) {
+    DeformOutput& out = outputs_.at(o);
     const scene::DrawItem* found = static_cast<size_t>(out.item) < pose.items.size() ? &pose.items[size_t(out.item)] : nullptr;
     if (!found || found->scene != &scene_ || found->shape != out.shape || found->jointMatrices.size() != out.jointCount) {
       throw vk::VulkanError("deform pass: the pose is not of the scene and draw items it was built for");
     }
     const scene::DrawItem& item = *found;
-    const DeformInputs& in = *inputs_[size_t(out.shape)];
-    uint32_t targets = std::min<uint32_t>(in.targetCount, static_cast<uint32_t>(item.weights.size()));
-    if (targets) std::memcpy(out.morphWeights.mapped().data(), item.weights.data(), targets * sizeof(float));
-    if (out.jointCount) {
-      auto* matrices = reinterpret_cast<glm::mat4*>(out.jointMatrices.mapped().data());
-      for (uint32_t j = 0; j < out.jointCount; ++j) matrices[j] = glm::mat4(rebase * item.jointMatrices[j]);
-    }
-    gpu::DeformPush push{in.vertexCount, targets, item.skinned ? out.jointCount : 0u, out.slot.firstVertex};
-    auto orEmpty = [&](const vk::Buffer& b) { return b.handle() ? &b : &empty_; };
-    program_->dispatchThreads(commands,
-                              {{gpu::kDeformBindingRestPositions, &in.positions},
-                               {gpu::kDeformBindingRestNormals, &in.normals},
-                               {gpu::kDeformBindingMorphDeltas, orEmpty(in.morphDeltas)},
-                               {gpu::kDeformBindingMorphWeights, &out.morphWeights},
-                               {gpu::kDeformBindingJoints, orEmpty(in.joints)},
-                               {gpu::kDeformBindingSkinWeights, orEmpty(in.skinWeights)},
-                               {gpu::kDeformBindingJointMatrices, &out.jointMatrices},
-                               {gpu::kDeformBindingPositions, out.slot.positions},
-                               {gpu::kDeformBindingNormals, out.slot.normals}},
-                              push, in.vertexCount);
+    const ShapeData& shape = shapes_[size_t(out.shape)];
+    gpu::DeformJob job{};
+    job.threadBase = threads;
+    job.vertexCount = shape.vertexCount;
+    job.restFirst = shape.restFirst;
+    job.outputFirst = out.slot.firstVertex;
+    job.morphFirst = shape.morphFirst;
+    job.targetCount = std::min<uint32_t>(shape.targetCount, static_cast<uint32_t>(item.weights.size()));
+    job.weightFirst = static_cast<uint32_t>(weights.size());
+    job.skinFirst = shape.skinFirst;
+    job.jointFirst = static_cast<uint32_t>(matrices.size());
+    job.jointCount = item.skinned ? out.jointCount : 0u;
+    weights.insert(weights.end(), item.weights.begin(), item.weights.begin() + job.targetCount);
+    // Joint matrices moved to the anchor in double, before the cast to float.
+    out.anchor = anchorOf(item);
+    const glm::dmat4 rebase = glm::translate(glm::dmat4(1.0), -out.anchor);
+    for (uint32_t j = 0; j < job.jointCount; ++j) matrices.push_back(glm::mat4(rebase * item.jointMatrices[j]));
+    threads += shape.vertexCount;
+    jobs.push_back(job);
   }
-  if (!outputs_.empty()) {
-    commands.computeToCompute();
-    commands.computeToTransfer();
+  if (jobs.empty()) return;
+  arena.copy(commands, jobs, jobs_);
+  arena.copy(commands, weights, weights_);
+  arena.copy(commands, matrices, jointMatrices_);
+  commands.transferToCompute();
+  gpu::DeformPush push{threads, static_cast<uint32_t>(jobs.size()), 0, 0};
+  const DeformSlot& slot = outputs_.front().slot;
+  program_->dispatchThreads(commands,
+                            {{gpu::kDeformBindingRestPositions, &restPositions_},
+                             {gpu::kDeformBindingRestNormals, &restNormals_},
+                             {gpu::kDeformBindingMorphDeltas, &morphDeltas_},
+                             {gpu::kDeformBindingMorphWeights, &weights_},
+                             {gpu::kDeformBindingJoints, &joints_},
+                             {gpu::kDeformBindingSkinWeights, &skinWeights_},
+                             {gpu::kDeformBindingJointMatrices, &jointMatrices_},
+                             {gpu::kDeformBindingPositions, slot.positions},
+                             {gpu::kDeformBindingNormals, slot.normals},
+                             {gpu::kDeformBindingJobs, &jobs_}},
+                            push, threads);
+  commands.computeToCompute();
+  commands.computeToGraphics();
+  commands.computeToTransfer();
+}
+
+uint64_t DeformPass::bytes() const {
+  uint64_t total = 0;
+  for (const vk::Buffer* b : {&restPositions_, &restNormals_, &morphDeltas_, &joints_, &skinWeights_, &jobs_, &weights_,
+                              &jointMatrices_, &ownPositions_, &ownNormals_}) {
+    total += b->size();
   }
+  return total;
 }
 
 }  // namespace snell::render

@@ -1,6 +1,7 @@
 // The deform pass, first of every frame: for each drawn shape that is morphed
-// or skinned, morph targets then linear blend skinning on the GPU, into
-// storage buffers the BVH and raster passes read. Static shapes skip it.
+// or skinned and whose pose changed, morph targets then linear blend skinning
+// on the GPU, into storage buffers the BVH and raster passes read. All of a
+// frame's items go in one dispatch, whatever their number; static shapes skip it.
 #pragma once
 
 #include "scene/evaluate.h"
@@ -9,67 +10,73 @@
 #include "vk/commands.h"
 #include "vk/compute_program.h"
 #include "vk/context.h"
+#include "vk/upload_arena.h"
 
 #include <functional>
 #include <memory>
+#include <span>
 #include <vector>
 
 namespace snell::render {
 
-/// A shape's rest pose on the GPU: uploaded once, shared by its instances.
-struct DeformInputs {
-  uint32_t vertexCount = 0;
-  uint32_t targetCount = 0;
-  vk::Buffer positions, normals, morphDeltas, joints, skinWeights;
-};
-
 /// Where a deforming item's vertices go: a slice of vertex buffers shared
-/// with the BVH and raster passes (packed float triples).
+/// with the BVH and raster passes (packed float triples). Every item of one
+/// pass writes into the same two buffers.
 struct DeformSlot {
   const vk::Buffer* positions = nullptr;
   const vk::Buffer* normals = nullptr;
   uint32_t firstVertex = 0;
 };
 
-/// One deforming draw item: its per-frame weights and joint matrices (host
-/// visible, written by record) and where its deformed geometry goes.
+/// One deforming draw item and where its deformed geometry goes.
 struct DeformOutput {
   int item = -1;   ///< index into Pose::items
   int shape = -1;
   uint32_t jointCount = 0;
-  vk::Buffer morphWeights, jointMatrices;
-  DeformSlot slot;  ///< the caller's buffers, or ownPositions/ownNormals
-  vk::Buffer ownPositions, ownNormals;
+  DeformSlot slot;
+  /// Skinned positions of the last record are relative to this world point
+  /// (DeformPass::anchorOf); zero for morph-only items, which stay in shape space.
+  glm::dvec3 anchor{0.0};
 };
 
 class DeformPass {
  public:
-  /// Uploads every shape that some item deforms and allocates an output per
-  /// deforming item of `layout` (a pose of `scene` at any time: which items
-  /// exist does not depend on time).
-  /// `slots` gives the output slice of each deforming item (by pose item
-  /// index); without it each item gets buffers of its own.
+  /// Uploads every shape that some item deforms and an output per deforming
+  /// item of `layout` (a pose of `scene` at any time: which items exist does
+  /// not depend on time). `slots` gives the output slice of each deforming
+  /// item (by pose item index); without it the pass owns one pair of buffers.
   DeformPass(vk::Context& context, const scene::Scene& scene, const scene::Pose& layout,
              const std::function<DeformSlot(int item)>& slots = {});
 
-  /// Writes the pose's weights and joint matrices and records one dispatch
-  /// per deforming item, then a barrier that makes the outputs visible to
-  /// compute and transfer. The host writes shared buffers: the previous
-  /// frame's deform must have finished.
-  /// Skinned positions come out relative to `origin` (the camera, for the
-  /// renderer): the joint matrices are moved there in double, so a character
-  /// far from the world's origin keeps float precision where it is.
-  void record(vk::Commands& commands, const scene::Pose& pose, const glm::dvec3& origin = glm::dvec3(0.0));
+  /// Where a skinned item's deformed positions are measured from: its first
+  /// joint's world position, so they keep float precision however far the
+  /// character is from the world's origin, and move only when it does.
+  static glm::dvec3 anchorOf(const scene::DrawItem& item);
+
+  /// Records one dispatch deforming the outputs listed (indices into
+  /// outputs(); every one when `which` is empty) to `pose`, then a barrier
+  /// that makes them visible to compute, graphics and transfer. Weights,
+  /// joint matrices and the job list go through `arena`.
+  void record(vk::Commands& commands, const scene::Pose& pose, vk::UploadArena& arena,
+              std::span<const uint32_t> which = {});
 
   const std::vector<DeformOutput>& outputs() const { return outputs_; }
+  /// GPU memory of the rest poses, morph deltas, skins and per-frame tables.
+  uint64_t bytes() const;
 
  private:
+  struct ShapeData {
+    uint32_t restFirst = 0, morphFirst = 0, skinFirst = 0, vertexCount = 0, targetCount = 0;
+    bool uploaded = false;
+  };
   vk::Context& context_;
   const scene::Scene& scene_;
   std::unique_ptr<vk::ComputeProgram> program_;
-  std::vector<std::unique_ptr<DeformInputs>> inputs_;  ///< per shape; null when it never deforms
+  std::vector<ShapeData> shapes_;  ///< per scene shape
   std::vector<DeformOutput> outputs_;
-  vk::Buffer empty_;  ///< bound where a shape has no morph targets or no skin
+  vk::Buffer restPositions_, restNormals_, morphDeltas_, joints_, skinWeights_;
+  vk::Buffer jobs_, weights_, jointMatrices_;  ///< device-local, rewritten per record
+  vk::Buffer ownPositions_, ownNormals_;       ///< when no slots were given
 };
 
 }  // namespace snell::render

@@ -24,13 +24,11 @@ static_assert(offsetof(SortPush, blockCount) == 4);
 static_assert(offsetof(SortPush, shift) == 8);
 static_assert(kSortRadix == 1u << kSortRadixBits);
 
-static_assert(sizeof(DeformPush) == 16);
-static_assert(offsetof(DeformPush, vertexCount) == 0);
-static_assert(offsetof(DeformPush, targetCount) == 4);
-static_assert(offsetof(DeformPush, jointCount) == 8);
+static_assert(sizeof(DeformPush) == 16 && offsetof(DeformPush, jobCount) == 4);
+static_assert(sizeof(DeformJob) == 48 && offsetof(DeformJob, outputFirst) == 12 && offsetof(DeformJob, skinFirst) == 28 &&
+              offsetof(DeformJob, jointCount) == 36);
 // deform.comp reads these as std430 uvec4[], vec4[] and mat4[].
 static_assert(sizeof(glm::uvec4) == 16 && sizeof(glm::vec4) == 16 && sizeof(glm::mat4) == 64);
-static_assert(offsetof(DeformPush, outputFirst) == 12);
 
 static_assert(sizeof(BvhNode) == 64 && offsetof(BvhNode, child) == 48 && offsetof(BvhNode, parent) == 56 &&
               offsetof(BvhNode, arrivals) == 60);
@@ -49,6 +47,8 @@ static_assert(sizeof(GpuTexture) == 16 && offsetof(GpuTexture, flags) == 12);
 static_assert(sizeof(GpuLight) == 64 && offsetof(GpuLight, cone) == 48);
 static_assert(sizeof(TraceAov) == 32 && offsetof(TraceAov, nodeVisits) == 20);
 static_assert(sizeof(GpuRay) == 32 && offsetof(GpuRay, direction) == 16);
+static_assert(sizeof(TracePixelListHeader) == 32 && offsetof(TracePixelListHeader, dispatchX) == kTracePixelListDispatchOffset);
+static_assert(sizeof(TraceCompactPush) == 16 && offsetof(TraceCompactPush, maxGroupsX) == 12);
 static_assert(sizeof(PresentPush) == 48 && offsetof(PresentPush, gate) == 16 && offsetof(PresentPush, flags) == 32);
 static_assert(sizeof(RasterPush) == 96 && offsetof(RasterPush, flags) == 80 && offsetof(RasterPush, lightCount) == 84);
 static_assert(sizeof(TracePush) == 112 && offsetof(TracePush, eye) == 64 && offsetof(TracePush, width) == 80 &&

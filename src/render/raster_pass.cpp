@@ -1,11 +1,11 @@
 // The raster pass: one draw per draw item over the trace's own buffers.
 #include "render/raster_pass.h"
 
-#include "shared/raster.h"
 #include "vk/error.h"
 
 #include "raster_depth.spv.h"
 #include "raster_fragment.spv.h"
+#include "raster_mask.spv.h"
 #include "raster_vertex.spv.h"
 
 #include <algorithm>
@@ -48,6 +48,11 @@ RasterPass::RasterPass(vk::Context& context) : context_(context) {
   depthOnly.fragmentSpirv = kSpvRasterDepth;
   depthOnly.colorWrite = false;
   depth_ = std::make_unique<vk::GraphicsProgram>(context, depthOnly);
+  vk::GraphicsProgramDesc mask = desc;
+  mask.name = "raster depth and mask";
+  mask.fragmentSpirv = kSpvRasterMask;
+  mask.colorFormat = kMaskFormat;
+  mask_ = std::make_unique<vk::GraphicsProgram>(context, mask);
   desc.depthCompare = VK_COMPARE_OP_EQUAL;  // only the fragment the pre-pass kept
   desc.depthWrite = false;
   fill_ = std::make_unique<vk::GraphicsProgram>(context, desc);
@@ -64,9 +69,67 @@ RasterPass::RasterPass(vk::Context& context) : context_(context) {
 
 RasterPass::~RasterPass() = default;
 
-void RasterPass::record(vk::Commands& commands, const Renderer& renderer, const FrameSettings& settings,
-                        const vk::Image& traceImage, const vk::Image& target, const vk::Image& depth,
-                        const RasterOptions& options) const {
+gpu::RasterPush RasterPass::push(const RasterScene& scene, const FrameSettings& settings,
+                                 const RasterOptions& options) const {
+  const scene::View& v = settings.view;
+  double aspect = double(settings.width) / double(settings.height);
+  gpu::RasterPush push{};
+  push.right = glm::vec4(glm::vec3(v.right), float(1.0 / (v.halfHeight * aspect)));
+  push.up = glm::vec4(glm::vec3(v.up), float(1.0 / v.halfHeight));
+  push.forward = glm::vec4(glm::vec3(v.forward), float(options.nearPlane));
+  push.eye = glm::vec4(glm::vec3(v.eye - scene.origin), float(options.farPlane));
+  push.wireColor = options.wireColor;
+  push.flags = v.orthographic ? gpu::kRasterFlagOrthographic : 0u;
+  push.lightCount = scene.lightCount;
+  push.shiftX = float(v.shift.x);
+  push.shiftY = float(v.shift.y);
+  return push;
+}
+
+void RasterPass::drawItems(vk::Commands& commands, const vk::GraphicsProgram& program, const RasterScene& scene,
+                           const RasterOptions& options, const gpu::RasterPush& push,
+                           std::span<const vk::BufferBinding> resources, VkRect2D area) const {
+  program.bind(commands, resources, area);
+  const SceneGpu& gpuScene = *scene.scene;
+  for (size_t item = 0; item < gpuScene.itemGeometry.size(); ++item) {
+    const GeometryRange& g = gpuScene.geometries[gpuScene.itemGeometry[item]];
+    // Without refraction glass is left out and seen straight through, as IOR 1 would show it.
+    if (!options.refraction && gpuScene.itemRefractive[item]) continue;
+    program.draw(commands, push, 3 * g.triangleCount, 3 * g.firstTriangle, static_cast<uint32_t>(item));
+  }
+}
+
+void RasterPass::recordDepth(vk::Commands& commands, const RasterScene& scene, const FrameSettings& settings,
+                             const RasterOptions& options, const vk::Image& depth, const vk::Image* mask,
+                             const vk::Image& colorTarget) const {
+  for (const vk::Image* image : {&depth, mask, &colorTarget}) {
+    if (image && (image->width() != settings.width || image->height() != settings.height)) {
+      throw vk::VulkanError("raster pass: image '" + image->name() + "' is not the frame's size");
+    }
+  }
+  commands.beginPass("raster depth");
+  VkRect2D area{{0, 0}, {settings.width, settings.height}};
+  const float clearMask[4] = {0.0f, 0.0f, 0.0f, 0.0f};  // the uint attachment clears to 0
+  {
+    vk::RenderingScope scope(commands, mask ? *mask : colorTarget, &depth, area, mask ? clearMask : nullptr, true);
+    const SceneGpu& s = *scene.scene;
+    const vk::BufferBinding vertexStage[] = {{gpu::kRasterBindingInstances, scene.instances},
+                                             {gpu::kRasterBindingPositions, &s.positions},
+                                             {gpu::kRasterBindingNormals, &s.normals},
+                                             {gpu::kRasterBindingTexcoords, &s.texcoords},
+                                             {gpu::kRasterBindingIndices, &s.indices},
+                                             {gpu::kRasterBindingMaterials, &s.materials}};
+    static_assert(gpu::kRasterBindingInstances == 0 && gpu::kRasterBindingMaterials == gpu::kRasterBindingIndices + 1);
+    // The mask's fragment shader also reads the materials.
+    drawItems(commands, mask ? *mask_ : *depth_, scene, options, push(scene, settings, options),
+              std::span(vertexStage).first(mask ? 6 : 5), area);
+  }
+  commands.endPass();
+}
+
+void RasterPass::recordShading(vk::Commands& commands, const RasterScene& scene, const FrameSettings& settings,
+                               const RasterOptions& options, const vk::Image& traceImage, const vk::Image& target,
+                               const vk::Image& depth) const {
   for (const vk::Image* image : {&traceImage, &target, &depth}) {
     if (image->width() != settings.width || image->height() != settings.height) {
       throw vk::VulkanError("raster pass: image '" + image->name() + "' is not the frame's size");
@@ -75,91 +138,35 @@ void RasterPass::record(vk::Commands& commands, const Renderer& renderer, const 
   if (options.wireframe && !wire_) {
     throw vk::VulkanError("raster pass: this device cannot draw wireframes (no fillModeNonSolid)");
   }
-  const scene::View& v = settings.view;
-  double aspect = double(settings.width) / double(settings.height);
-  gpu::RasterPush push{};
-  push.right = glm::vec4(glm::vec3(v.right), float(1.0 / (v.halfHeight * aspect)));
-  push.up = glm::vec4(glm::vec3(v.up), float(1.0 / v.halfHeight));
-  push.forward = glm::vec4(glm::vec3(v.forward), float(options.nearPlane));
-  push.eye = glm::vec4(glm::vec3(v.eye - renderer.origin()), float(options.farPlane));
-  push.wireColor = options.wireColor;
-  push.flags = v.orthographic ? gpu::kRasterFlagOrthographic : 0u;
-  push.lightCount = renderer.lightCount();
-  push.shiftX = float(v.shift.x);
-  push.shiftY = float(v.shift.y);
-
-  // The one barrier: deformed vertices and the trace image, written by
-  // compute, become visible to the vertex and fragment shaders.
+  // The trace image (and deformed vertices), written by compute, become
+  // visible to the fragment shaders; the pre-pass's depth to the depth test.
   commands.computeToGraphics();
-  commands.beginPass("raster");
+  commands.barrier(VK_PIPELINE_STAGE_LATE_FRAGMENT_TESTS_BIT, VK_ACCESS_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT,
+                   VK_PIPELINE_STAGE_EARLY_FRAGMENT_TESTS_BIT, VK_ACCESS_DEPTH_STENCIL_ATTACHMENT_READ_BIT);
+  commands.beginPass("raster shading");
   VkRect2D area{{0, 0}, {settings.width, settings.height}};
   float clear[4] = {settings.background.r, settings.background.g, settings.background.b, 1.0f};
   {
-    vk::RenderingScope scope(commands, target, &depth, area, clear);
-    const SceneGpu& scene = renderer.sceneGpu();
-    const scene::Scene& model = renderer.scene();
-    auto refractive = [&](int shape) {
-      int material = shape >= 0 ? model.shapes[size_t(shape)].material : -1;
-      return material >= 0 && model.materials[size_t(material)].refractive();
-    };
-    // Vertex-stage bindings first (slots 0 to kRasterBindingIndices): the depth pre-pass binds only those.
-    constexpr size_t kVertexBindings = gpu::kRasterBindingIndices + 1;
-    static_assert(gpu::kRasterBindingInstances == 0 && gpu::kRasterBindingMaterials == kVertexBindings);
-    const vk::BufferBinding resources[] = {{gpu::kRasterBindingInstances, &renderer.instances()},
-                                           {gpu::kRasterBindingPositions, &scene.positions},
-                                           {gpu::kRasterBindingNormals, &scene.normals},
-                                           {gpu::kRasterBindingTexcoords, &scene.texcoords},
-                                           {gpu::kRasterBindingIndices, &scene.indices},
-                                           {gpu::kRasterBindingMaterials, &scene.materials},
-                                           {gpu::kRasterBindingTextures, &scene.textures},
-                                           {gpu::kRasterBindingTexels, &scene.texels},
-                                           {gpu::kRasterBindingLights, &renderer.lights()},
+    vk::RenderingScope scope(commands, target, &depth, area, clear, false);
+    const SceneGpu& s = *scene.scene;
+    const vk::BufferBinding resources[] = {{gpu::kRasterBindingInstances, scene.instances},
+                                           {gpu::kRasterBindingPositions, &s.positions},
+                                           {gpu::kRasterBindingNormals, &s.normals},
+                                           {gpu::kRasterBindingTexcoords, &s.texcoords},
+                                           {gpu::kRasterBindingIndices, &s.indices},
+                                           {gpu::kRasterBindingMaterials, &s.materials},
+                                           {gpu::kRasterBindingTextures, &s.textures},
+                                           {gpu::kRasterBindingTexels, &s.texels},
+                                           {gpu::kRasterBindingLights, scene.lights},
                                            {gpu::kRasterBindingTraceImage, nullptr, &traceImage}};
-    auto drawItems = [&](const vk::GraphicsProgram& program, const gpu::RasterPush& p) {
-      bool depthOnly = &program == depth_.get();
-      program.bind(commands, std::span(resources).first(depthOnly ? kVertexBindings : std::size(resources)), area);
-      for (size_t item = 0; item < scene.itemGeometry.size(); ++item) {
-        const GeometryRange& g = scene.geometries[scene.itemGeometry[item]];
-        // Without refraction glass is left out and seen straight through, as IOR 1 would show it.
-        if (!options.refraction && refractive(g.shape)) continue;
-        program.draw(commands, p, 3 * g.triangleCount, 3 * g.firstTriangle, static_cast<uint32_t>(item));
-      }
-    };
-    drawItems(*depth_, push);
-    drawItems(*fill_, push);
+    gpu::RasterPush p = push(scene, settings, options);
+    drawItems(commands, *fill_, scene, options, p, resources, area);
     if (options.wireframe) {
-      gpu::RasterPush wirePush = push;
-      wirePush.flags |= gpu::kRasterFlagWireframe;
-      drawItems(*wire_, wirePush);
+      p.flags |= gpu::kRasterFlagWireframe;
+      drawItems(commands, *wire_, scene, options, p, resources, area);
     }
   }
   commands.endPass();
-}
-
-CompositeFrame renderComposite(vk::Context& context, Renderer& renderer, const scene::Pose& pose,
-                               const FrameSettings& settings, const RasterOptions& options, bool withAov) {
-  if (!settings.rays.empty()) throw std::invalid_argument("renderComposite: ray lists have no raster image");
-  RasterPass raster(context);
-  FrameTargets targets = makeFrameTargets(context, settings, withAov);
-  vk::Image composite(context, {settings.width, settings.height, kCompositeFormat,
-                                VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT, "composite"});
-  vk::Image depth(context, {settings.width, settings.height, kDepthFormat, VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT,
-                            "composite depth"});
-  vk::Commands commands(context, "composite frame");
-  commands.begin();
-  for (const vk::Image* image : {&targets.image, &composite, &depth}) {
-    commands.imageLayout(*image, VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_GENERAL);
-  }
-  renderer.update(commands, pose, settings.view.eye);
-  renderer.trace(commands, settings, targets.image, withAov ? &targets.aov : nullptr);
-  raster.record(commands, renderer, settings, targets.image, composite, depth, options);
-  commands.computeToTransfer();
-  commands.graphicsToTransfer();
-  commands.submitAndWait();
-  CompositeFrame frame;
-  frame.trace = readFrame(context, renderer, targets, commands);
-  frame.rgba = downloadRgba16f(context, composite);
-  return frame;
 }
 
 }  // namespace snell::render

@@ -1,11 +1,16 @@
 // The raster pass: the viewport's own drawing of the scene, from the deformed
-// buffers the trace used, with each transmissive fragment taking the trace
-// image's texel at its pixel (the talk's viewport shader). The trace image
-// reaches it through one pipeline barrier, never through host memory.
+// buffers the trace uses, with each transmissive fragment taking the trace
+// image's texel at its pixel (the talk's viewport shader). Two halves: a
+// depth pre-pass (which also marks where the visible face is transmissive,
+// for the masked trace), then the shading pass, one fragment per pixel. The
+// trace image reaches it through pipeline barriers, never through host memory.
 #pragma once
 
-#include "render/renderer.h"
+#include "render/frame_settings.h"
+#include "render/scene_gpu.h"
+#include "scene/scene.h"
 #include "scene/view.h"
+#include "shared/raster.h"
 #include "vk/buffer.h"
 #include "vk/commands.h"
 #include "vk/context.h"
@@ -14,22 +19,24 @@
 #include <glm/glm.hpp>
 
 #include <memory>
+#include <span>
 
 namespace snell::render {
 
 /// Formats of the raster pass's attachments.
 inline constexpr VkFormat kCompositeFormat = VK_FORMAT_R16G16B16A16_SFLOAT;
 inline constexpr VkFormat kDepthFormat = VK_FORMAT_D32_SFLOAT;
+inline constexpr VkFormat kMaskFormat = VK_FORMAT_R32_UINT;
 
 struct RasterOptions {
   /// Off: transmissive faces are left out, so glass is seen straight through
-  /// (as IOR 1 would show it) and the trace image is not read.
+  /// (as IOR 1 would show it) and nothing is traced.
   bool refraction = true;
   /// Draws every triangle's edges over the shaded image.
   bool wireframe = false;
   glm::vec4 wireColor{0.95f, 0.8f, 0.3f, 0.35f};  ///< blended over the image by its alpha
   /// Perspective: the near plane's distance. Orthographic: the depth range
-  /// along the view's forward axis. depthRange() picks them from the scene.
+  /// along the view's forward axis. fitDepthRange() picks them from the scene.
   double nearPlane = 1e-3, farPlane = 1e3;
 };
 
@@ -37,32 +44,43 @@ struct RasterOptions {
 /// (nearPlane/farPlane of RasterOptions).
 void fitDepthRange(const scene::View& view, const glm::dvec3& lo, const glm::dvec3& hi, RasterOptions& options);
 
+/// What the raster pass draws: the scene's buffers and the frame's instances and lights.
+struct RasterScene {
+  const SceneGpu* scene = nullptr;
+  const scene::Scene* model = nullptr;
+  const vk::Buffer* instances = nullptr;
+  const vk::Buffer* lights = nullptr;
+  uint32_t lightCount = 0;
+  glm::dvec3 origin{0.0};  ///< the frame origin the instances are relative to
+};
+
 class RasterPass {
  public:
   explicit RasterPass(vk::Context& context);
   ~RasterPass();
 
-  /// Records the view of the pose `renderer` last updated into `target`
-  /// (kCompositeFormat, GENERAL) with `depth` (kDepthFormat, GENERAL); both and
-  /// `traceImage` (GENERAL, written by Renderer::trace for this view) have the
-  /// frame's size. Starts with the compute-to-graphics barrier.
-  void record(vk::Commands& commands, const Renderer& renderer, const FrameSettings& settings,
-              const vk::Image& traceImage, const vk::Image& target, const vk::Image& depth,
-              const RasterOptions& options = {}) const;
+  /// The depth pre-pass into `depth` (kDepthFormat, GENERAL, cleared). With
+  /// `mask` (kMaskFormat, GENERAL) it also writes 1 where the nearest face
+  /// is transmissive and 0 elsewhere; without, `colorTarget` (kCompositeFormat)
+  /// stands in as the attachment it leaves untouched.
+  void recordDepth(vk::Commands& commands, const RasterScene& scene, const FrameSettings& settings,
+                   const RasterOptions& options, const vk::Image& depth, const vk::Image* mask,
+                   const vk::Image& colorTarget) const;
+  /// The shading pass into `target` (kCompositeFormat, GENERAL, cleared to the
+  /// background) over the pre-pass's depth; transmissive fragments take
+  /// `traceImage`'s texel (rgba16f, GENERAL, written before a compute-to-graphics barrier).
+  void recordShading(vk::Commands& commands, const RasterScene& scene, const FrameSettings& settings,
+                     const RasterOptions& options, const vk::Image& traceImage, const vk::Image& target,
+                     const vk::Image& depth) const;
 
  private:
+  gpu::RasterPush push(const RasterScene& scene, const FrameSettings& settings, const RasterOptions& options) const;
+  void drawItems(vk::Commands& commands, const vk::GraphicsProgram& program, const RasterScene& scene,
+                 const RasterOptions& options, const gpu::RasterPush& push, std::span<const vk::BufferBinding> resources,
+                 VkRect2D area) const;
+
   vk::Context& context_;
-  std::unique_ptr<vk::GraphicsProgram> depth_, fill_, wire_;
+  std::unique_ptr<vk::GraphicsProgram> depth_, mask_, fill_, wire_;
 };
-
-/// A traced frame and its raster composite, read back (tests, `snell render --viewport`).
-struct CompositeFrame {
-  RenderedFrame trace;            ///< the trace image and its AOV
-  std::vector<glm::vec4> rgba;    ///< the composite, row 0 at the top
-};
-
-/// Renders one frame (update, trace, raster) and reads both images back.
-CompositeFrame renderComposite(vk::Context& context, Renderer& renderer, const scene::Pose& pose,
-                               const FrameSettings& settings, const RasterOptions& options, bool withAov = false);
 
 }  // namespace snell::render

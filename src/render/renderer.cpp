@@ -1,12 +1,16 @@
-// The frame's passes, recorded in order.
+// The frame: what changed since the GPU last saw the scene, the passes that
+// follow from it, and the readbacks, recorded into one submission per frame.
 #include "render/renderer.h"
 
 #include "vk/error.h"
 
 #include "trace.spv.h"
+#include "trace_compact.spv.h"
 
 #include <glm/gtc/packing.hpp>
 
+#include <algorithm>
+#include <cmath>
 #include <cstring>
 #include <stdexcept>
 
@@ -14,83 +18,300 @@ namespace snell::render {
 
 namespace {
 
-std::vector<uint32_t> triangleCounts(const SceneGpu& scene) {
-  std::vector<uint32_t> counts;
-  for (const GeometryRange& g : scene.geometries) counts.push_back(g.triangleCount);
-  return counts;
-}
+constexpr VkBufferUsageFlags kStorage =
+    VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT;
 
 void rows(const glm::dmat4& m, glm::vec4 out[3]) {
   for (int r = 0; r < 3; ++r) out[r] = glm::vec4(glm::dvec4(m[0][r], m[1][r], m[2][r], m[3][r]));
 }
 
+double maxScale(const glm::dmat4& m) {
+  return std::max({glm::length(glm::dvec3(m[0])), glm::length(glm::dvec3(m[1])), glm::length(glm::dvec3(m[2]))});
+}
+
+bool sameView(const scene::View& a, const scene::View& b) {
+  return a.eye == b.eye && a.right == b.right && a.up == b.up && a.forward == b.forward &&
+         a.orthographic == b.orthographic && a.halfHeight == b.halfHeight && a.shift == b.shift;
+}
+
+// Whether a view asks for exactly what it asked for last time (ray lists always count as new).
+bool sameRequest(const ViewRequest& a, const ViewRequest& b) {
+  const FrameSettings &s = a.settings, &t = b.settings;
+  const RasterOptions &r = a.raster, &q = b.raster;
+  return s.width == t.width && s.height == t.height && sameView(s.view, t.view) && s.background == t.background &&
+         s.maxInterfaces == t.maxInterfaces && s.rays.empty() && t.rays.empty() && a.output == b.output &&
+         a.masked == b.masked && a.aov == b.aov && r.refraction == q.refraction && r.wireframe == q.wireframe &&
+         r.wireColor == q.wireColor && r.nearPlane == q.nearPlane && r.farPlane == q.farPlane;
+}
+
+std::vector<glm::vec4> unpackHalves(const std::byte* data, size_t pixels) {
+  std::vector<glm::vec4> rgba(pixels);
+  const auto* halves = reinterpret_cast<const uint16_t*>(data);
+  for (size_t i = 0; i < pixels; ++i) {
+    for (int c = 0; c < 4; ++c) rgba[i][c] = glm::unpackHalf1x16(halves[4 * i + size_t(c)]);
+  }
+  return rgba;
+}
+
 }  // namespace
 
-Renderer::Renderer(vk::Context& context, const scene::Scene& scene, const scene::Pose& layout)
-    : context_(context),
-      sceneModel_(scene),
-      scene_(uploadScene(context, scene, layout)),
-      builder_(context),
-      arena_(context, "frame uploads") {
+// One frame in flight: its commands, the host data it uploads, what it reads back.
+struct Renderer::Slot {
+  Slot(vk::Context& context, size_t index)
+      : commands(context, "frame " + std::to_string(index)), arena(context, "frame uploads " + std::to_string(index)) {}
+  vk::Commands commands;
+  vk::UploadArena arena;
+  vk::Buffer readback;  ///< SAH statistics of both levels, dropped triangles, pixels traced per view
+  VkDeviceSize topStatsAt = 0, droppedAt = 0, pixelCountsAt = 0;
+  uint64_t frame = 0;
+  bool pending = false;
+  FrameResult result;
+  std::vector<uint32_t> refitGroups, builtGroups;  ///< bottom-level groups to read the SAH of
+  bool topRefit = false, topBuilt = false;
+  struct ViewReadback {
+    size_t view = 0;
+    uint32_t width = 0, height = 0;
+    bool composite = false, aov = false;
+    vk::Buffer pixels;  ///< trace image, then composite, then AOV
+  };
+  std::vector<ViewReadback> readbacks;
+  std::vector<size_t> maskedViews;  ///< views whose pixel count the GPU counted (index into the frame's views)
+};
+
+// What the renderer keeps per view index: its images and what it last drew.
+struct Renderer::View {
+  ViewImages images;
+  vk::Buffer rays;
+  bool fresh = false;  ///< images just made: UNDEFINED to GENERAL before use
+  bool rendered = false;
+  uint64_t version = 0;
+  ViewRequest last;
+};
+
+// The host's plan for a frame's update.
+struct Renderer::Update {
+  bool work = false;  ///< any view: the frame's scene work runs
+  bool trees = false;
+  std::vector<uint32_t> deform;  ///< DeformPass outputs
+  bool instancesChanged = false, lightsChanged = false;
+  std::vector<gpu::GpuInstance> instances;
+  std::vector<gpu::GpuLight> lights;
+  std::vector<uint32_t> build, refit;  ///< bottom-level groups (refit lists the built ones too, for their SAH)
+  bool buildTop = false, refitTop = false;
+};
+
+Renderer::Renderer(vk::Context& context, const scene::Scene& scene, const scene::Pose& layout, RendererOptions options)
+    : context_(context), sceneModel_(scene), options_(options), scene_(uploadScene(context, scene, layout)) {
+  if (options_.framesInFlight == 0) throw std::invalid_argument("renderer: framesInFlight must be at least 1");
   deform_ = std::make_unique<DeformPass>(context, scene, layout, [&](int item) {
     for (const GeometryRange& g : scene_.geometries) {
       if (g.item == item) return DeformSlot{&scene_.positions, &scene_.normals, g.firstVertex};
     }
     throw std::logic_error("deforming item without a geometry");
   });
+  raster_ = std::make_unique<RasterPass>(context);
   std::string name = scene.source.empty() ? std::string("scene") : scene.source;
-  blas_ = builder_.makeBvh(triangleCounts(scene_), BvhLeaves::Triangles, name + " bottom level");
-  tlas_ = builder_.makeBvh({static_cast<uint32_t>(layout.items.size())}, BvhLeaves::Instances, name + " top level");
-  instances_ = vk::Buffer(context, {std::max<size_t>(layout.items.size(), 1) * sizeof(gpu::GpuInstance),
-                                    VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, vk::MemoryDomain::Upload, name + " instances"});
   size_t lightNodes = 0;
   for (const scene::Node& node : scene.nodes) lightNodes += node.light >= 0 ? 1 : 0;
-  lights_ = vk::Buffer(context, {std::max<size_t>(lightNodes, 1) * sizeof(gpu::GpuLight), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
-                                 vk::MemoryDomain::Upload, name + " lights"});
+  instances_ = vk::Buffer(context, {std::max<size_t>(layout.items.size(), 1) * sizeof(gpu::GpuInstance),
+                                    kStorage | VK_BUFFER_USAGE_VERTEX_BUFFER_BIT, vk::MemoryDomain::Device,
+                                    name + " instances"});
+  lights_ = vk::Buffer(context, {std::max<size_t>(lightNodes, 1) * sizeof(gpu::GpuLight), kStorage,
+                                 vk::MemoryDomain::Device, name + " lights"});
   static_assert(sizeof(gpu::TraceAov) == sizeof(gpu::GpuRay));
-  placeholder_ = vk::Buffer(context, {sizeof(gpu::TraceAov), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
-                                      vk::MemoryDomain::Device, "no AOV or ray list"});
-  trace_ = std::make_unique<vk::ComputeProgram>(context, vk::ComputeProgramDesc{"trace", kSpvTrace, {}, false});
+  placeholder_ = vk::Buffer(context, {sizeof(gpu::TracePixelListHeader), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
+                                      vk::MemoryDomain::Device, "placeholder"});
+  for (char r : scene_.itemRefractive) refractive_ = refractive_ || r;
+
+  items_.resize(layout.items.size());
+  itemDeformOutput_.assign(layout.items.size(), ~0u);
+  for (size_t o = 0; o < deform_->outputs().size(); ++o) {
+    itemDeformOutput_[size_t(deform_->outputs()[o].item)] = static_cast<uint32_t>(o);
+  }
+  geometryDirty_.assign(scene_.geometries.size(), 1);
+  baselineSah_.assign(scene_.geometries.size(), 0.0);
+  queued_.assign(scene_.geometries.size(), 0);
+  // Rest-pose bounding spheres per shape, and how far each morph target can move a vertex.
+  for (const scene::Shape& shape : scene.shapes) {
+    glm::dvec3 lo(INFINITY), hi(-INFINITY);
+    for (const glm::vec3& p : shape.positions) {
+      lo = glm::min(lo, glm::dvec3(p));
+      hi = glm::max(hi, glm::dvec3(p));
+    }
+    Sphere sphere;
+    if (!shape.positions.empty()) sphere = {0.5 * (lo + hi), 0.5 * glm::length(hi - lo)};
+    std::vector<double> reach;
+    for (const scene::MorphTarget& target : shape.targets) {
+      double most = 0.0;
+      for (const glm::vec3& d : target.positions) most = std::max(most, double(glm::length(d)));
+      reach.push_back(most);
+    }
+    shapeSpheres_.push_back(sphere);
+    shapeMorphReach_.push_back(std::move(reach));
+  }
+  for (uint32_t i = 0; i < options_.framesInFlight; ++i) slots_.push_back(std::make_unique<Slot>(context, i));
 }
 
-Renderer::~Renderer() = default;
+Renderer::~Renderer() {
+  try {
+    finish();
+  } catch (...) {
+    // A lost device is reported by the frame that met it; nothing more to do here.
+  }
+}
+
+const ViewImages& Renderer::viewImages(size_t index) const { return views_.at(index).images; }
+
+void Renderer::invalidateViews() {
+  for (View& v : views_) v.rendered = false;
+}
+
+void Renderer::invalidateTrees() {
+  treesBuilt_ = false;
+  topBuilt_ = false;
+}
+
+void Renderer::prepareTrees() {
+  if (builder_) return;
+  builder_ = std::make_unique<BvhBuilder>(context_);
+  std::vector<uint32_t> counts;
+  for (const GeometryRange& g : scene_.geometries) counts.push_back(g.triangleCount);
+  std::string name = sceneModel_.source.empty() ? std::string("scene") : sceneModel_.source;
+  blas_ = std::make_unique<Bvh>(builder_->makeBvh(counts, BvhLeaves::Triangles, name + " bottom level"));
+  tlas_ = std::make_unique<Bvh>(builder_->makeBvh({static_cast<uint32_t>(scene_.itemGeometry.size())},
+                                                  BvhLeaves::Instances, name + " top level"));
+  trace_ = std::make_unique<vk::ComputeProgram>(context_, vk::ComputeProgramDesc{"trace", kSpvTrace, {}, false});
+  compact_ = std::make_unique<vk::ComputeProgram>(context_,
+                                                  vk::ComputeProgramDesc{"trace compact", kSpvTraceCompact, {}, false});
+}
 
 uint64_t Renderer::memoryBytes() const {
-  return scene_.bytes + instances_.size() + lights_.size() + blas_.treeBytes() + tlas_.treeBytes() +
-         builder_.scratchBytes();
+  uint64_t bytes = scene_.bytes + deform_->bytes() + instances_.size() + lights_.size();
+  if (blas_) bytes += blas_->treeBytes() + tlas_->treeBytes() + builder_->scratchBytes();
+  return bytes;
 }
 
-void Renderer::record(vk::Commands& commands, const scene::Pose& pose, const FrameSettings& settings,
-                      const vk::Image& target, const vk::Buffer* aov, const vk::Buffer* rays) {
-  update(commands, pose, settings.view.eye);
-  trace(commands, settings, target, aov, rays);
+double Renderer::treeBytesPerTriangle() const {
+  if (!blas_ || scene_.triangleCount == 0) return 0.0;
+  return double(blas_->treeBytes() + tlas_->treeBytes()) / scene_.triangleCount;
 }
 
-void Renderer::update(vk::Commands& commands, const scene::Pose& pose, const glm::dvec3& origin) {
-  if (pose.items.size() != scene_.itemGeometry.size()) {
-    throw vk::VulkanError("renderer: the pose has " + std::to_string(pose.items.size()) + " draw items; it was built for " +
-                          std::to_string(scene_.itemGeometry.size()));
+bool Renderer::viewNeedsTrees(const ViewRequest& request) const {
+  if (request.output == ViewOutput::Trace) return true;
+  return request.raster.refraction && refractive_ && transmissiveInView(request.settings);
+}
+
+// A bounding sphere per refractive item against the view's frustum: no glass
+// in the frustum, no trace. Conservative: a sphere that may touch it counts.
+bool Renderer::transmissiveInView(const FrameSettings& settings) const {
+  if (itemSpheres_.size() != scene_.itemRefractive.size()) return true;  // no frame placed the items yet
+  const scene::View& v = settings.view;
+  double aspect = double(settings.width) / double(std::max(settings.height, 1u));
+  double sx = v.halfHeight * aspect, sy = v.halfHeight;
+  for (size_t i = 0; i < scene_.itemRefractive.size() && i < itemSpheres_.size(); ++i) {
+    if (!scene_.itemRefractive[i]) continue;
+    const Sphere& s = itemSpheres_[i];
+    glm::dvec3 d = s.centre - v.eye;
+    double x = glm::dot(d, v.right), y = glm::dot(d, v.up), z = glm::dot(d, v.forward);
+    if (v.orthographic) {
+      if (std::abs(x - v.shift.x) <= sx + s.radius && std::abs(y - v.shift.y) <= sy + s.radius) return true;
+      continue;
+    }
+    if (z < -s.radius) continue;
+    // Distance to each side plane of the window [shift - s, shift + s] in slope space.
+    auto inside = [&](double a, double slopeLo, double slopeHi) {
+      double hiDist = (a - slopeHi * z) / std::sqrt(1.0 + slopeHi * slopeHi);
+      double loDist = (slopeLo * z - a) / std::sqrt(1.0 + slopeLo * slopeLo);
+      return hiDist <= s.radius && loDist <= s.radius;
+    };
+    if (inside(x, v.shift.x - sx, v.shift.x + sx) && inside(y, v.shift.y - sy, v.shift.y + sy)) return true;
   }
-  const glm::dvec3 eye = origin;
-  origin_ = origin;
+  return false;
+}
 
-  // Instances and lights, camera-relative: subtracted in double so the float
-  // data near the camera keeps its precision however far it is from the origin.
-  auto* instances = reinterpret_cast<gpu::GpuInstance*>(instances_.mapped().data());
-  glm::dmat4 rebase = glm::dmat4(1.0);
-  rebase[3] = glm::dvec4(-eye, 1.0);
+Renderer::Update Renderer::planUpdate(const scene::Pose& pose, const std::vector<ViewRequest>& views,
+                                      FrameStats& stats) {
+  Update u;
+  u.work = !views.empty();
+  if (!u.work) return u;
+
+  // Where every item is (bounding spheres), for culling and the origin.
+  itemSpheres_.resize(pose.items.size());
   for (size_t i = 0; i < pose.items.size(); ++i) {
-    // Skinned positions come out of the deform pass camera-relative already.
-    glm::dmat4 toWorld = pose.items[i].skinned ? glm::dmat4(1.0) : rebase * pose.items[i].world;
+    const scene::DrawItem& item = pose.items[i];
+    glm::dvec3 centre = shapeSpheres_[size_t(item.shape)].centre;
+    double radius = shapeSpheres_[size_t(item.shape)].radius;
+    const std::vector<double>& reach = shapeMorphReach_[size_t(item.shape)];
+    for (size_t k = 0; k < reach.size() && k < item.weights.size(); ++k) radius += std::abs(item.weights[k]) * reach[k];
+    if (item.skinned && !item.jointMatrices.empty()) {
+      // Skinned vertices are convex blends of joint-moved rest positions, so
+      // the joint-moved rest spheres hold them all.
+      glm::dvec3 mean(0.0);
+      for (const glm::dmat4& m : item.jointMatrices) mean += glm::dvec3(m * glm::dvec4(centre, 1.0));
+      mean /= double(item.jointMatrices.size());
+      double farthest = 0.0;
+      for (const glm::dmat4& m : item.jointMatrices) {
+        farthest = std::max(farthest, glm::length(glm::dvec3(m * glm::dvec4(centre, 1.0)) - mean) + radius * maxScale(m));
+      }
+      itemSpheres_[i] = {mean, farthest};
+    } else {
+      itemSpheres_[i] = {glm::dvec3(item.world * glm::dvec4(centre, 1.0)), radius * maxScale(item.world)};
+    }
+  }
+
+  // The origin follows the first view's camera, but only once the camera is
+  // farther from it than from the nearest item: coordinates near the camera
+  // then lose at most a bit to it, and orbiting mostly moves no tree.
+  glm::dvec3 eye = views.front().settings.view.eye;
+  double nearest = INFINITY, extent = 0.0;
+  for (const Sphere& s : itemSpheres_) {
+    nearest = std::min(nearest, std::max(0.0, glm::length(s.centre - eye) - s.radius));
+    extent = std::max(extent, glm::length(s.centre - eye) + s.radius);
+  }
+  if (!originSet_ || glm::length(eye - origin_) > std::max(nearest, 1e-9 * extent)) {
+    stats.rebased = originSet_;
+    origin_ = eye;
+    originSet_ = true;
+  }
+
+  // Deform what changed.
+  for (size_t i = 0; i < pose.items.size(); ++i) {
+    if (itemDeformOutput_[i] == ~0u) continue;
+    const scene::DrawItem& item = pose.items[i];
+    ItemState& state = items_[i];
+    if (state.deformed && state.weights == item.weights && state.joints == item.jointMatrices) {
+      ++stats.itemsDeformSkipped;
+      continue;
+    }
+    state.deformed = true;
+    state.weights = item.weights;
+    state.joints = item.jointMatrices;
+    u.deform.push_back(itemDeformOutput_[i]);
+    ++stats.itemsDeformed;
+    for (size_t g = 0; g < scene_.geometries.size(); ++g) {
+      if (scene_.geometries[g].item == int(i)) geometryDirty_[g] = 1;
+    }
+  }
+
+  // Instances and lights, relative to the origin in double, so float data near
+  // the camera keeps its precision however far the scene is from the world's origin.
+  u.instances.resize(pose.items.size());
+  for (size_t i = 0; i < pose.items.size(); ++i) {
+    const scene::DrawItem& item = pose.items[i];
+    // Skinned positions come out of the deform pass relative to the item's anchor.
+    glm::dmat4 toWorld = item.world;
+    if (item.skinned) toWorld = glm::dmat4(1.0), toWorld[3] = glm::dvec4(DeformPass::anchorOf(item), 1.0);
+    toWorld[3] -= glm::dvec4(origin_, 0.0);
     gpu::GpuInstance inst{};
     rows(toWorld, inst.objectToWorld);
     rows(glm::inverse(toWorld), inst.worldToObject);
     inst.geometry = scene_.itemGeometry[i];
     inst.material = scene_.itemMaterial[i];
-    instances[i] = inst;
+    u.instances[i] = inst;
   }
-  auto* lights = reinterpret_cast<gpu::GpuLight*>(lights_.mapped().data());
-  uint32_t lightCount = 0;
+  u.instancesChanged = uploadedInstances_.size() != u.instances.size() ||
+                       std::memcmp(uploadedInstances_.data(), u.instances.data(),
+                                   u.instances.size() * sizeof(gpu::GpuInstance)) != 0;
   for (size_t n = 0; n < sceneModel_.nodes.size() && n < pose.world.size(); ++n) {
     int index = sceneModel_.nodes[n].light;
     if (index < 0 || size_t(index) >= sceneModel_.lights.size()) continue;
@@ -100,58 +321,120 @@ void Renderer::update(vk::Commands& commands, const scene::Pose& pose, const glm
     uint32_t type = light.type == scene::LightType::Directional ? gpu::kLightDirectional
                     : light.type == scene::LightType::Point     ? gpu::kLightPoint
                                                                 : gpu::kLightSpot;
-    g.positionType = glm::vec4(glm::vec3(glm::dvec3(world[3]) - eye), float(type));
+    g.positionType = glm::vec4(glm::vec3(glm::dvec3(world[3]) - origin_), float(type));
     glm::dvec3 direction = -glm::normalize(glm::dvec3(world[2]));
     g.direction = glm::vec4(glm::vec3(direction), std::isfinite(light.range) ? light.range : 0.0f);
     g.radiance = glm::vec4(light.color * light.intensity, 0.0f);
     g.cone = glm::vec4(std::cos(light.innerConeAngle), std::cos(light.outerConeAngle), 0.0f, 0.0f);
-    lights[lightCount++] = g;
+    u.lights.push_back(g);
   }
-  lightCount_ = lightCount;
+  u.lightsChanged = uploadedLights_.size() != u.lights.size() ||
+                    std::memcmp(uploadedLights_.data(), u.lights.data(), u.lights.size() * sizeof(gpu::GpuLight)) != 0;
+  if (!u.deform.empty() || u.instancesChanged || u.lightsChanged) ++sceneVersion_;
 
-  arena_.reset();
-  // Counts the triangles this frame's box pass finds non-finite (RenderedFrame::droppedTriangles).
-  commands.fillBuffer(blas_.dropped, 0);
-  commands.transferToCompute();
-
-  commands.beginPass("deform");
-  deform_->record(commands, pose, eye);
-  commands.endPass();
-
-  BvhInputs triangles{&scene_.positions, &scene_.indices, nullptr, nullptr};
-  if (!blasBuilt_) {
-    commands.beginPass("blas build");
-    builder_.recordBuild(commands, blas_, triangles, {}, arena_);
-    commands.endPass();
-    blasBuilt_ = true;
+  // Trees, only when some view traces.
+  for (const ViewRequest& v : views) u.trees = u.trees || viewNeedsTrees(v);
+  if (!u.trees) return u;
+  prepareTrees();
+  bool bottomChanged = false;
+  if (!treesBuilt_) {
+    for (uint32_t g = 0; g < scene_.geometries.size(); ++g) u.build.push_back(g);
+    rebuildQueue_.clear();
+    std::fill(queued_.begin(), queued_.end(), 0);
   } else {
-    std::vector<uint32_t> deforming;
-    for (size_t g = 0; g < scene_.geometries.size(); ++g) {
-      if (scene_.geometries[g].item >= 0) deforming.push_back(static_cast<uint32_t>(g));
-    }
-    if (!deforming.empty()) {
-      commands.beginPass("blas refit");
-      builder_.recordRefit(commands, blas_, triangles, deforming, arena_);
-      commands.endPass();
+    // Rebuilds the SAH asked for, within the budget (at least one a frame).
+    uint64_t budget = 0;
+    while (!rebuildQueue_.empty()) {
+      uint32_t g = rebuildQueue_.front();
+      uint64_t size = scene_.geometries[g].triangleCount;
+      if (!u.build.empty() && budget + size > options_.rebuildBudget) break;
+      rebuildQueue_.pop_front();
+      queued_[g] = 0;
+      budget += size;
+      u.build.push_back(g);
     }
   }
+  for (uint32_t g : u.build) geometryDirty_[g] = 0;
+  u.refit = u.build;  // a refit right after a build measures the new tree's SAH
+  for (uint32_t g = 0; g < scene_.geometries.size(); ++g) {
+    if (!geometryDirty_[g]) continue;
+    geometryDirty_[g] = 0;
+    u.refit.push_back(g);
+  }
+  bottomChanged = !u.refit.empty();
+  stats.treesBuilt = static_cast<uint32_t>(u.build.size());
+  stats.treesRefit = static_cast<uint32_t>(u.refit.size() - u.build.size());
+  stats.treesSkipped = static_cast<uint32_t>(scene_.geometries.size() - u.refit.size());
+  for (uint32_t g : u.build) stats.trianglesBuilt += scene_.geometries[g].triangleCount;
+  for (size_t k = u.build.size(); k < u.refit.size(); ++k) stats.trianglesRefit += scene_.geometries[u.refit[k]].triangleCount;
+  treesBuilt_ = true;
 
-  commands.beginPass("tlas");
-  builder_.recordBuild(commands, tlas_, {nullptr, nullptr, &instances_, &blas_}, {}, arena_);
-  commands.endPass();
-  updated_ = true;
+  if (!topBuilt_ || topRebuildDue_) {
+    u.buildTop = u.refitTop = true;
+    topBuilt_ = true;
+    topRebuildDue_ = false;
+    topDirty_ = false;
+  } else if (topDirty_ || u.instancesChanged || bottomChanged) {
+    u.refitTop = true;
+    topDirty_ = false;
+  }
+  stats.topLevelBuilt = u.buildTop ? 1 : 0;
+  stats.topLevelRefit = u.refitTop && !u.buildTop ? 1 : 0;
+  stats.topLevelSkipped = u.refitTop ? 0 : 1;
+  return u;
 }
 
-void Renderer::trace(vk::Commands& commands, const FrameSettings& settings, const vk::Image& target,
-                     const vk::Buffer* aov, const vk::Buffer* rays) {
-  if (!updated_) throw vk::VulkanError("renderer: trace() before any update()");
-  if (target.width() != settings.width || target.height() != settings.height) {
-    throw vk::VulkanError("renderer: the target image is not the frame's size");
+void Renderer::recordUpdate(vk::Commands& commands, Slot& slot, const scene::Pose& pose, const Update& u) {
+  if (u.instancesChanged) {
+    slot.arena.copy(commands, u.instances, instances_);
+    uploadedInstances_ = u.instances;
+    topDirty_ = topDirty_ || !u.trees;  // trees skipped this frame: the top level catches up later
   }
-  // After the top level; and between two views' traces, which both bind the
-  // placeholder in the AOV slot the shader declares writable.
-  commands.computeToCompute();
-  commands.beginPass("trace");
+  if (u.lightsChanged) {
+    slot.arena.copy(commands, u.lights, lights_);
+    uploadedLights_ = u.lights;
+  }
+  lightCount_ = static_cast<uint32_t>(u.lights.size());
+  commands.barrier(VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT,
+                   VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_VERTEX_SHADER_BIT |
+                       VK_PIPELINE_STAGE_FRAGMENT_SHADER_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT,
+                   VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_TRANSFER_READ_BIT | VK_ACCESS_TRANSFER_WRITE_BIT);
+  if (!u.deform.empty()) {
+    commands.beginPass("deform");
+    deform_->record(commands, pose, slot.arena, u.deform);
+    commands.endPass();
+  }
+  if (!u.trees) return;
+  BvhInputs triangles{&scene_.positions, &scene_.indices, nullptr, nullptr};
+  if (!u.build.empty()) {
+    commands.beginPass("blas build");
+    builder_->recordBuild(commands, *blas_, triangles, u.build, slot.arena);
+    commands.endPass();
+  }
+  if (!u.refit.empty()) {
+    // Counts the triangles the refit finds non-finite (it covers every tree built this frame too).
+    commands.fillBuffer(blas_->dropped, 0);
+    commands.transferToCompute();
+    commands.beginPass("blas refit");
+    builder_->recordRefit(commands, *blas_, triangles, u.refit, slot.arena);
+    commands.endPass();
+  }
+  slot.refitGroups = u.refit;
+  slot.builtGroups = u.build;
+  if (u.refitTop) {
+    commands.beginPass("tlas");
+    BvhInputs top{nullptr, nullptr, &instances_, blas_.get()};
+    if (u.buildTop) builder_->recordBuild(commands, *tlas_, top, {}, slot.arena);
+    builder_->recordRefit(commands, *tlas_, top, {}, slot.arena);
+    commands.endPass();
+  }
+  slot.topRefit = u.refitTop;
+  slot.topBuilt = u.buildTop;
+}
+
+void Renderer::recordTrace(vk::Commands& commands, const ViewRequest& request, View& view, bool masked,
+                           FrameStats& stats) {
+  const FrameSettings& settings = request.settings;
   const scene::View& v = settings.view;
   double aspect = double(settings.width) / double(settings.height);
   gpu::TracePush push{};
@@ -164,31 +447,308 @@ void Renderer::trace(vk::Commands& commands, const FrameSettings& settings, cons
   push.height = settings.height;
   push.maxInterfaces = settings.maxInterfaces;
   push.lightCount = lightCount_;
-  push.flags = (aov ? gpu::kTraceFlagAov : 0u) | (v.orthographic ? gpu::kTraceFlagOrthographic : 0u) |
-               (rays ? gpu::kTraceFlagRayList : 0u);
+  push.flags = (request.aov ? gpu::kTraceFlagAov : 0u) | (v.orthographic ? gpu::kTraceFlagOrthographic : 0u) |
+               (settings.rays.empty() ? 0u : gpu::kTraceFlagRayList) | (masked ? gpu::kTraceFlagPixelList : 0u);
   push.tilesX = (settings.width + gpu::kTraceTile - 1) / gpu::kTraceTile;
   push.shiftX = float(v.shift.x);
   push.shiftY = float(v.shift.y);
   uint32_t tilesY = (settings.height + gpu::kTraceTile - 1) / gpu::kTraceTile;
-  trace_->dispatchGroups(commands,
-                         {{gpu::kTraceBindingTlasNodes, &tlas_.nodes},
-                          {gpu::kTraceBindingTlasGroups, &tlas_.groups},
-                          {gpu::kTraceBindingInstances, &instances_},
-                          {gpu::kTraceBindingBlasNodes, &blas_.nodes},
-                          {gpu::kTraceBindingBlasGroups, &blas_.groups},
-                          {gpu::kTraceBindingPositions, &scene_.positions},
-                          {gpu::kTraceBindingNormals, &scene_.normals},
-                          {gpu::kTraceBindingTexcoords, &scene_.texcoords},
-                          {gpu::kTraceBindingIndices, &scene_.indices},
-                          {gpu::kTraceBindingMaterials, &scene_.materials},
-                          {gpu::kTraceBindingTextures, &scene_.textures},
-                          {gpu::kTraceBindingTexels, &scene_.texels},
-                          {gpu::kTraceBindingLights, &lights_},
-                          {gpu::kTraceBindingImage, nullptr, &target},
-                          {gpu::kTraceBindingAov, aov ? aov : &placeholder_},
-                          {gpu::kTraceBindingRays, rays ? rays : &placeholder_}},
-                         push, uint64_t(push.tilesX) * tilesY);
+  ViewImages& images = view.images;
+  if (masked) {
+    // The pre-pass's mask becomes the list of pixels to trace, and the trace's workgroup count.
+    commands.graphicsToCompute();
+    commands.fillBuffer(images.pixels, 0, 0, sizeof(gpu::TracePixelListHeader));
+    commands.transferToCompute();
+    gpu::TraceCompactPush compact{settings.width, settings.height, push.tilesX,
+                                  context_.caps().maxComputeWorkgroupCount[0]};
+    commands.beginPass("trace");
+    compact_->dispatchGroups(commands,
+                             {{gpu::kTraceBindingMask, nullptr, &images.mask},
+                              {gpu::kTraceBindingPixels, &images.pixels}},
+                             compact, uint64_t(push.tilesX) * tilesY);
+    commands.computeToIndirect();
+  } else {
+    commands.computeToCompute();
+    commands.beginPass("trace");
+    stats.pixelsTraced += uint64_t(settings.width) * settings.height;
+  }
+  std::initializer_list<vk::BufferBinding> bindings = {
+      {gpu::kTraceBindingTlasNodes, &tlas_->nodes},
+      {gpu::kTraceBindingTlasGroups, &tlas_->groups},
+      {gpu::kTraceBindingInstances, &instances_},
+      {gpu::kTraceBindingBlasNodes, &blas_->nodes},
+      {gpu::kTraceBindingBlasGroups, &blas_->groups},
+      {gpu::kTraceBindingPositions, &scene_.positions},
+      {gpu::kTraceBindingNormals, &scene_.normals},
+      {gpu::kTraceBindingTexcoords, &scene_.texcoords},
+      {gpu::kTraceBindingIndices, &scene_.indices},
+      {gpu::kTraceBindingMaterials, &scene_.materials},
+      {gpu::kTraceBindingTextures, &scene_.textures},
+      {gpu::kTraceBindingTexels, &scene_.texels},
+      {gpu::kTraceBindingLights, &lights_},
+      {gpu::kTraceBindingImage, nullptr, &images.trace},
+      {gpu::kTraceBindingAov, request.aov ? &images.aov : &placeholder_},
+      {gpu::kTraceBindingRays, settings.rays.empty() ? &placeholder_ : &view.rays},
+      {gpu::kTraceBindingPixels, masked ? &images.pixels : &placeholder_}};
+  if (masked) {
+    trace_->dispatchIndirect(commands, bindings, push, images.pixels, gpu::kTracePixelListDispatchOffset);
+  } else {
+    trace_->dispatchGroups(commands, bindings, push, uint64_t(push.tilesX) * tilesY);
+  }
   commands.endPass();
+  ++stats.traceDispatches;
+}
+
+void Renderer::recordView(vk::Commands& commands, Slot& slot, size_t index, const ViewRequest& request,
+                          FrameStats& stats) {
+  View& view = views_[index];
+  const FrameSettings& settings = request.settings;
+  bool unchanged = view.rendered && view.version == sceneVersion_ && sameRequest(request, view.last);
+  if (unchanged) {
+    ++stats.viewsSkipped;
+  } else {
+    ++stats.viewsRendered;
+    if (!settings.rays.empty()) slot.arena.copy(commands, [&] {
+        std::vector<gpu::GpuRay> rays(settings.rays.size());
+        for (size_t i = 0; i < rays.size(); ++i) {
+          // Relative to the origin in double, like the instances, before the cast to float.
+          rays[i].origin = glm::vec4(glm::vec3(settings.rays[i].origin - origin_), 1.0f);
+          rays[i].direction = glm::vec4(glm::vec3(glm::normalize(settings.rays[i].direction)), 0.0f);
+        }
+        return rays;
+      }(), view.rays);
+    if (!settings.rays.empty()) commands.transferToCompute();
+    RasterScene scene{&scene_, &sceneModel_, &instances_, &lights_, lightCount_, origin_};
+    if (request.output == ViewOutput::Trace) {
+      recordTrace(commands, request, view, false, stats);
+    } else {
+      bool traces = request.raster.refraction && refractive_ && transmissiveInView(settings);
+      bool masked = traces && request.masked;
+      raster_->recordDepth(commands, scene, settings, request.raster, view.images.depth,
+                           masked ? &view.images.mask : nullptr, view.images.composite);
+      if (traces) {
+        recordTrace(commands, request, view, masked, stats);
+        if (masked) slot.maskedViews.push_back(index);
+      }
+      raster_->recordShading(commands, scene, settings, request.raster, view.images.trace, view.images.composite,
+                             view.images.depth);
+    }
+    view.rendered = true;
+    view.version = sceneVersion_;
+    view.last = request;
+    view.last.settings.rays.clear();
+    if (!settings.rays.empty()) view.rendered = false;  // a ray list is never assumed the same
+  }
+  if (!request.readback) return;
+  Slot::ViewReadback rb;
+  rb.view = index;
+  rb.width = settings.width;
+  rb.height = settings.height;
+  rb.composite = request.output == ViewOutput::Composite;
+  rb.aov = request.aov;
+  VkDeviceSize pixels = VkDeviceSize(settings.width) * settings.height;
+  VkDeviceSize bytes = pixels * 8 * (rb.composite ? 2 : 1) + (rb.aov ? pixels * sizeof(gpu::TraceAov) : 0);
+  rb.pixels = vk::Buffer(context_, {bytes, VK_BUFFER_USAGE_TRANSFER_DST_BIT, vk::MemoryDomain::Readback,
+                                    "view " + std::to_string(index) + " readback"});
+  commands.barrier(VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT,
+                   VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_COLOR_ATTACHMENT_WRITE_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT,
+                   VK_ACCESS_TRANSFER_READ_BIT);
+  commands.copyImageToBuffer(view.images.trace, rb.pixels, 0);
+  if (rb.composite) commands.copyImageToBuffer(view.images.composite, rb.pixels, pixels * 8);
+  if (rb.aov) commands.copyBuffer(view.images.aov, rb.pixels, pixels * sizeof(gpu::TraceAov), 0, pixels * 8 * (rb.composite ? 2 : 1));
+  slot.readbacks.push_back(std::move(rb));
+}
+
+uint64_t Renderer::submit(const FrameRequest& request) {
+  if (!request.pose) throw std::invalid_argument("renderer: a frame needs a pose");
+  const scene::Pose& pose = *request.pose;
+  if (pose.items.size() != scene_.itemGeometry.size()) {
+    throw vk::VulkanError("renderer: the pose has " + std::to_string(pose.items.size()) + " draw items; it was built for " +
+                          std::to_string(scene_.itemGeometry.size()));
+  }
+  for (const ViewRequest& v : request.views) {
+    checkImageSize(context_, v.settings.width, v.settings.height);
+    if (!v.settings.rays.empty() && v.settings.rays.size() != size_t(v.settings.width) * v.settings.height) {
+      throw std::invalid_argument("renderer: " + std::to_string(v.settings.rays.size()) + " rays for " +
+                                  std::to_string(size_t(v.settings.width) * v.settings.height) + " pixels");
+    }
+    if (!v.settings.rays.empty() && v.output != ViewOutput::Trace) {
+      throw std::invalid_argument("renderer: ray lists have no raster image");
+    }
+  }
+  uint64_t frame = ++submitted_;
+  Slot& slot = *slots_[frame % slots_.size()];
+  if (slot.pending) collect(slot);
+  slot.frame = frame;
+  slot.result = FrameResult{};
+  slot.readbacks.clear();
+  slot.maskedViews.clear();
+  slot.refitGroups.clear();
+  slot.builtGroups.clear();
+  slot.topRefit = slot.topBuilt = false;
+  slot.arena.reset();
+  FrameStats& stats = slot.result.stats;
+  stats.frame = frame;
+
+  // Every view's images, at its size.
+  if (views_.size() < request.views.size()) views_.resize(request.views.size());
+  for (size_t i = 0; i < request.views.size(); ++i) {
+    const ViewRequest& r = request.views[i];
+    View& v = views_[i];
+    ViewImages& im = v.images;
+    bool composite = r.output == ViewOutput::Composite;
+    bool resized = im.width != r.settings.width || im.height != r.settings.height;
+    if (resized) v = View{};
+    uint32_t w = r.settings.width, h = r.settings.height;
+    std::string name = "view " + std::to_string(i);
+    uint64_t pixels = uint64_t(w) * h;
+    im.width = w;
+    im.height = h;
+    if (!im.trace.handle()) {
+      im.trace = vk::Image(context_, {w, h, VK_FORMAT_R16G16B16A16_SFLOAT,
+                                      VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT, name + " trace"});
+      v.fresh = true;
+    }
+    if (composite && !im.composite.handle()) {
+      im.composite = vk::Image(context_, {w, h, kCompositeFormat,
+                                          VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_STORAGE_BIT |
+                                              VK_IMAGE_USAGE_TRANSFER_SRC_BIT,
+                                          name + " composite"});
+      im.depth = vk::Image(context_, {w, h, kDepthFormat, VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT, name + " depth"});
+      im.mask = vk::Image(context_, {w, h, kMaskFormat,
+                                     VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_STORAGE_BIT |
+                                         VK_IMAGE_USAGE_TRANSFER_SRC_BIT,
+                                     name + " transmissive mask"});
+      im.pixels = vk::Buffer(context_, {sizeof(gpu::TracePixelListHeader) + pixels * 4,
+                                        kStorage | VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT, vk::MemoryDomain::Device,
+                                        name + " pixels to trace"});
+      v.fresh = true;
+    }
+    if (r.aov && !im.aov.handle()) {
+      im.aov = vk::Buffer(context_, {pixels * sizeof(gpu::TraceAov), kStorage, vk::MemoryDomain::Device, name + " AOV"});
+      v.rendered = false;
+    }
+    if (!r.settings.rays.empty() && !v.rays.handle()) {
+      v.rays = vk::Buffer(context_, {pixels * sizeof(gpu::GpuRay), kStorage, vk::MemoryDomain::Device, name + " rays"});
+    }
+  }
+
+  Update update = planUpdate(pose, request.views, stats);
+  vk::Commands& commands = slot.commands;
+  commands.begin();
+  // Frames in flight share the scene's GPU data: what this frame rewrites,
+  // the one before may still be reading.
+  commands.fullBarrier();
+  for (size_t i = 0; i < request.views.size(); ++i) {
+    View& v = views_[i];
+    if (!v.fresh) continue;
+    for (const vk::Image* image : {&v.images.trace, &v.images.composite, &v.images.depth, &v.images.mask}) {
+      if (image->handle()) commands.imageLayout(*image, VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_GENERAL);
+    }
+    v.fresh = false;
+  }
+  if (update.work) recordUpdate(commands, slot, pose, update);
+  for (size_t i = 0; i < request.views.size(); ++i) recordView(commands, slot, i, request.views[i], stats);
+
+  // What the host reads back of this frame: tree statistics, pixel counts.
+  uint32_t groups = blas_ ? blas_->groupCount() : 0;
+  slot.topStatsAt = uint64_t(groups) * 16;
+  slot.droppedAt = slot.topStatsAt + 16;
+  slot.pixelCountsAt = slot.droppedAt + 16;
+  VkDeviceSize readbackBytes = slot.pixelCountsAt + 4 * std::max<size_t>(request.views.size(), 1);
+  if (slot.readback.size() < readbackBytes) {
+    slot.readback = vk::Buffer(context_, {readbackBytes, VK_BUFFER_USAGE_TRANSFER_DST_BIT, vk::MemoryDomain::Readback,
+                                          "frame statistics"});
+  }
+  commands.computeToTransfer();
+  if (!slot.refitGroups.empty()) {
+    commands.copyBuffer(blas_->stats, slot.readback, uint64_t(groups) * 16);
+    commands.copyBuffer(blas_->dropped, slot.readback, 4, 0, slot.droppedAt);
+  }
+  if (slot.topRefit) commands.copyBuffer(tlas_->stats, slot.readback, 16, 0, slot.topStatsAt);
+  for (size_t k = 0; k < slot.maskedViews.size(); ++k) {
+    commands.copyBuffer(views_[slot.maskedViews[k]].images.pixels, slot.readback, 4, 0, slot.pixelCountsAt + 4 * k);
+  }
+  commands.transferToHost();
+  if (request.record) request.record(commands);
+  stats.dispatches = commands.dispatches();
+  stats.draws = commands.draws();
+  commands.submit(request.waitSemaphore, request.waitStage, request.signalSemaphore);
+  slot.pending = true;
+  return frame;
+}
+
+void Renderer::collect(Slot& slot) {
+  slot.commands.wait();
+  slot.pending = false;
+  FrameResult& result = slot.result;
+  result.passes = slot.commands.passTimes();
+  const std::byte* data = slot.readback.mapped().data();
+  auto word = [&](VkDeviceSize at) {
+    uint32_t w;
+    std::memcpy(&w, data + at, 4);
+    return w;
+  };
+  auto sahAt = [&](VkDeviceSize at) {
+    glm::uvec4 s;
+    std::memcpy(&s, data + at, 16);
+    return BvhBuilder::sahCost(s);
+  };
+  if (!slot.refitGroups.empty()) {
+    result.stats.droppedTriangles = word(slot.droppedAt);
+    std::vector<char> built(scene_.geometries.size(), 0);
+    for (uint32_t g : slot.builtGroups) built[g] = 1;
+    for (uint32_t g : slot.refitGroups) {
+      double cost = sahAt(uint64_t(g) * 16);
+      if (built[g] || baselineSah_[g] <= 0.0) {
+        baselineSah_[g] = cost;
+        continue;
+      }
+      result.stats.sahGrowth = std::max(result.stats.sahGrowth, cost / baselineSah_[g]);
+      if (cost > options_.rebuildGrowth * baselineSah_[g] && !queued_[g]) {
+        queued_[g] = 1;
+        rebuildQueue_.push_back(g);
+      }
+    }
+  }
+  if (slot.topRefit) {
+    double cost = sahAt(slot.topStatsAt);
+    if (slot.topBuilt || topBaselineSah_ <= 0.0) topBaselineSah_ = cost;
+    else if (cost > options_.rebuildGrowth * topBaselineSah_) topRebuildDue_ = true;
+  }
+  for (size_t k = 0; k < slot.maskedViews.size(); ++k) result.stats.pixelsTraced += word(slot.pixelCountsAt + 4 * k);
+  result.views.clear();
+  for (const Slot::ViewReadback& rb : slot.readbacks) {
+    ViewPixels v;
+    v.width = rb.width;
+    v.height = rb.height;
+    size_t pixels = size_t(rb.width) * rb.height;
+    const std::byte* bytes = rb.pixels.mapped().data();
+    v.trace = unpackHalves(bytes, pixels);
+    if (rb.composite) v.composite = unpackHalves(bytes + pixels * 8, pixels);
+    if (rb.aov) {
+      v.aov.resize(pixels);
+      std::memcpy(v.aov.data(), bytes + pixels * 8 * (rb.composite ? 2 : 1), pixels * sizeof(gpu::TraceAov));
+    }
+    result.views.push_back(std::move(v));
+  }
+  slot.readbacks.clear();
+}
+
+const FrameResult& Renderer::wait(uint64_t frame) {
+  Slot& slot = *slots_[frame % slots_.size()];
+  if (slot.frame != frame) {
+    throw std::logic_error("renderer: frame " + std::to_string(frame) + " is no longer held (" +
+                           std::to_string(slots_.size()) + " frames in flight)");
+  }
+  if (slot.pending) collect(slot);
+  return slot.result;
+}
+
+void Renderer::finish() {
+  for (auto& slot : slots_) {
+    if (slot->pending) collect(*slot);
+  }
 }
 
 void checkImageSize(const vk::Context& context, uint32_t width, uint32_t height) {
@@ -203,71 +763,50 @@ void checkImageSize(const vk::Context& context, uint32_t width, uint32_t height)
   }
 }
 
-FrameTargets makeFrameTargets(vk::Context& context, const FrameSettings& settings, bool withAov) {
-  checkImageSize(context, settings.width, settings.height);
-  FrameTargets t;
-  t.image = vk::Image(context, {settings.width, settings.height, VK_FORMAT_R16G16B16A16_SFLOAT,
-                                VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT, "trace image"});
-  size_t pixels = size_t(settings.width) * settings.height;
-  if (withAov) {
-    t.aov = vk::Buffer(context, {pixels * sizeof(gpu::TraceAov),
-                                 VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT,
-                                 vk::MemoryDomain::Device, "trace AOV"});
-  }
-  if (!settings.rays.empty()) {
-    if (settings.rays.size() != pixels) {
-      throw std::invalid_argument("renderFrame: " + std::to_string(settings.rays.size()) + " rays for " +
-                                  std::to_string(pixels) + " pixels");
-    }
-    t.rays = vk::Buffer(context, {pixels * sizeof(gpu::GpuRay), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
-                                  vk::MemoryDomain::Upload, "ray list"});
-    auto* out = reinterpret_cast<gpu::GpuRay*>(t.rays.mapped().data());
-    for (size_t i = 0; i < pixels; ++i) {
-      // Camera-relative in double, like the instances, before the cast to float.
-      out[i].origin = glm::vec4(glm::vec3(settings.rays[i].origin - settings.view.eye), 1.0f);
-      out[i].direction = glm::vec4(glm::vec3(glm::normalize(settings.rays[i].direction)), 0.0f);
-    }
-  }
-  return t;
-}
+namespace {
 
-std::vector<glm::vec4> downloadRgba16f(vk::Context& context, const vk::Image& image) {
-  size_t pixels = size_t(image.width()) * image.height();
-  std::vector<uint16_t> halves(pixels * 4);
-  vk::downloadImage(context, image, halves.data());
-  std::vector<glm::vec4> rgba(pixels);
-  for (size_t i = 0; i < pixels; ++i) {
-    for (int c = 0; c < 4; ++c) rgba[i][c] = glm::unpackHalf1x16(halves[4 * i + size_t(c)]);
-  }
-  return rgba;
-}
-
-RenderedFrame readFrame(vk::Context& context, const Renderer& renderer, const FrameTargets& targets,
-                        const vk::Commands& commands) {
+// One view, read back: what the two convenience calls below share.
+RenderedFrame renderOneView(Renderer& renderer, const scene::Pose& pose, const ViewRequest& view,
+                            std::vector<glm::vec4>* composite) {
+  FrameRequest request;
+  request.pose = &pose;
+  request.views.push_back(view);
+  request.views.back().readback = true;
+  const FrameResult& result = renderer.wait(renderer.submit(request));
   RenderedFrame frame;
-  frame.width = targets.image.width();
-  frame.height = targets.image.height();
-  frame.passes = commands.passTimes();
-  frame.rgba = downloadRgba16f(context, targets.image);
-  vk::download(context, renderer.blas().dropped, &frame.droppedTriangles, 4);
-  if (targets.aov.handle()) {
-    frame.aov.resize(frame.rgba.size());
-    vk::download(context, targets.aov, frame.aov.data(), frame.aov.size() * sizeof(gpu::TraceAov));
-  }
+  frame.width = view.settings.width;
+  frame.height = view.settings.height;
+  frame.rgba = result.views.at(0).trace;
+  frame.aov = result.views.at(0).aov;
+  frame.droppedTriangles = result.stats.droppedTriangles;
+  frame.passes = result.passes;
+  frame.stats = result.stats;
+  if (composite) *composite = result.views.at(0).composite;
   return frame;
 }
 
-RenderedFrame renderFrame(vk::Context& context, Renderer& renderer, const scene::Pose& pose,
-                          const FrameSettings& settings, bool withAov) {
-  FrameTargets targets = makeFrameTargets(context, settings, withAov);
-  vk::Commands commands(context, "frame");
-  commands.begin();
-  commands.imageLayout(targets.image, VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_GENERAL);
-  renderer.record(commands, pose, settings, targets.image, withAov ? &targets.aov : nullptr,
-                  settings.rays.empty() ? nullptr : &targets.rays);
-  commands.computeToTransfer();
-  commands.submitAndWait();
-  return readFrame(context, renderer, targets, commands);
+}  // namespace
+
+RenderedFrame renderFrame(vk::Context&, Renderer& renderer, const scene::Pose& pose, const FrameSettings& settings,
+                          bool withAov) {
+  ViewRequest view;
+  view.settings = settings;
+  view.aov = withAov;
+  return renderOneView(renderer, pose, view, nullptr);
+}
+
+CompositeFrame renderComposite(vk::Context&, Renderer& renderer, const scene::Pose& pose,
+                               const FrameSettings& settings, const RasterOptions& options, bool withAov,
+                               bool masked) {
+  ViewRequest view;
+  view.settings = settings;
+  view.output = ViewOutput::Composite;
+  view.raster = options;
+  view.masked = masked;
+  view.aov = withAov;
+  CompositeFrame frame;
+  frame.trace = renderOneView(renderer, pose, view, &frame.rgba);
+  return frame;
 }
 
 }  // namespace snell::render

@@ -1,10 +1,24 @@
-// One frame of snell: deform -> bottom-level BVH (build once, then refit what
-// deformed) -> top level -> trace, each a timed pass on one command buffer.
-// Nothing comes back to the host unless renderFrame is asked for pixels.
+// The frame: one object runs a frame's passes in order with the barriers
+// between them, keeps frames in flight, and owns what changed and what is
+// skipped. Callers (the CLI, the viewer, benchmarks, a host application)
+// describe what they want of a frame (a pose and some views) and never order
+// passes themselves.
+//
+// A frame: deform (only the items whose pose changed) -> bottom-level trees
+// (built once, then refitted where positions changed, rebuilt where the
+// surface area heuristic says refitting has spoiled them) -> top level (only
+// when an instance moved) -> per view, either the trace of every pixel, or
+// the viewport composite: the raster pass's depth pre-pass, the trace of just
+// the pixels whose visible face is transmissive, and the raster pass's
+// shading -> what the caller asked to read back, in the frame's own submit.
+// Positions in the trees are relative to a frame origin near the cameras,
+// moved only when a camera gets far from it (so orbiting alone touches no tree).
 #pragma once
 
 #include "render/bvh.h"
 #include "render/deform_pass.h"
+#include "render/frame_settings.h"
+#include "render/raster_pass.h"
 #include "render/scene_gpu.h"
 #include "scene/evaluate.h"
 #include "scene/scene.h"
@@ -18,77 +32,201 @@
 
 #include <glm/glm.hpp>
 
+#include <deque>
+#include <functional>
 #include <memory>
 #include <vector>
 
 namespace snell::render {
 
-struct FrameSettings {
+enum class ViewOutput {
+  Trace,      ///< every pixel traced (the CLI's default image, the golden tests)
+  Composite,  ///< the viewport: raster pass, transmissive pixels traced
+};
+
+/// One view of a frame.
+struct ViewRequest {
+  FrameSettings settings;
+  ViewOutput output = ViewOutput::Trace;
+  RasterOptions raster;  ///< composite only
+  /// Composite only: trace just the pixels whose visible face is transmissive
+  /// (off: trace every pixel, so the trace image is whole, for tests).
+  bool masked = true;
+  bool aov = false;       ///< per-pixel gpu::TraceAov of the traced pixels
+  bool readback = false;  ///< bring the images (and AOV) back with the frame
+};
+
+/// What one frame did and skipped.
+struct FrameStats {
+  uint64_t frame = 0;
+  uint32_t itemsDeformed = 0, itemsDeformSkipped = 0;
+  uint32_t treesBuilt = 0, treesRefit = 0, treesSkipped = 0;  ///< bottom level
+  uint64_t trianglesBuilt = 0, trianglesRefit = 0;
+  uint32_t topLevelBuilt = 0, topLevelRefit = 0, topLevelSkipped = 0;
+  uint32_t viewsRendered = 0, viewsSkipped = 0;
+  uint32_t traceDispatches = 0;  ///< trace dispatches recorded (a masked one may find no pixel)
+  uint64_t pixelsTraced = 0;     ///< counted on the GPU
+  uint32_t dispatches = 0, draws = 0;
+  uint32_t droppedTriangles = 0;  ///< non-finite triangles left out of this frame's trees
+  bool rebased = false;           ///< the frame origin moved this frame
+  /// The largest SAH cost of a refitted bottom-level tree over its cost just
+  /// after its build (1: as good as new); past RendererOptions::rebuildGrowth it is rebuilt.
+  double sahGrowth = 1.0;
+};
+
+/// A view's pixels as the frame left them, brought back when asked.
+struct ViewPixels {
   uint32_t width = 0, height = 0;
-  scene::View view;
-  glm::vec3 background{0.02f, 0.02f, 0.025f};
-  uint32_t maxInterfaces = gpu::kDefaultMaxInterfaces;
-  /// When not empty: width * height primary rays in world space, pixel i
-  /// (row-major) tracing rays[i] instead of the camera's ray through it.
-  /// The view's eye still sets the camera-relative origin the trace works in.
-  std::vector<scene::Ray> rays;
+  std::vector<glm::vec4> trace;      ///< the trace image, linear RGBA, row 0 at the top
+  std::vector<glm::vec4> composite;  ///< composite views
+  std::vector<gpu::TraceAov> aov;    ///< when asked for
+};
+
+struct FrameResult {
+  FrameStats stats;
+  std::vector<vk::PassTime> passes;
+  std::vector<ViewPixels> views;  ///< per view asked to read back (empty otherwise)
+};
+
+/// What a frame is asked to do.
+struct FrameRequest {
+  const scene::Pose* pose = nullptr;
+  std::vector<ViewRequest> views;
+  /// Records more work after the views (a viewer's display pass and UI),
+  /// once every view's images are written.
+  std::function<void(vk::Commands&)> record;
+  /// A swapchain's semaphores: waited for at `waitStage`, signalled at the end.
+  VkSemaphore waitSemaphore = VK_NULL_HANDLE;
+  VkPipelineStageFlags waitStage = 0;
+  VkSemaphore signalSemaphore = VK_NULL_HANDLE;
+};
+
+struct RendererOptions {
+  /// Frames the host records ahead of the GPU; host-written data has a copy per frame.
+  uint32_t framesInFlight = 2;
+  /// A refitted tree whose SAH cost has grown past this many times its cost
+  /// after its last build is rebuilt.
+  double rebuildGrowth = 1.5;
+  /// Triangles rebuilt per frame at most (refitted meanwhile), so rebuilds spread over frames.
+  uint64_t rebuildBudget = 1u << 20;
+};
+
+/// The images of one view; they keep the last frame's result until the next frame that renders the view.
+struct ViewImages {
+  uint32_t width = 0, height = 0;
+  vk::Image trace;           ///< rgba16f, storage
+  vk::Image composite;       ///< kCompositeFormat (composite views)
+  vk::Image depth, mask;     ///< the pre-pass's (composite views)
+  vk::Buffer pixels;         ///< the masked trace's pixel list
+  vk::Buffer aov;            ///< gpu::TraceAov per pixel, when asked for
 };
 
 class Renderer {
  public:
-  /// Uploads the scene and builds the passes for the items of `layout`.
-  Renderer(vk::Context& context, const scene::Scene& scene, const scene::Pose& layout);
+  /// Uploads the scene for the draw items of `layout`. Builds no tree and
+  /// no trace pipeline until a frame needs them.
+  Renderer(vk::Context& context, const scene::Scene& scene, const scene::Pose& layout, RendererOptions options = {});
   ~Renderer();
+  Renderer(const Renderer&) = delete;
+  Renderer& operator=(const Renderer&) = delete;
 
-  /// Records a frame of `pose` seen from settings.view into `target` (rgba16f,
-  /// GENERAL layout) and, when `aov` is given, per-pixel gpu::TraceAov records.
-  /// `rays`, when given, holds width * height gpu::GpuRay (camera-relative) to
-  /// trace instead of the camera's. update() at the view's eye, then trace().
-  void record(vk::Commands& commands, const scene::Pose& pose, const FrameSettings& settings, const vk::Image& target,
-              const vk::Buffer* aov = nullptr, const vk::Buffer* rays = nullptr);
+  /// Records and submits a frame and returns its number. Waits only for the
+  /// frame that used its in-flight slot before (framesInFlight frames ago).
+  uint64_t submit(const FrameRequest& request);
+  /// Waits for frame `frame` (the most recent one framesInFlight can hold)
+  /// and returns its results: the pixels asked for, what it did, pass times.
+  const FrameResult& wait(uint64_t frame);
+  /// Waits for every frame in flight.
+  void finish();
 
-  /// Records the passes that depend on the pose but not on a view: deform,
-  /// bottom level, top level, with the scene rebased to `origin` (world space,
-  /// in double) so float precision does not depend on where the scene is. The
-  /// host writes the frame's instances and lights: the previous frame must
-  /// have finished.
-  void update(vk::Commands& commands, const scene::Pose& pose, const glm::dvec3& origin);
-  /// Records the trace pass of one view of the pose last updated; a frame may
-  /// trace several views (viewports) whose eyes are near its origin.
-  void trace(vk::Commands& commands, const FrameSettings& settings, const vk::Image& target,
-             const vk::Buffer* aov = nullptr, const vk::Buffer* rays = nullptr);
+  /// The images of view `index` (valid once a frame rendered it; a view's
+  /// images are rewritten by later frames that render it).
+  const ViewImages& viewImages(size_t index) const;
 
-  /// Forces the next frame to rebuild the bottom level instead of refitting it.
-  void invalidateBlas() { blasBuilt_ = false; }
+  /// Forces the next frame that needs trees to rebuild every tree.
+  void invalidateTrees();
+  /// Forces the next frame to redraw every view, even one that nothing
+  /// changed for (for tools that change GPU data behind the renderer's back).
+  void invalidateViews();
 
   const SceneGpu& sceneGpu() const { return scene_; }
   const scene::Scene& scene() const { return sceneModel_; }
-  /// The last update's instances (gpu::GpuInstance, rebased to its origin) and
-  /// lights (gpu::GpuLight), which the raster pass shares.
+  const glm::dvec3& origin() const { return origin_; }
+  /// Whether any face of the scene refracts (else a composite never traces).
+  bool refractive() const { return refractive_; }
+  /// The trees, built by the first frame that traces (null before).
+  const Bvh* blas() const { return blas_.get(); }
+  const Bvh* tlas() const { return tlas_.get(); }
+  BvhBuilder* builder() { return builder_.get(); }
+  /// The last update's instances (gpu::GpuInstance, rebased to the origin) and lights (gpu::GpuLight).
   const vk::Buffer& instances() const { return instances_; }
   const vk::Buffer& lights() const { return lights_; }
   uint32_t lightCount() const { return lightCount_; }
-  const glm::dvec3& origin() const { return origin_; }
-  const Bvh& blas() const { return blas_; }
-  const Bvh& tlas() const { return tlas_; }
-  BvhBuilder& builder() { return builder_; }
-  /// GPU memory of geometry, BVHs and per-frame buffers (not the output image).
+  /// GPU memory of geometry, deformation, trees and per-frame tables (not view images).
   uint64_t memoryBytes() const;
+  /// Bytes of tree memory (both levels) per bottom-level triangle, build scratch apart.
+  double treeBytesPerTriangle() const;
 
  private:
+  struct Slot;
+  struct View;
+  struct Update;
+  void prepareTrees();
+  Update planUpdate(const scene::Pose& pose, const std::vector<ViewRequest>& views, FrameStats& stats);
+  void recordUpdate(vk::Commands& commands, Slot& slot, const scene::Pose& pose, const Update& update);
+  void recordView(vk::Commands& commands, Slot& slot, size_t index, const ViewRequest& request, FrameStats& stats);
+  void recordTrace(vk::Commands& commands, const ViewRequest& request, View& view, bool masked, FrameStats& stats);
+  void collect(Slot& slot);
+  bool viewNeedsTrees(const ViewRequest& request) const;
+  bool transmissiveInView(const FrameSettings& settings) const;
+
   vk::Context& context_;
   const scene::Scene& sceneModel_;
+  RendererOptions options_;
   SceneGpu scene_;
   std::unique_ptr<DeformPass> deform_;
-  BvhBuilder builder_;
-  Bvh blas_, tlas_;
-  bool blasBuilt_ = false;
-  bool updated_ = false;
-  glm::dvec3 origin_{0.0};
+  std::unique_ptr<RasterPass> raster_;
+  std::unique_ptr<BvhBuilder> builder_;
+  std::unique_ptr<Bvh> blas_, tlas_;
+  std::unique_ptr<vk::ComputeProgram> trace_, compact_;
+  vk::Buffer instances_, lights_, placeholder_, stats_;
   uint32_t lightCount_ = 0;
-  vk::Buffer instances_, lights_, placeholder_;
-  vk::UploadArena arena_;
-  std::unique_ptr<vk::ComputeProgram> trace_;
+  bool refractive_ = false;
+
+  // What the GPU holds, to find what changed.
+  struct ItemState {
+    bool deformed = false;
+    std::vector<float> weights;
+    std::vector<glm::dmat4> joints;
+  };
+  std::vector<ItemState> items_;           ///< per pose item
+  std::vector<uint32_t> itemDeformOutput_; ///< per pose item: its DeformPass output, or ~0
+  std::vector<gpu::GpuInstance> uploadedInstances_;
+  std::vector<gpu::GpuLight> uploadedLights_;
+  std::vector<char> geometryDirty_;  ///< per bottom-level group: positions changed since its tree last saw them
+  bool treesBuilt_ = false, topDirty_ = true, topBuilt_ = false;
+  bool originSet_ = false;
+  glm::dvec3 origin_{0.0};
+  uint64_t sceneVersion_ = 0;  ///< bumps whenever what a view shows may have changed
+  // Tree quality: SAH cost right after each group's build, and rebuilds due.
+  std::vector<double> baselineSah_;
+  double topBaselineSah_ = 0.0;
+  std::deque<uint32_t> rebuildQueue_;
+  std::vector<char> queued_;
+  bool topRebuildDue_ = false;
+  // Bounding spheres: per shape at rest (its morph targets' largest
+  // displacements apart), and per item as the last frame placed it.
+  struct Sphere {
+    glm::dvec3 centre{0.0};
+    double radius = 0.0;
+  };
+  std::vector<Sphere> shapeSpheres_;
+  std::vector<std::vector<double>> shapeMorphReach_;  ///< per shape, per target: its largest displacement
+  std::vector<Sphere> itemSpheres_;
+
+  std::vector<std::unique_ptr<Slot>> slots_;
+  std::vector<View> views_;
+  uint64_t submitted_ = 0;
 };
 
 /// A frame brought back to the host: linear RGBA, row 0 at the top.
@@ -100,24 +238,23 @@ struct RenderedFrame {
   /// NaN or infinite (all triangles are checked on a build, deforming ones on a refit).
   uint32_t droppedTriangles = 0;
   std::vector<vk::PassTime> passes;
+  FrameStats stats;
 };
 
-/// What one frame writes, sized for its settings: the trace image (rgba16f),
-/// the AOV buffer when asked for, the ray list when the settings give one.
-struct FrameTargets {
-  vk::Image image;
-  vk::Buffer aov, rays;
-};
-FrameTargets makeFrameTargets(vk::Context& context, const FrameSettings& settings, bool withAov);
-/// Reads a completed frame's targets back, with the passes `commands` timed.
-RenderedFrame readFrame(vk::Context& context, const Renderer& renderer, const FrameTargets& targets,
-                        const vk::Commands& commands);
-/// A whole rgba16f image (GENERAL layout) as linear floats, row 0 at the top.
-std::vector<glm::vec4> downloadRgba16f(vk::Context& context, const vk::Image& image);
-
-/// Renders one frame and reads it back (waits for the GPU).
+/// Renders one view's trace of every pixel and reads it back (waits for the GPU).
 RenderedFrame renderFrame(vk::Context& context, Renderer& renderer, const scene::Pose& pose,
                           const FrameSettings& settings, bool withAov = false);
+
+/// A traced frame and its raster composite, read back (tests, `snell render --viewport`).
+struct CompositeFrame {
+  RenderedFrame trace;          ///< the trace image (whole unless masked) and its AOV
+  std::vector<glm::vec4> rgba;  ///< the composite, row 0 at the top
+};
+
+/// Renders one viewport composite (update, trace, raster) and reads both images back.
+CompositeFrame renderComposite(vk::Context& context, Renderer& renderer, const scene::Pose& pose,
+                               const FrameSettings& settings, const RasterOptions& options, bool withAov = false,
+                               bool masked = false);
 
 /// Checks a requested image size against the device: throws
 /// std::invalid_argument saying what is wrong.

@@ -86,6 +86,7 @@ SceneGpu uploadScene(vk::Context& context, const scene::Scene& scene, const scen
     bool hasMaterial = shape.material >= 0 && size_t(shape.material) < scene.materials.size();
     gpu.itemMaterial.push_back(hasMaterial ? static_cast<uint32_t>(shape.material)
                                            : static_cast<uint32_t>(scene.materials.size()));
+    gpu.itemRefractive.push_back(hasMaterial && scene.materials[size_t(shape.material)].refractive() ? 1 : 0);
   }
   gpu.vertexCount = static_cast<uint32_t>(vertices);
   gpu.triangleCount = static_cast<uint32_t>(triangles);

@@ -27,6 +27,7 @@ struct SceneGpu {
   std::vector<GeometryRange> geometries;
   std::vector<uint32_t> itemGeometry;  ///< per pose item
   std::vector<uint32_t> itemMaterial;  ///< per pose item: index into the material table
+  std::vector<char> itemRefractive;    ///< per pose item: its faces refract (material transmission > 0)
   uint32_t vertexCount = 0, triangleCount = 0;
   vk::Buffer positions, normals;  ///< float[3 * vertexCount]; rest pose, deformed slices rewritten per frame
   vk::Buffer texcoords;           ///< vec4 per vertex: uv0, uv1

@@ -70,6 +70,8 @@ void Commands::begin() {
   VK_CHECK(vkBeginCommandBuffer(buffer_, &info));
   recording_ = true;
   queryCount_ = 0;
+  dispatches_ = 0;
+  draws_ = 0;
   passNames_.clear();
   passOpen_ = false;
   if (queries_) vkCmdResetQueryPool(buffer_, queries_, 0, kMaxTimestamps);
@@ -136,6 +138,24 @@ void Commands::computeToTransfer() {
                 VK_ACCESS_TRANSFER_READ_BIT | VK_ACCESS_TRANSFER_WRITE_BIT);
 }
 
+void Commands::computeToIndirect() {
+  barrier(VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT,
+          VK_PIPELINE_STAGE_DRAW_INDIRECT_BIT | VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
+          VK_ACCESS_INDIRECT_COMMAND_READ_BIT | VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT);
+}
+
+void Commands::graphicsToCompute() {
+  barrier(VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT | VK_PIPELINE_STAGE_EARLY_FRAGMENT_TESTS_BIT |
+              VK_PIPELINE_STAGE_LATE_FRAGMENT_TESTS_BIT,
+          VK_ACCESS_COLOR_ATTACHMENT_WRITE_BIT | VK_ACCESS_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT,
+          VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_READ_BIT);
+}
+
+void Commands::fullBarrier() {
+  barrier(VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, VK_ACCESS_MEMORY_WRITE_BIT, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT,
+          VK_ACCESS_MEMORY_READ_BIT | VK_ACCESS_MEMORY_WRITE_BIT);
+}
+
 void Commands::transferToHost() {
   barrier(VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_HOST_BIT,
                 VK_ACCESS_HOST_READ_BIT);
@@ -191,6 +211,26 @@ void Commands::copyBuffer(const Buffer& from, const Buffer& to, VkDeviceSize byt
 void Commands::fillBuffer(const Buffer& buffer, uint32_t word) {
   if (buffer.size() == 0) return;
   vkCmdFillBuffer(buffer_, buffer.handle(), 0, buffer.size() & ~VkDeviceSize(3), word);
+}
+
+void Commands::copyImageToBuffer(const Image& image, const Buffer& buffer, VkDeviceSize offset) {
+  VkDeviceSize bytes = VkDeviceSize(image.width()) * image.height() * image.bytesPerPixel();
+  if (offset + bytes > buffer.size()) {
+    throw VulkanError("copy of image '" + image.name() + "' into '" + buffer.name() + "' runs past the buffer's end");
+  }
+  VkBufferImageCopy region{};
+  region.bufferOffset = offset;
+  region.imageSubresource = {aspectOf(image.format()), 0, 0, 1};
+  region.imageExtent = {image.width(), image.height(), 1};
+  // Through the layout copies are meant for, and back: whatever wrote the image before, reads it after.
+  VkImageAspectFlags aspect = aspectOf(image.format());
+  imageBarrier(image.handle(), aspect, VK_IMAGE_LAYOUT_GENERAL, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
+               VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, VK_ACCESS_MEMORY_WRITE_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT,
+               VK_ACCESS_TRANSFER_READ_BIT);
+  vkCmdCopyImageToBuffer(buffer_, image.handle(), VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, buffer.handle(), 1, &region);
+  imageBarrier(image.handle(), aspect, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, VK_IMAGE_LAYOUT_GENERAL,
+               VK_PIPELINE_STAGE_TRANSFER_BIT, 0, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT,
+               VK_ACCESS_MEMORY_READ_BIT | VK_ACCESS_MEMORY_WRITE_BIT);
 }
 
 void Commands::fillBuffer(const Buffer& buffer, uint32_t word, VkDeviceSize offset, VkDeviceSize bytes) {

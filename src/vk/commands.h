@@ -50,6 +50,14 @@ class Commands {
   void transferToCompute();
   /// Compute writes become visible to transfers (copies to readback buffers).
   void computeToTransfer();
+  /// Compute writes become visible to indirect dispatch arguments and to later compute shaders.
+  void computeToIndirect();
+  /// Depth and colour attachment writes become visible to compute shaders (the mask the trace compacts).
+  void graphicsToCompute();
+  /// Every earlier command, of this submission or an earlier one, finishes
+  /// and its writes are visible before anything later starts: the start of a
+  /// frame that rewrites what frames still in flight read.
+  void fullBarrier();
   /// Transfer writes become visible to the host after wait().
   void transferToHost();
   /// Compute writes (deformed vertices, the trace image) become visible to the
@@ -77,6 +85,8 @@ class Commands {
   void fillBuffer(const Buffer& buffer, uint32_t word);
   /// Fills `bytes` (a multiple of 4) from `offset` with `word`.
   void fillBuffer(const Buffer& buffer, uint32_t word, VkDeviceSize offset, VkDeviceSize bytes);
+  /// Copies a whole image (GENERAL layout, one mip, one layer) into a buffer, tightly packed.
+  void copyImageToBuffer(const Image& image, const Buffer& buffer, VkDeviceSize offset = 0);
 
   /// Starts timing a pass once every earlier command has finished; passes do
   /// not nest; at most 128 per submission. No-op where the queue has no timestamps.
@@ -87,6 +97,12 @@ class Commands {
 
   /// A descriptor set that lives until this object is next begun.
   VkDescriptorSet allocateSet(VkDescriptorSetLayout layout);
+  /// Dispatches and draws recorded since begin() (the frame's counters).
+  void noteDispatch() { ++dispatches_; }
+  void noteDraw() { ++draws_; }
+  uint32_t dispatches() const { return dispatches_; }
+  uint32_t draws() const { return draws_; }
+
   /// Keeps `object` alive until this object is next begun: for resources a
   /// recorded command uses whose owner lets go of them before the submit.
   void keepAlive(std::shared_ptr<void> object) { keptAlive_.push_back(std::move(object)); }
@@ -110,6 +126,7 @@ class Commands {
   bool passOpen_ = false;
   std::vector<PassTime> times_;
   std::vector<std::shared_ptr<void>> keptAlive_;
+  uint32_t dispatches_ = 0, draws_ = 0;
 };
 
 /// Copies bytes into a buffer: directly when it is mapped, else through a staging

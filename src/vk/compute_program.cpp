@@ -120,7 +120,8 @@ std::vector<std::string> ComputeProgram::statistics() const {
 }
 
 void ComputeProgram::record(Commands& commands, std::initializer_list<BufferBinding> buffers, const void* push,
-                            size_t pushBytes, uint64_t groups) const {
+                            size_t pushBytes, uint64_t groups, const Buffer* indirect,
+                            VkDeviceSize indirectOffset) const {
   if (pushBytes != reflection_.pushConstantBytes && !(reflection_.pushConstantBytes == 0 && push == nullptr)) {
     throw VulkanError("program '" + name_ + "' takes " + std::to_string(reflection_.pushConstantBytes) +
                       " bytes of push constants; the call gave " + std::to_string(pushBytes));
@@ -129,7 +130,7 @@ void ComputeProgram::record(Commands& commands, std::initializer_list<BufferBind
     throw VulkanError("program '" + name_ + "' has " + std::to_string(reflection_.bindings.size()) +
                       " bindings; the call gave " + std::to_string(buffers.size()));
   }
-  if (groups == 0) return;
+  if (groups == 0 && !indirect) return;
   VkDescriptorSet set =
       writeSet(commands, setLayout_, reflection_.bindings, std::span(buffers.begin(), buffers.size()), name_);
 
@@ -138,6 +139,11 @@ void ComputeProgram::record(Commands& commands, std::initializer_list<BufferBind
   vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, pipelineLayout_, 0, 1, &set, 0, nullptr);
   if (reflection_.pushConstantBytes) {
     vkCmdPushConstants(cmd, pipelineLayout_, VK_SHADER_STAGE_COMPUTE_BIT, 0, reflection_.pushConstantBytes, push);
+  }
+  commands.noteDispatch();
+  if (indirect) {
+    vkCmdDispatchIndirect(cmd, indirect->handle(), indirectOffset);
+    return;
   }
   const DeviceCaps& caps = context_->caps();
   uint64_t maxX = caps.maxComputeWorkgroupCount[0];

@@ -57,10 +57,17 @@ class ComputeProgram {
                       uint64_t groups) const {
     record(commands, buffers, &push, sizeof(Push), groups);
   }
+  /// Dispatches the workgroup counts (x, y, z) the GPU wrote at `offset` of
+  /// `arguments` (VkDispatchIndirectCommand), made visible to the indirect stage before.
+  template <typename Push>
+  void dispatchIndirect(Commands& commands, std::initializer_list<BufferBinding> buffers, const Push& push,
+                        const Buffer& arguments, VkDeviceSize offset = 0) const {
+    record(commands, buffers, &push, sizeof(Push), 0, &arguments, offset);
+  }
 
  private:
   void record(Commands& commands, std::initializer_list<BufferBinding> buffers, const void* push, size_t pushBytes,
-              uint64_t groups) const;
+              uint64_t groups, const Buffer* indirect = nullptr, VkDeviceSize indirectOffset = 0) const;
 
   Context* context_;
   std::string name_;

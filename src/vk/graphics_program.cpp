@@ -176,10 +176,11 @@ void GraphicsProgram::record(Commands& commands, const void* push, size_t pushBy
                        pushConstantBytes_, push);
   }
   vkCmdDraw(cmd, vertexCount, 1, firstVertex, instance);
+  commands.noteDraw();
 }
 
 RenderingScope::RenderingScope(Commands& commands, const Image& color, const Image* depth, VkRect2D area,
-                               const float* clearColor)
+                               const float* clearColor, bool clearDepth)
     : commands_(commands) {
   VkRenderingAttachmentInfo colorAttachment{VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO};
   colorAttachment.imageView = color.view();
@@ -193,8 +194,8 @@ RenderingScope::RenderingScope(Commands& commands, const Image& color, const Ima
   if (depth) {
     depthAttachment.imageView = depth->view();
     depthAttachment.imageLayout = VK_IMAGE_LAYOUT_GENERAL;
-    depthAttachment.loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR;
-    depthAttachment.storeOp = VK_ATTACHMENT_STORE_OP_DONT_CARE;
+    depthAttachment.loadOp = clearDepth ? VK_ATTACHMENT_LOAD_OP_CLEAR : VK_ATTACHMENT_LOAD_OP_LOAD;
+    depthAttachment.storeOp = VK_ATTACHMENT_STORE_OP_STORE;
     depthAttachment.clearValue.depthStencil = {0.0f, 0};  // reverse Z: 0 is infinitely far
   }
   VkRenderingInfo info{VK_STRUCTURE_TYPE_RENDERING_INFO};

@@ -70,10 +70,12 @@ class GraphicsProgram {
 };
 
 /// A rendering scope (dynamic rendering) on one colour image and an optional
-/// depth image, both in GENERAL layout; cleared when asked. Ends on destruction.
+/// depth image, both in GENERAL layout; the colour cleared when a clear colour
+/// is given, the depth cleared or loaded (kept after either). Ends on destruction.
 class RenderingScope {
  public:
-  RenderingScope(Commands& commands, const Image& color, const Image* depth, VkRect2D area, const float* clearColor);
+  RenderingScope(Commands& commands, const Image& color, const Image* depth, VkRect2D area, const float* clearColor,
+                 bool clearDepth = true);
   ~RenderingScope();
   RenderingScope(const RenderingScope&) = delete;
   RenderingScope& operator=(const RenderingScope&) = delete;

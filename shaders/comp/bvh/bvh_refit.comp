@@ -29,7 +29,7 @@ layout(std430, binding = kBvhBindingBlasGroups) readonly buffer BlasGroups { Bvh
 // Coherent: a box one invocation writes is read by another after the atomic.
 layout(std430, binding = kBvhBindingNodes) coherent buffer Nodes { BvhNode nodes[]; };
 layout(std430, binding = kBvhBindingGroups) buffer Groups { BvhGroup groups[]; };
-layout(std430, binding = kBvhBindingStats) buffer Stats { uvec2 stats[]; };
+layout(std430, binding = kBvhBindingStats) buffer Stats { uvec4 stats[]; };
 layout(std430, binding = kBvhBindingDropped) buffer Dropped { uint dropped; };
 #include "bvh_leaves.glsl"
 
@@ -66,11 +66,14 @@ void writeSlot(uint node, uint slot, vec3 lo, vec3 hi) {
   }
 }
 
+// The root's new box, and its area next to the build's for the host's SAH ratio.
 void writeGroupBox(uint g, vec3 lo, vec3 hi) {
   for (uint k = 0u; k < 3u; ++k) {
     groups[g].boxLo[k] = lo[k];
     groups[g].boxHi[k] = hi[k];
   }
+  stats[g].z = floatBitsToUint(boxArea(lo, hi));
+  stats[g].w = floatBitsToUint(groups[g].buildArea);
 }
 
 // Whether `node` is complete after this invocation's arrival (the second

@@ -1,0 +1,25 @@
+// What one view of a frame looks like: its size, camera and background. The
+// trace and the raster pass both draw from it.
+#pragma once
+
+#include "scene/view.h"
+#include "shared/trace.h"
+
+#include <glm/glm.hpp>
+
+#include <cstdint>
+#include <vector>
+
+namespace snell::render {
+
+struct FrameSettings {
+  uint32_t width = 0, height = 0;
+  scene::View view;
+  glm::vec3 background{0.02f, 0.02f, 0.025f};
+  uint32_t maxInterfaces = gpu::kDefaultMaxInterfaces;
+  /// When not empty: width * height primary rays in world space, pixel i
+  /// (row-major) tracing rays[i] instead of the camera's ray through it.
+  std::vector<scene::Ray> rays;
+};
+
+}  // namespace snell::render
