@@ -137,7 +137,7 @@ std::multiset<uint32_t> walk(const BvhSnapshot& s, uint32_t group, const Soup& s
       if (child & gpu::kBvhLeafBit) {
         leaf(child, lo, hi);
       } else {
-        EXPECT_EQ(s.nodes[child].parent, n);
+        EXPECT_EQ(s.nodes[child].parent, n | (c == 1 ? gpu::kBvhParentRight : 0u));
         const gpu::BvhNode& c2 = s.nodes[child];
         EXPECT_TRUE(contains(lo, hi, &c2.box[0], &c2.box[3]) && contains(lo, hi, &c2.box[6], &c2.box[9]))
             << "node " << child << " pokes out of its parent " << n;

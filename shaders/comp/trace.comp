@@ -231,19 +231,8 @@ vec3 offsetRay(vec3 p, vec3 n) {
   return mix(pi, p + kFloatScale * n, lessThan(abs(p), vec3(kOrigin)));
 }
 
-void main() {
-  uint tile = gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x;
-  uvec2 pixel;
-  if ((pc.flags & kTraceFlagPixelList) != 0u) {
-    // The masked trace: one invocation per listed pixel (listed tile by tile, so neighbours stay together).
-    uint i = tile * gl_WorkGroupSize.x + gl_LocalInvocationID.x;
-    if (i >= list.count) return;
-    pixel = uvec2(listed[i] & 0xffffu, listed[i] >> 16);
-  } else {
-    pixel = uvec2(tile % pc.tilesX, tile / pc.tilesX) * kTraceTile +
-            uvec2(gl_LocalInvocationID.x % kTraceTile, gl_LocalInvocationID.x / kTraceTile);
-  }
-  if (pixel.x >= pc.width || pixel.y >= pc.height) return;
+// One pixel's ray (or its listed ray), its whole path, and what it writes.
+void tracePixel(uvec2 pixel) {
 
   float sx = (2.0 * (float(pixel.x) + 0.5) / float(pc.width) - 1.0) * pc.right.w + pc.shiftX;
   float sy = (1.0 - 2.0 * (float(pixel.y) + 0.5) / float(pc.height)) * pc.up.w + pc.shiftY;
@@ -322,4 +311,21 @@ void main() {
     aovs[pixel.y * pc.width + pixel.x] =
         TraceAov(firstDistance, firstInstance, firstPrimitive, interfaces, outcome, visits, 0u, 0u);
   }
+}
+
+void main() {
+  uint tile = gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x;
+  if ((pc.flags & kTraceFlagPixelList) != 0u) {
+    // The masked trace: each workgroup takes pixelsPerGroup listed pixels
+    // (listed tile by tile, so neighbours stay together).
+    uint first = tile * pc.pixelsPerGroup;
+    for (uint i = first + gl_LocalInvocationID.x; i < min(first + pc.pixelsPerGroup, list.count); i += gl_WorkGroupSize.x) {
+      tracePixel(uvec2(listed[i] & 0xffffu, listed[i] >> 16));
+    }
+    return;
+  }
+  uvec2 pixel = uvec2(tile % pc.tilesX, tile / pc.tilesX) * kTraceTile +
+          uvec2(gl_LocalInvocationID.x % kTraceTile, gl_LocalInvocationID.x / kTraceTile);
+  if (pixel.x >= pc.width || pixel.y >= pc.height) return;
+  tracePixel(pixel);
 }

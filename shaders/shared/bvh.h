@@ -22,6 +22,7 @@ SNELL_GPU_BEGIN
 // triangle index in the bottom level, an instance in the top level).
 SNELL_CONST kBvhLeafBit = 0x80000000u;
 SNELL_CONST kBvhNone = 0xffffffffu;  // no parent (a group's root), no root (an empty group), no cluster
+SNELL_CONST kBvhParentRight = 0x80000000u;  // in BvhNode::parent: the node is its parent's child 1
 SNELL_CONST kBvhMaxPrimitives = 0x7fffffffu;
 // Morton codes use 10 bits per axis; the build entry of a primitive sits above
 // them in the sort key, so one sort orders every group of a build.
@@ -68,7 +69,7 @@ SNELL_CONST kBvhFlagKeys32 = 2u;     // sort keys are 32-bit
 struct BvhNode {
   float box[12];   // 48: child 0 lo xyz, hi xyz; child 1 lo xyz, hi xyz
   uint child[2];   // 8: node index, or a leaf reference
-  uint parent;     // 4: kBvhNone at a group's root
+  uint parent;     // 4: kBvhNone at a group's root; else the parent's slot, kBvhParentRight set when this is its child 1
   uint arrivals;   // 4: refit arrivals; even between refits (a build zeroes it)
 };
 

@@ -153,41 +153,16 @@ SNELL_CONST kTraceBindingRays = 15;       // GpuRay[width * height], with kTrace
 SNELL_CONST kTraceBindingPixels = 16;     // TracePixelList, with kTraceFlagPixelList
 SNELL_CONST kTraceBindingMask = 17;       // r32ui image: non-zero where a transmissive face is visible (compaction)
 
-// The masked trace's pixel list (shaders/comp/trace_compact.comp writes it,
-// the trace reads it): a header, then one packed pixel (x | y << 16) per entry.
-// The header's dispatch fields are a VkDispatchIndirectCommand for the trace.
-// 32 bytes, total: 32 bytes
-struct TracePixelListHeader {
-  uint count;       // 4: pixels listed
-  uint groupsDone;  // 4: compaction workgroups finished (the last one writes the dispatch)
-  uint dispatchX;   // 4: trace workgroups, split over y beyond the device's x limit
-  uint dispatchY;   // 4
-  uint dispatchZ;   // 4
-  uint pad0;        // 4
-  uint pad1;        // 4
-  uint pad2;        // 4
-};
-SNELL_CONST kTracePixelListDispatchOffset = 8;  // bytes into the list: the indirect arguments
-
-// 16 bytes, total: 16 bytes
-struct TraceCompactPush {
-  uint width;        // 4
-  uint height;       // 4
-  uint tilesX;       // 4: kTraceTile-wide tiles per row
-  uint maxGroupsX;   // 4: the device's workgroup-count limit along x
-};
-
-// A primary ray from a list, camera-relative like everything the trace sees.
+// A primary ray from a list, relative to the frame origin like everything the trace sees.
 // 32 bytes, total: 32 bytes
 struct GpuRay {
   vec4 origin;     // 16: xyz; w unused
   vec4 direction;  // 16: xyz, unit length; w unused
 };
 
-// The scene is rebased to a frame origin near the camera (Renderer::update);
-// `eye` is the camera relative to it: zero when a frame has one view, the
-// offset of a second viewport's camera from the first's otherwise.
-// 112 bytes, total: 112 bytes
+// The scene is rebased to a frame origin near the cameras (Renderer);
+// `eye` is the camera relative to it.
+// 128 bytes, total: 128 bytes
 struct TracePush {
   vec4 right;       // 16: xyz; w: half width of the view at unit distance (or of the ortho view)
   vec4 up;          // 16: xyz; w: half height
@@ -202,6 +177,37 @@ struct TracePush {
   uint tilesX;      // 4: tiles per row
   float shiftX;     // 4: the film back's offset (View::shift)
   float shiftY;     // 4
+  uint pixelsPerGroup;  // 4: with kTraceFlagPixelList, listed pixels per workgroup
+  uint pad0;        // 4
+  uint pad1;        // 4
+  uint pad2;        // 4
+};
+
+// The masked trace's pixel list (shaders/comp/trace_compact.comp writes it,
+// the trace reads it): a header, then one packed pixel (x | y << 16) per entry.
+// The header's dispatch fields are a VkDispatchIndirectCommand for the trace;
+// the host writes the header (count 0, dispatch 0 x 1 x 1) before compacting.
+// 32 bytes, total: 32 bytes
+struct TracePixelListHeader {
+  uint count;      // 4: pixels listed
+  uint pad0;       // 4
+  uint dispatchX;  // 4: trace workgroups (atomicMax as pixels are listed)
+  uint dispatchY;  // 4: 1
+  uint dispatchZ;  // 4: 1
+  uint pad1;       // 4
+  uint pad2;       // 4
+  uint pad3;       // 4
+};
+SNELL_CONST kTracePixelListDispatchOffset = 8;  // bytes into the list: the indirect arguments
+// Tiles of kTraceTile x kTraceTile pixels each compaction workgroup lists, one after another.
+SNELL_CONST kTraceCompactTiles = 16;
+
+// 16 bytes, total: 16 bytes
+struct TraceCompactPush {
+  uint width;           // 4
+  uint height;          // 4
+  uint tilesX;          // 4: kTraceTile-wide tiles per row
+  uint pixelsPerGroup;  // 4: listed pixels one trace workgroup takes (its dispatch stays within the device's limit)
 };
 
 SNELL_GPU_END

@@ -126,12 +126,6 @@ int runBenchFrame(const Args& args) {
   double duration = std::max(scene::animationDuration(scene), 1e-3);
   scene::Pose layout = scene::evaluate(scene, 0.0);
   render::Renderer renderer(*context, scene, layout);
-  // Depth range from the first pose's bounds, grown: bounds deform on the CPU, too slow per frame for a crowd.
-  glm::dvec3 lo, hi;
-  scene::sceneBounds(scene, layout, lo, hi);
-  glm::dvec3 pad = 0.25 * (hi - lo);
-  lo -= pad;
-  hi += pad;
   std::map<std::string, std::vector<double>> times;
   std::vector<std::string> order;
   std::vector<double> totals, refractionTotals;
@@ -148,6 +142,8 @@ int runBenchFrame(const Args& args) {
       view.output = render::ViewOutput::Composite;
       view.masked = masked;
       view.raster.refraction = refraction;
+      glm::dvec3 lo, hi;
+      scene::approximateBounds(scene, pose, lo, hi);
       render::fitDepthRange(view.settings.view, lo, hi, view.raster);
     }
     render::FrameRequest request;

@@ -1,13 +1,23 @@
-// `snell bench scale`: how the bottom-level update scales with triangles, on
-// UV spheres of 1e4 to 1e7 triangles: build and refit times (GPU timestamps,
+// `snell bench scale`: how the work of a frame scales. With triangles, on UV
+// spheres of 1e4 to 1e7 triangles: build and refit times (GPU timestamps,
 // medians), their rates, tree memory per triangle and the build's SAH cost
-// against a CPU binned-SAH tree.
+// against a CPU binned-SAH tree, next to the driver's own acceleration
+// structures built and updated over the same triangles in the same run.
+// With characters, on crowds of the procedural eye: the viewport frame's passes.
 #include "cli/cli.h"
 
+#include "peer/driver_bvh.h"
 #include "ref/sah_bvh.h"
 #include "render/bvh.h"
+#include "render/renderer.h"
+#include "scene/evaluate.h"
+#include "scene/procedural_eye.h"
+#include "scene/view.h"
 #include "vk/commands.h"
 #include "vk/upload_arena.h"
+
+#include <map>
+#include <optional>
 
 #include <algorithm>
 #include <cmath>
@@ -21,18 +31,30 @@ namespace {
 
 constexpr const char* kHelp = R"(usage: snell bench scale [options]
 
-Builds and refits the bottom-level tree of UV spheres of increasing size on
-the GPU and reports, per size, the median GPU time of a build (boxes, Morton
-codes, sort, H-PLOC) and of a refit, in milliseconds and millions of
-triangles per second, the tree's memory per triangle (nodes and per-tree
-records; the build's scratch separately) and, up to --sah-limit triangles,
-its SAH cost against a CPU binned-SAH tree of the same triangles.
+Triangles: builds and refits the bottom-level tree of UV spheres of
+increasing size on the GPU and reports, per size, the median GPU time of a
+build (boxes, Morton codes, sort, H-PLOC) and of a refit, in milliseconds and
+millions of triangles per second, the tree's memory per triangle (the build's
+scratch separately) and, up to --sah-limit triangles, its SAH cost against a
+CPU binned-SAH tree of the same triangles. Where the device has its own
+acceleration structures (VK_KHR_acceleration_structure), the same triangles
+are built with them in the same run (fast-build and fast-trace), and the
+fast-trace one updated in place, as the peer to beat.
+
+Characters: animated viewport frames of crowds of the procedural eye (two
+eyes a character): the median GPU time of each pass, the refraction work
+(deform, trees, masked trace), pixels traced and the trace's rays per second.
 
 options:
-  --triangles N,N,...  sphere sizes (default 10000,100000,1000000,10000000)
+  --triangles N,N,...  sphere sizes (default 10000,100000,1000000,10000000; 0 skips)
   --runs N             timed builds and refits per size (default 10, after one warm-up)
   --restructure N      rounds of treelet restructuring after each build (default 0)
   --sah-limit N        price the tree against binned SAH up to this size (default 1000000)
+  --hploc-workgroup N  H-PLOC's workgroup size (default: the device's choice)
+  --refit-workgroup N  the refit's workgroup size (default: the device's choice)
+  --crowds N,N,...     characters per crowd (default 1,2,10,100,1000; 0 skips)
+  --size WxH           viewport size of the crowd frames (default 3840x2160)
+  --frames N           animated frames measured per crowd (default 20, after 5)
   --json FILE          write the results as JSON too
 )";
 
@@ -73,6 +95,15 @@ double median(std::vector<double> v) {
 struct Row {
   uint64_t triangles = 0;
   double buildMs = 0, refitMs = 0, bytesPerTriangle = 0, scratchPerTriangle = 0, sahRatio = 0;
+  // The driver's, where it has them (0 otherwise).
+  double driverFastBuildMs = 0, driverFastTraceMs = 0, driverUpdateMs = 0, driverBytesPerTriangle = 0;
+};
+
+struct CrowdRow {
+  uint32_t characters = 0;
+  uint64_t triangles = 0;
+  std::map<std::string, double> passMs;  ///< medians
+  double frameMs = 0, refractionMs = 0, pixelsTraced = 0, memoryPerTriangle = 0, treeBytesPerTriangle = 0;
 };
 
 std::vector<uint64_t> parseList(const std::string& option, const std::string& value) {
@@ -86,19 +117,70 @@ std::vector<uint64_t> parseList(const std::string& option, const std::string& va
     } catch (const std::exception&) {
       throw UsageError{"bench scale: " + option + " takes numbers separated by commas, not '" + item + "'"};
     }
-    if (!(v >= 2 && v <= 1e9)) throw UsageError{"bench scale: " + option + " sizes must be within 2 and 1e9"};
+    if (v == 0) continue;  // none
+    if (!(v >= 1 && v <= 1e9)) throw UsageError{"bench scale: " + option + " sizes must be within 1 and 1e9"};
     out.push_back(static_cast<uint64_t>(v));
   }
-  if (out.empty()) throw UsageError{"bench scale: " + option + " needs at least one size"};
   return out;
+}
+
+bool refractionPass(const std::string& name) {
+  return name == "deform" || name == "blas refit" || name == "blas build" || name == "tlas" || name == "trace";
+}
+
+CrowdRow measureCrowd(vk::Context& context, uint32_t characters, uint32_t width, uint32_t height, uint32_t frames) {
+  scene::EyeOptions options;
+  options.crowd = characters;
+  scene::Scene scene = scene::makeEye(options);
+  double duration = std::max(scene::animationDuration(scene), 1e-3);
+  scene::Pose layout = scene::evaluate(scene, 0.0);
+  render::Renderer renderer(context, scene, layout);
+  CrowdRow row;
+  row.characters = characters;
+  for (const scene::DrawItem& item : layout.items) row.triangles += scene.shapes[size_t(item.shape)].triangleCount();
+  std::map<std::string, std::vector<double>> passes;
+  std::vector<double> totals, refraction, pixels;
+  const uint32_t warmup = 5;
+  for (uint32_t f = 0; f < warmup + frames; ++f) {
+    scene::Pose pose = scene::evaluate(scene, std::fmod(double(f) / 24.0, duration));
+    render::ViewRequest view;
+    view.settings = {width, height, scene::resolveView(scene, pose, {}), {0.02f, 0.02f, 0.025f},
+                     gpu::kDefaultMaxInterfaces};
+    view.output = render::ViewOutput::Composite;
+    glm::dvec3 lo, hi;
+    scene::approximateBounds(scene, pose, lo, hi);
+    render::fitDepthRange(view.settings.view, lo, hi, view.raster);
+    render::FrameRequest request;
+    request.pose = &pose;
+    request.views = {view};
+    const render::FrameResult& result = renderer.wait(renderer.submit(request));
+    if (f < warmup) continue;
+    double total = 0, work = 0;
+    for (const vk::PassTime& p : result.passes) {
+      passes[p.name].push_back(p.milliseconds);
+      total += p.milliseconds;
+      if (refractionPass(p.name)) work += p.milliseconds;
+    }
+    totals.push_back(total);
+    refraction.push_back(work);
+    pixels.push_back(double(result.stats.pixelsTraced));
+  }
+  for (auto& [name, v] : passes) row.passMs[name] = median(v);
+  row.frameMs = median(totals);
+  row.refractionMs = median(refraction);
+  row.pixelsTraced = median(pixels);
+  row.memoryPerTriangle = double(renderer.memoryBytes()) / double(row.triangles);
+  row.treeBytesPerTriangle = renderer.treeBytesPerTriangle();
+  return row;
 }
 
 }  // namespace
 
 int runBenchScale(const Args& args) {
-  std::vector<uint64_t> sizes = {10000, 100000, 1000000, 10000000};
-  uint32_t runs = 10, restructure = 0;
+  std::vector<uint64_t> sizes = {10000, 100000, 1000000, 10000000}, crowds = {1, 2, 10, 100, 1000};
+  uint32_t runs = 10, restructure = 0, width = 3840, height = 2160, frames = 20;
   uint64_t sahLimit = 1000000;
+  render::BvhTuning tuning;
   std::string json;
   for (size_t i = 0; i < args.size(); ++i) {
     const std::string& a = args[i];
@@ -112,22 +194,35 @@ int runBenchScale(const Args& args) {
     else if (a == "--runs") runs = std::max<uint32_t>(1, uint32_t(parseCount(a, v)));
     else if (a == "--restructure") restructure = uint32_t(parseCount(a, v));
     else if (a == "--sah-limit") sahLimit = parseCount(a, v);
+    else if (a == "--crowds") crowds = parseList(a, v);
+    else if (a == "--hploc-workgroup") tuning.hplocWorkgroup = uint32_t(parseCount(a, v));
+    else if (a == "--refit-workgroup") tuning.refitWorkgroup = uint32_t(parseCount(a, v));
+    else if (a == "--size") parseSize(a, v, width, height);
+    else if (a == "--frames") frames = std::max<uint32_t>(1, uint32_t(parseCount(a, v)));
     else if (a == "--json") json = v;
     else throw UsageError{"bench scale: unknown option " + a};
   }
-  auto context = vk::Context::create(contextDescFromEnvironment());
-  std::printf("device: %s\n", context->facts().name.c_str());
-  render::BvhBuilder builder(*context);
+  vk::ContextDesc desc = contextDescFromEnvironment();
+  desc.driverAccelerationStructures = true;
+  auto context = vk::Context::create(desc);
+  bool driver = context->caps().driverAccelerationStructures;
+  std::printf("device: %s; the driver's acceleration structures: %s\n", context->facts().name.c_str(),
+              driver ? "measured beside snell's" : "unsupported");
+  render::BvhBuilder builder(*context, tuning);
   vk::UploadArena arena(*context, "bench scale uploads");
   std::vector<Row> rows;
-  std::printf("%12s %10s %10s %10s %10s %10s %10s %10s\n", "triangles", "build ms", "Mtri/s", "refit ms", "Mtri/s",
-              "B/tri", "scratch", "SAH/binned");
+  if (!sizes.empty()) {
+    std::printf("\nsnell: build and refit of one sphere's tree; driver: fast-build and fast-trace builds, update of the latter\n");
+    std::printf("%10s %9s %8s %9s %8s %6s %7s %6s | %9s %9s %9s %6s\n", "triangles", "build ms", "Mtri/s", "refit ms",
+                "Mtri/s", "B/tri", "scratch", "SAH", "drv FB ms", "drv FT ms", "drv upd", "B/tri");
+  }
   for (uint64_t target : sizes) {
     Mesh mesh = uvSphere(target);
     uint32_t triangles = static_cast<uint32_t>(mesh.indices.size() / 3);
     auto buffer = [&](const void* data, size_t bytes, const char* name) {
-      vk::Buffer b(*context, {bytes, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
-                              vk::MemoryDomain::Device, name});
+      VkBufferUsageFlags usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT |
+                                 (driver ? peer::kDriverInputUsage : 0);
+      vk::Buffer b(*context, {bytes, usage, vk::MemoryDomain::Device, name, driver});
       vk::upload(*context, b, data, bytes);
       return b;
     };
@@ -151,6 +246,32 @@ int runBenchScale(const Args& args) {
       for (const vk::PassTime& p : commands.passTimes()) (p.name == "build" ? build : refit).push_back(p.milliseconds);
     }
     Row row;
+    if (driver) {
+      // The driver's structures over the same buffers, timed the same way.
+      uint32_t vertices = static_cast<uint32_t>(mesh.positions.size() / 3);
+      peer::DriverBlas fastBuild(*context, positions, vertices, indices, triangles, peer::DriverBuild::FastBuild);
+      peer::DriverBlas fastTrace(*context, positions, vertices, indices, triangles, peer::DriverBuild::FastTrace);
+      std::vector<double> fb, ft, update;
+      for (uint32_t run = 0; run <= runs; ++run) {
+        commands.begin();
+        commands.beginPass("fast build");
+        fastBuild.recordBuild(commands);
+        commands.beginPass("fast trace");
+        fastTrace.recordBuild(commands);
+        commands.beginPass("update");
+        fastTrace.recordUpdate(commands);
+        commands.endPass();
+        commands.submitAndWait();
+        if (run == 0) continue;
+        for (const vk::PassTime& p : commands.passTimes()) {
+          (p.name == "fast build" ? fb : p.name == "fast trace" ? ft : update).push_back(p.milliseconds);
+        }
+      }
+      row.driverFastBuildMs = median(fb);
+      row.driverFastTraceMs = median(ft);
+      row.driverUpdateMs = median(update);
+      row.driverBytesPerTriangle = double(fastTrace.structureBytes()) / triangles;
+    }
     row.triangles = triangles;
     row.buildMs = median(build);
     row.refitMs = median(refit);
@@ -169,24 +290,64 @@ int runBenchScale(const Args& args) {
       row.sahRatio = ref::sahCost(tree.internal, tree.leaves) / ref::binnedSahCost(boxes);
     }
     rows.push_back(row);
-    std::printf("%12llu %10.3f %10.1f %10.4f %10.1f %10.1f %10.1f %10s\n", static_cast<unsigned long long>(triangles),
-                row.buildMs, triangles / row.buildMs / 1e3, row.refitMs, triangles / row.refitMs / 1e3,
-                row.bytesPerTriangle, row.scratchPerTriangle,
-                row.sahRatio > 0 ? std::to_string(row.sahRatio).substr(0, 5).c_str() : "-");
+    auto ms = [&](double v) { return driver ? std::to_string(v).substr(0, 7) : std::string("-"); };
+    std::printf("%10llu %9.3f %8.1f %9.4f %8.1f %6.1f %7.1f %6s | %9s %9s %9s %6s\n",
+                static_cast<unsigned long long>(triangles), row.buildMs, triangles / row.buildMs / 1e3, row.refitMs,
+                triangles / row.refitMs / 1e3, row.bytesPerTriangle, row.scratchPerTriangle,
+                row.sahRatio > 0 ? std::to_string(row.sahRatio).substr(0, 5).c_str() : "-",
+                ms(row.driverFastBuildMs).c_str(), ms(row.driverFastTraceMs).c_str(), ms(row.driverUpdateMs).c_str(),
+                driver ? std::to_string(row.driverBytesPerTriangle).substr(0, 5).c_str() : "-");
     std::fflush(stdout);
     builder.releaseScratch();
   }
+
+  std::vector<CrowdRow> crowdRows;
+  if (!crowds.empty()) {
+    std::printf("\nviewport frames of eye crowds at %ux%u (median GPU ms per animated frame)\n", width, height);
+    std::printf("%6s %10s %7s %7s %7s %7s %7s %7s %8s %8s %10s %7s %6s\n", "chars", "triangles", "deform", "refit",
+                "tlas", "r.depth", "trace", "r.shade", "frame", "refract", "pixels", "Grays/s", "B/tri");
+  }
+  for (uint64_t characters : crowds) {
+    CrowdRow r = measureCrowd(*context, static_cast<uint32_t>(characters), width, height, frames);
+    auto pass = [&](const char* name) { return r.passMs.count(name) ? r.passMs.at(name) : 0.0; };
+    double trace = pass("trace");
+    std::printf("%6u %10llu %7.3f %7.3f %7.3f %7.3f %7.3f %7.3f %8.3f %8.3f %10.0f %7.2f %6.1f\n", r.characters,
+                static_cast<unsigned long long>(r.triangles), pass("deform"), pass("blas refit"), pass("tlas"),
+                pass("raster depth"), trace, pass("raster shading"), r.frameMs, r.refractionMs, r.pixelsTraced,
+                trace > 0 ? r.pixelsTraced / trace / 1e6 : 0.0, r.treeBytesPerTriangle);
+    std::fflush(stdout);
+    crowdRows.push_back(std::move(r));
+  }
   if (!json.empty()) {
     std::ofstream out(json);
-    out << "{\n  \"device\": \"" << context->facts().name << "\",\n  \"restructure_rounds\": " << restructure
-        << ",\n  \"runs\": " << runs << ",\n  \"spheres\": [\n";
+    out << "{\n  \"device\": \"" << context->facts().name << "\",\n  \"driver_acceleration_structures\": "
+        << (driver ? "true" : "false") << ",\n  \"restructure_rounds\": " << restructure << ",\n  \"runs\": " << runs
+        << ",\n  \"spheres\": [\n";
     for (size_t i = 0; i < rows.size(); ++i) {
       const Row& r = rows[i];
       out << "    {\"triangles\": " << r.triangles << ", \"build_ms\": " << r.buildMs << ", \"refit_ms\": " << r.refitMs
           << ", \"build_mtris_per_s\": " << double(r.triangles) / r.buildMs / 1e3
           << ", \"refit_mtris_per_s\": " << double(r.triangles) / r.refitMs / 1e3 << ", \"tree_bytes_per_triangle\": "
           << r.bytesPerTriangle << ", \"scratch_bytes_per_triangle\": " << r.scratchPerTriangle
-          << ", \"sah_over_binned\": " << r.sahRatio << "}" << (i + 1 < rows.size() ? "," : "") << "\n";
+          << ", \"sah_over_binned\": " << r.sahRatio << ", \"driver_fast_build_ms\": " << r.driverFastBuildMs
+          << ", \"driver_fast_trace_build_ms\": " << r.driverFastTraceMs << ", \"driver_update_ms\": " << r.driverUpdateMs
+          << ", \"driver_bytes_per_triangle\": " << r.driverBytesPerTriangle << "}" << (i + 1 < rows.size() ? "," : "")
+          << "\n";
+    }
+    out << "  ],\n  \"crowd_viewport\": {\"width\": " << width << ", \"height\": " << height
+        << ", \"frames\": " << frames << "},\n  \"crowds\": [\n";
+    for (size_t i = 0; i < crowdRows.size(); ++i) {
+      const CrowdRow& r = crowdRows[i];
+      out << "    {\"characters\": " << r.characters << ", \"triangles\": " << r.triangles
+          << ", \"frame_ms\": " << r.frameMs << ", \"refraction_ms\": " << r.refractionMs
+          << ", \"pixels_traced\": " << r.pixelsTraced << ", \"memory_bytes_per_triangle\": " << r.memoryPerTriangle
+          << ", \"tree_bytes_per_triangle\": " << r.treeBytesPerTriangle << ", \"passes_ms\": {";
+      bool first = true;
+      for (const auto& [name, ms] : r.passMs) {
+        out << (first ? "" : ", ") << "\"" << name << "\": " << ms;
+        first = false;
+      }
+      out << "}}" << (i + 1 < crowdRows.size() ? "," : "") << "\n";
     }
     out << "  ]\n}\n";
     if (!out) throw std::runtime_error(json + ": could not write");

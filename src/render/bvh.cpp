@@ -53,7 +53,7 @@ struct BvhBuilder::Scratch {
   RadixSort::Scratch sort32, sort64;
 };
 
-BvhBuilder::BvhBuilder(vk::Context& context)
+BvhBuilder::BvhBuilder(vk::Context& context, BvhTuning tuning)
     : context_(context), sort32_(context, KeyWidth::Bits32), sort64_(context, KeyWidth::Bits64) {
   auto program = [&](const char* name, std::span<const uint32_t> spirv, std::vector<vk::SpecConstant> spec) {
     return std::make_unique<vk::ComputeProgram>(context, vk::ComputeProgramDesc{name, spirv, std::move(spec), false});
@@ -63,8 +63,9 @@ BvhBuilder::BvhBuilder(vk::Context& context)
   // H-PLOC's teams are subgroups, each clustering one window; several per
   // workgroup for occupancy, but one where lavapipe needs it (above).
   const vk::DeviceCaps& caps = context.caps();
-  uint32_t hplocWidth = context.facts().type == VK_PHYSICAL_DEVICE_TYPE_CPU ? caps.maxSubgroupSize
-                                                                            : std::max(caps.maxSubgroupSize, 128u);
+  uint32_t hplocWidth = tuning.hplocWorkgroup                                   ? tuning.hplocWorkgroup
+                        : context.facts().type == VK_PHYSICAL_DEVICE_TYPE_CPU ? caps.maxSubgroupSize
+                                                                              : std::max(caps.maxSubgroupSize, 128u);
   hploc_ = std::make_unique<vk::ComputeProgram>(
       context, vk::ComputeProgramDesc{"bvh hploc",
                                       kSpvBvhHploc,
@@ -72,7 +73,8 @@ BvhBuilder::BvhBuilder(vk::Context& context)
                                        {gpu::kBvhSpecSlots, (gpu::kBvhWindow + caps.minSubgroupSize - 1) / caps.minSubgroupSize},
                                        {gpu::kBvhSpecTeams, hplocWidth / caps.minSubgroupSize}},
                                       true});
-  refit_ = program("bvh refit", kSpvBvhRefit, {{gpu::kBvhSpecWorkgroupSize, handOffWorkgroup(context)}});
+  refit_ = program("bvh refit", kSpvBvhRefit,
+                   {{gpu::kBvhSpecWorkgroupSize, tuning.refitWorkgroup ? tuning.refitWorkgroup : handOffWorkgroup(context)}});
   restructure_ = program("bvh restructure", kSpvBvhRestructure, {{gpu::kBvhSpecWorkgroupSize, handOffWorkgroup(context)}});
   placeholder_ = deviceBuffer(context, 16, "bvh placeholder");
 }

@@ -84,9 +84,15 @@ struct BvhInputs {
 /// round costs one bottom-up pass. Off by default: see bench/results for when it pays.
 inline constexpr uint32_t kDefaultRestructureRounds = 0;
 
+/// Workgroup shapes of the build and refit; zero fields are chosen from the device.
+struct BvhTuning {
+  uint32_t hplocWorkgroup = 0;  ///< H-PLOC invocations per workgroup (a multiple of the subgroup size)
+  uint32_t refitWorkgroup = 0;
+};
+
 class BvhBuilder {
  public:
-  explicit BvhBuilder(vk::Context& context);
+  explicit BvhBuilder(vk::Context& context, BvhTuning tuning = {});
   ~BvhBuilder();
 
   /// Allocates a forest whose group g holds primitives [sum of earlier sizes, + groupSizes[g]).

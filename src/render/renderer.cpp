@@ -455,17 +455,23 @@ void Renderer::recordTrace(vk::Commands& commands, const ViewRequest& request, V
   uint32_t tilesY = (settings.height + gpu::kTraceTile - 1) / gpu::kTraceTile;
   ViewImages& images = view.images;
   if (masked) {
-    // The pre-pass's mask becomes the list of pixels to trace, and the trace's workgroup count.
+    // The pre-pass's mask becomes the list of pixels to trace, and the
+    // trace's workgroup count: enough pixels a workgroup that even a list of
+    // every pixel stays within the device's limit on workgroups.
+    uint64_t pixels = uint64_t(settings.width) * settings.height;
+    uint64_t maxGroups = context_.caps().maxComputeWorkgroupCount[0];
+    push.pixelsPerGroup = static_cast<uint32_t>(64 * ((pixels + 64 * maxGroups - 1) / (64 * maxGroups)));
     commands.graphicsToCompute();
-    commands.fillBuffer(images.pixels, 0, 0, sizeof(gpu::TracePixelListHeader));
+    const gpu::TracePixelListHeader header{0, 0, 0, 1, 1, 0, 0, 0};
+    commands.updateBuffer(images.pixels, &header, sizeof(header));
     commands.transferToCompute();
-    gpu::TraceCompactPush compact{settings.width, settings.height, push.tilesX,
-                                  context_.caps().maxComputeWorkgroupCount[0]};
+    gpu::TraceCompactPush compact{settings.width, settings.height, push.tilesX, push.pixelsPerGroup};
+    uint64_t tiles = uint64_t(push.tilesX) * tilesY;
     commands.beginPass("trace");
     compact_->dispatchGroups(commands,
                              {{gpu::kTraceBindingMask, nullptr, &images.mask},
                               {gpu::kTraceBindingPixels, &images.pixels}},
-                             compact, uint64_t(push.tilesX) * tilesY);
+                             compact, (tiles + gpu::kTraceCompactTiles - 1) / gpu::kTraceCompactTiles);
     commands.computeToIndirect();
   } else {
     commands.computeToCompute();

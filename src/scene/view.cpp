@@ -52,6 +52,38 @@ void sceneBounds(const Scene& scene, const Pose& pose, glm::dvec3& lo, glm::dvec
   }
 }
 
+void approximateBounds(const Scene& scene, const Pose& pose, glm::dvec3& lo, glm::dvec3& hi, double margin) {
+  lo = glm::dvec3(std::numeric_limits<double>::infinity());
+  hi = -lo;
+  std::vector<glm::dvec3> shapeLo(scene.shapes.size(), lo), shapeHi(scene.shapes.size(), hi);
+  for (size_t s = 0; s < scene.shapes.size(); ++s) {
+    for (const glm::vec3& p : scene.shapes[s].positions) {
+      shapeLo[s] = glm::min(shapeLo[s], glm::dvec3(p));
+      shapeHi[s] = glm::max(shapeHi[s], glm::dvec3(p));
+    }
+  }
+  for (const DrawItem& item : pose.items) {
+    glm::dvec3 a = shapeLo[size_t(item.shape)], b = shapeHi[size_t(item.shape)];
+    if (!(a.x <= b.x)) continue;
+    glm::dvec3 pad = margin * (b - a);
+    a -= pad;
+    b += pad;
+    auto extend = [&](const glm::dmat4& m) {
+      for (int corner = 0; corner < 8; ++corner) {
+        glm::dvec3 p((corner & 1) ? b.x : a.x, (corner & 2) ? b.y : a.y, (corner & 4) ? b.z : a.z);
+        glm::dvec3 w = glm::dvec3(m * glm::dvec4(p, 1.0));
+        lo = glm::min(lo, w);
+        hi = glm::max(hi, w);
+      }
+    };
+    if (item.skinned && !item.jointMatrices.empty()) {
+      for (const glm::dmat4& m : item.jointMatrices) extend(m);
+    } else {
+      extend(item.world);
+    }
+  }
+}
+
 View resolveView(const Scene& scene, const Pose& pose, const ViewRequest& request) {
   if (request.lookAt) return lookAtView(*request.lookAt, request.yfov, "look-at");
 

@@ -53,4 +53,9 @@ View resolveView(const Scene& scene, const Pose& pose, const ViewRequest& reques
 /// an empty scene gives min > max.
 void sceneBounds(const Scene& scene, const Pose& pose, glm::dvec3& lo, glm::dvec3& hi);
 
+/// Cheap bounds for big scenes: each shape's rest-pose box moved by its
+/// item's transform (skinned items: by every joint matrix, which holds any
+/// blend of them), grown by `margin` of its size for what morph targets add.
+void approximateBounds(const Scene& scene, const Pose& pose, glm::dvec3& lo, glm::dvec3& hi, double margin = 0.1);
+
 }  // namespace snell::scene

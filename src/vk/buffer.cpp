@@ -10,7 +10,8 @@ namespace snell::vk {
 
 namespace {
 
-VkDeviceMemory allocate(Context& context, const VkMemoryRequirements& needs, MemoryDomain domain, const std::string& name) {
+VkDeviceMemory allocate(Context& context, const VkMemoryRequirements& needs, MemoryDomain domain, const std::string& name,
+                        bool deviceAddress = false) {
   VkMemoryPropertyFlags required = 0;
   VkMemoryPropertyFlags preferred = 0;
   switch (domain) {
@@ -34,7 +35,10 @@ VkDeviceMemory allocate(Context& context, const VkMemoryRequirements& needs, Mem
     throw VulkanError("'" + name + "' needs " + std::to_string(needs.size) + " bytes, more than the device's " +
                       std::to_string(context.caps().maxMemoryAllocationSize) + "-byte allocation limit");
   }
+  VkMemoryAllocateFlagsInfo flags{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_FLAGS_INFO};
+  flags.flags = VK_MEMORY_ALLOCATE_DEVICE_ADDRESS_BIT;
   VkMemoryAllocateInfo info{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
+  info.pNext = deviceAddress ? &flags : nullptr;
   info.allocationSize = needs.size;
   info.memoryTypeIndex = type;
   VkDeviceMemory memory = VK_NULL_HANDLE;
@@ -65,7 +69,10 @@ Buffer::Buffer(Context& context, const BufferDesc& desc)
   try {
     VkMemoryRequirements needs{};
     vkGetBufferMemoryRequirements(context.device(), buffer_, &needs);
-    memory_ = allocate(context, needs, desc.domain, desc.name);
+    if (desc.deviceAddress && !context.caps().bufferDeviceAddress) {
+      throw VulkanError("buffer '" + desc.name + "' asks for a device address, which this context was created without");
+    }
+    memory_ = allocate(context, needs, desc.domain, desc.name, desc.deviceAddress);
     VK_CHECK(vkBindBufferMemory(context.device(), buffer_, memory_, 0));
     if (desc.domain != MemoryDomain::Device) VK_CHECK(vkMapMemory(context.device(), memory_, 0, VK_WHOLE_SIZE, 0, &mapped_));
   } catch (...) {
@@ -104,6 +111,12 @@ void Buffer::release() {
     if (memory) vkFreeMemory(device, memory, nullptr);  // unmaps implicitly
   });
   context_ = nullptr;
+}
+
+VkDeviceAddress Buffer::address() const {
+  VkBufferDeviceAddressInfo info{VK_STRUCTURE_TYPE_BUFFER_DEVICE_ADDRESS_INFO};
+  info.buffer = buffer_;
+  return vkGetBufferDeviceAddress(context_->device(), &info);
 }
 
 VkImageAspectFlags aspectOf(VkFormat format) {

@@ -26,6 +26,9 @@ struct BufferDesc {
       VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT;
   MemoryDomain domain = MemoryDomain::Device;
   std::string name;  ///< shown by validation messages and debuggers
+  /// Its memory can give the buffer a device address (needs DeviceCaps::bufferDeviceAddress
+  /// and VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT in `usage`).
+  bool deviceAddress = false;
 };
 
 /// A VkBuffer with its own memory.
@@ -45,6 +48,8 @@ class Buffer {
   const std::string& name() const { return name_; }
   /// Host view of a mapped (Upload or Readback) buffer; empty for Device.
   std::span<std::byte> mapped() const { return {static_cast<std::byte*>(mapped_), mapped_ ? size_ : 0}; }
+  /// The buffer's device address (BufferDesc::deviceAddress).
+  VkDeviceAddress address() const;
 
  private:
   void release();

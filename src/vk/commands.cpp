@@ -213,6 +213,15 @@ void Commands::fillBuffer(const Buffer& buffer, uint32_t word) {
   vkCmdFillBuffer(buffer_, buffer.handle(), 0, buffer.size() & ~VkDeviceSize(3), word);
 }
 
+void Commands::updateBuffer(const Buffer& buffer, const void* data, VkDeviceSize bytes, VkDeviceSize offset) {
+  if (bytes == 0) return;
+  if (bytes > 65536 || bytes % 4 || offset % 4 || offset + bytes > buffer.size()) {
+    throw VulkanError("update of " + std::to_string(bytes) + " bytes at " + std::to_string(offset) + " of '" +
+                      buffer.name() + "' is too large, misaligned or runs past its end");
+  }
+  vkCmdUpdateBuffer(buffer_, buffer.handle(), offset, bytes, data);
+}
+
 void Commands::copyImageToBuffer(const Image& image, const Buffer& buffer, VkDeviceSize offset) {
   VkDeviceSize bytes = VkDeviceSize(image.width()) * image.height() * image.bytesPerPixel();
   if (offset + bytes > buffer.size()) {

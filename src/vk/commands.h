@@ -85,6 +85,8 @@ class Commands {
   void fillBuffer(const Buffer& buffer, uint32_t word);
   /// Fills `bytes` (a multiple of 4) from `offset` with `word`.
   void fillBuffer(const Buffer& buffer, uint32_t word, VkDeviceSize offset, VkDeviceSize bytes);
+  /// Writes up to 64 KiB of host data into a buffer, in the command stream.
+  void updateBuffer(const Buffer& buffer, const void* data, VkDeviceSize bytes, VkDeviceSize offset = 0);
   /// Copies a whole image (GENERAL layout, one mip, one layer) into a buffer, tightly packed.
   void copyImageToBuffer(const Image& image, const Buffer& buffer, VkDeviceSize offset = 0);
 

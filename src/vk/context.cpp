@@ -217,7 +217,41 @@ std::unique_ptr<Context> Context::create(const ContextDesc& desc) {
   if (desc.pipelineStatistics && chosen.pipelineStatistics) {
     extensions.push_back(VK_KHR_PIPELINE_EXECUTABLE_PROPERTIES_EXTENSION_NAME);
     executableInfo.pipelineExecutableInfo = VK_TRUE;
+    executableInfo.pNext = features13.pNext;
     features13.pNext = &executableInfo;
+  }
+  // The driver's acceleration structures, for the peer benchmarks, only where offered.
+  VkPhysicalDeviceVulkan12Features features12{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES};
+  VkPhysicalDeviceAccelerationStructureFeaturesKHR accelerationFeatures{
+      VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_ACCELERATION_STRUCTURE_FEATURES_KHR};
+  bool driverAcceleration = false;
+  if (desc.driverAccelerationStructures) {
+    uint32_t count = 0;
+    VK_CHECK(vkEnumerateDeviceExtensionProperties(physical, nullptr, &count, nullptr));
+    std::vector<VkExtensionProperties> available(count);
+    VK_CHECK(vkEnumerateDeviceExtensionProperties(physical, nullptr, &count, available.data()));
+    auto has = [&](const char* name) {
+      return std::any_of(available.begin(), available.end(),
+                         [&](const VkExtensionProperties& a) { return std::string(a.extensionName) == name; });
+    };
+    VkPhysicalDeviceAccelerationStructureFeaturesKHR supportedAcceleration{
+        VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_ACCELERATION_STRUCTURE_FEATURES_KHR};
+    VkPhysicalDeviceVulkan12Features supported12{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES,
+                                                 &supportedAcceleration};
+    VkPhysicalDeviceFeatures2 probe{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2, &supported12};
+    if (has(VK_KHR_ACCELERATION_STRUCTURE_EXTENSION_NAME) && has(VK_KHR_DEFERRED_HOST_OPERATIONS_EXTENSION_NAME)) {
+      vkGetPhysicalDeviceFeatures2(physical, &probe);
+      driverAcceleration = supportedAcceleration.accelerationStructure && supported12.bufferDeviceAddress;
+    }
+    if (driverAcceleration) {
+      extensions.push_back(VK_KHR_ACCELERATION_STRUCTURE_EXTENSION_NAME);
+      extensions.push_back(VK_KHR_DEFERRED_HOST_OPERATIONS_EXTENSION_NAME);
+      features12.bufferDeviceAddress = VK_TRUE;
+      accelerationFeatures.accelerationStructure = VK_TRUE;
+      features12.pNext = &accelerationFeatures;
+      accelerationFeatures.pNext = features13.pNext;
+      features13.pNext = &features12;
+    }
   }
 
   VkDeviceCreateInfo info{VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO};
@@ -234,6 +268,8 @@ std::unique_ptr<Context> Context::create(const ContextDesc& desc) {
         vkGetInstanceProcAddr(c.instance_, "vkSetDebugUtilsObjectNameEXT"));
   }
   c.initialise(physical, chosen, features13.dynamicRendering, features.features.fillModeNonSolid);
+  c.caps_.driverAccelerationStructures = driverAcceleration;
+  c.caps_.bufferDeviceAddress = driverAcceleration;
   return context;
 }
 

@@ -30,6 +30,10 @@ struct ContextDesc {
   /// Extra extensions a window needs (a surface on the instance, the swapchain
   /// on the device); creation fails naming any the system lacks.
   std::vector<std::string> instanceExtensions, deviceExtensions;
+  /// Turn on the driver's own acceleration structures (VK_KHR_acceleration_structure
+  /// and buffer device addresses) where the device offers them, for the
+  /// benchmarks' peer; DeviceCaps::driverAccelerationStructures says whether it is on.
+  bool driverAccelerationStructures = false;
 };
 
 /// Handles a host application created; snell uses them and never destroys them.
@@ -65,6 +69,10 @@ struct DeviceCaps {
   bool dynamicRendering = false;
   /// Wireframes (VK_POLYGON_MODE_LINE).
   bool fillModeNonSolid = false;
+  /// VK_KHR_acceleration_structure is enabled (ContextDesc::driverAccelerationStructures asked for it).
+  bool driverAccelerationStructures = false;
+  /// Buffers may ask for device addresses (bufferDeviceAddress is enabled).
+  bool bufferDeviceAddress = false;
 };
 
 /// Every devices' facts and the verdict on each, without creating a device.

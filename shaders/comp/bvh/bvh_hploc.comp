@@ -48,10 +48,15 @@ shared uint sTaskL[kTeams], sTaskR[kTeams], sTaskSplit[kTeams], sTaskFinal[kTeam
 
 uint team, lane, width, w0;  // w0: the first of this team's window slots in shared memory
 
-// A barrier for the team that also orders buffer memory at device scope: a
-// node one invocation writes during a merge happens before the owner's
-// release of the range.
+// Barriers for the team. Within a merge only the window in shared memory
+// changes hands. Around one, buffer memory too, at device scope: what the
+// owner acquired from other workgroups is seen by every member, and every
+// node a member writes happens before the owner's release of the range.
 void teamSync() {
+  controlBarrier(gl_ScopeSubgroup, gl_ScopeSubgroup, gl_StorageSemanticsShared, gl_SemanticsAcquireRelease);
+}
+
+void teamSyncDevice() {
   controlBarrier(gl_ScopeSubgroup, gl_ScopeDevice, gl_StorageSemanticsBuffer | gl_StorageSemanticsShared,
                  gl_SemanticsAcquireRelease);
 }
@@ -223,7 +228,7 @@ void mergeRange(uint L, uint R, uint split, bool final, uint e) {
         n.arrivals = 0u;
         nodes[node] = n;
         setParent(ref[k], node);
-        setParent(sRef[w0 + j], node);
+        setParent(sRef[w0 + j], node | kBvhParentRight);
         ref[k] = node;
         first[k] = min(first[k], sFirst[w0 + j]);
         lo[k] = min(lo[k], sLo[w0 + j]);
@@ -323,9 +328,9 @@ void main() {
         needMerge = false;
         if (final) climbing = false;
       }
-      teamSync();
+      teamSyncDevice();
       mergeRange(sTaskL[team], sTaskR[team], sTaskSplit[team], sTaskFinal[team] != 0u, sTaskEntry[team]);
-      teamSync();
+      teamSyncDevice();
     }
   }
 }

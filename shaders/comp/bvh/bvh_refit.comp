@@ -124,8 +124,10 @@ void main() {
       writeGroupBox(g, lo, hi);
       break;
     }
+    uint slot = (parent & kBvhParentRight) != 0u ? 6u : 0u;
+    parent &= ~kBvhParentRight;
     if (parent >= pc.total) break;  // a corrupted link: stop rather than write out of bounds
-    writeSlot(parent, nodes[parent].child[0] == node ? 0u : 6u, lo, hi);
+    writeSlot(parent, slot, lo, hi);
     node = parent;
     climb = arrive(node);
   }

@@ -153,7 +153,7 @@ void rewire(uint leaves) {
         ++pending;
       }
       nodes[node].child[c] = ref;
-      setParent(ref, node);
+      setParent(ref, node | (c == 1u ? kBvhParentRight : 0u));
       for (uint k = 0u; k < 3u; ++k) {
         nodes[node].box[6u * c + k] = subsetLo[side][k];
         nodes[node].box[6u * c + 3u + k] = subsetHi[side][k];
@@ -219,8 +219,10 @@ void main() {
   bool settled = (leaf0 && leaf1) || arrive(node);
   for (uint step = 0u; settled && step < kBvhMaxDepth; ++step) {
     settle(node);
-    node = nodes[node].parent;
-    if (node == kBvhNone || node >= pc.total) break;
+    uint parent = nodes[node].parent;
+    if (parent == kBvhNone) break;
+    node = parent & ~kBvhParentRight;
+    if (node >= pc.total) break;
     settled = arrive(node);
   }
 }

@@ -1,0 +1,39 @@
+#!/usr/bin/env bash
+# Runs on the lent NVIDIA machine (see ../.library/device): the scale issue's
+# measurements in one place. Binaries are built on the Debian machine without
+# OpenImageIO or the viewer and carried in .carry/ (snell, snell_tests, their
+# two Debian libraries in .carry/lib, the validation layer in .carry/layer);
+# the Vulkan loader in .gl/; the shared glTF assets in .assets/.
+#   bench/run_frame_on_device.sh tests   # the suite, validation on
+#   bench/run_frame_on_device.sh bench   # bench scale, frame and bvh
+# Results land in $OUT.
+set -uo pipefail
+for f in .gl/*.deb; do dpkg -x "$f" /; done
+ldconfig
+icd=/usr/local/nvidia/share/vulkan/icd.d/nvidia_icd.json
+[[ -f $icd ]] && export VK_DRIVER_FILES=$icd
+export LD_LIBRARY_PATH=$PWD/.carry/lib VK_ADD_LAYER_PATH=$PWD/.carry/layer XDG_RUNTIME_DIR=/tmp
+export SNELL_ASSETS_DIR=$PWD/.assets SNELL_GOLDEN_DIR=$PWD/golden
+OUT=${OUT:-/tmp/out}
+mkdir -p "$OUT"
+nvidia-smi --query-gpu=name,driver_version,clocks.sm,clocks.mem --format=csv
+step=${1:-all}
+if [[ $step == all || $step == tests ]]; then
+  echo "== tests on the GPU, validation on (not the ones that run the CLI, the viewer or node)"
+  SNELL_VALIDATION=1 .carry/snell_tests --gtest_brief=1 \
+    --gtest_filter='-SceneInfoCommand.*:Viewer.*:ProceduralEye.PassesTheKhronos*' > "$OUT/tests.log" 2>&1
+  echo "tests exit $?"; grep -E "FAILED|PASSED|tests ran" "$OUT/tests.log" | tail -12
+fi
+if [[ $step == all || $step == bench ]]; then
+  s=.carry/snell
+  assets=(.assets/gltf/TransmissionRoughnessTest/glTF-Binary/*.glb .assets/gltf/GlassVaseFlowers/glTF-Binary/*.glb
+          .assets/gltf/IridescenceSuzanne/glTF-Binary/*.glb .assets/gltf/TransmissionTest/glTF-Binary/*.glb)
+  {
+    $s bench scale --json "$OUT/scale.json"
+    $s bench frame --crowd 2 --viewport --json "$OUT/frame-crowd2.json"
+    $s bench frame --crowd 100 --viewport --size 3840x2160 --json "$OUT/frame-crowd100-4k.json"
+    $s bench frame --eye-resolution 256 --viewport --json "$OUT/frame-eye256.json"
+    $s bench frame --eye-resolution 256 --json "$OUT/frame-eye256-trace.json"
+    $s bench bvh --eye-resolution 256 "${assets[@]}" --json "$OUT/bvh.json"
+  } 2>&1 | tee "$OUT/bench.log"
+fi
