@@ -3,6 +3,7 @@
 #include "assets.h"
 #include "command_run.h"
 
+#include "scene/evaluate.h"
 #include "scene/gltf_loader.h"
 #include "scene/gltf_writer.h"
 #include "scene/procedural_eye.h"
@@ -86,6 +87,31 @@ TEST(ProceduralEye, CrowdHasTwoEyesPerCharacterWithStaggeredClips) {
   std::set<float> starts;
   for (const scene::AnimationSampler& s : crowd.animations.at(0).samplers) starts.insert(s.times.front());
   EXPECT_GE(starts.size(), 5u) << "characters should not all start their clip together";
+}
+
+// Each eye of a crowd sits where its character's head puts it (the skin's
+// inverse bind once undid that and stacked every eye at the origin).
+TEST(ProceduralEye, EveryEyeOfACrowdStandsApartFromTheOthers) {
+  EyeOptions options;
+  options.crowd = 4;
+  options.resolution = 8;
+  scene::Scene crowd = scene::makeEye(options);
+  scene::Pose pose = scene::evaluate(crowd, 0.0);
+  std::vector<glm::dvec3> centres;
+  for (const scene::DrawItem& item : pose.items) {
+    if (crowd.shapes[size_t(item.shape)].name != "sclera") continue;
+    std::vector<glm::dvec3> positions, normals;
+    scene::deformOnCpu(item, positions, normals);
+    glm::dvec3 sum(0.0);
+    for (const glm::dvec3& p : positions) sum += p;
+    centres.push_back(sum / double(positions.size()));
+  }
+  ASSERT_EQ(centres.size(), 8u);
+  for (size_t a = 0; a < centres.size(); ++a) {
+    for (size_t b = a + 1; b < centres.size(); ++b) {
+      EXPECT_GT(glm::length(centres[a] - centres[b]), 0.05) << "eyes " << a << " and " << b << " overlap";
+    }
+  }
 }
 
 TEST(ProceduralEye, OutOfRangeOptionsAreRefusedByName) {

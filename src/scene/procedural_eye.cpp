@@ -175,13 +175,12 @@ EyeRig addEyeRig(Scene& scene, int parent, glm::vec3 offset, const std::string& 
   skin.name = name + "_skin";
   skin.joints = {joint};
   skin.skeleton = joint;
-  // The joint rests at the eye's centre; its inverse bind undoes the eye's
-  // placement in the world, so vertices stay in the eye's own space.
-  glm::mat4 bindWorld(1.0f);
-  for (int at = joint; at >= 0; at = scene.nodes[size_t(at)].parent) {
-    bindWorld = glm::translate(glm::mat4(1.0f), scene.nodes[size_t(at)].translation) * bindWorld;
-  }
-  skin.inverseBindMatrices = {glm::inverse(bindWorld)};
+  // The joint rests at the eye's centre, unrotated: the mesh's own space (the
+  // eye centred at its origin) is the joint's space at bind, so the inverse
+  // bind is the identity and the joint's world transform places the eye.
+  // (Undoing the joint's world placement here stacked every eye of a crowd
+  // at the world's origin.)
+  skin.inverseBindMatrices = {glm::mat4(1.0f)};
   scene.skins.push_back(skin);
   EyeRig rig;
   rig.joint = joint;
