@@ -84,10 +84,14 @@ TEST_F(GpuTest, ACorruptedBvhEndsEveryRayWithinTheVisitBudget) {
   for (size_t n = 0; n < tree.nodes.size(); ++n) {
     gpu::BvhNode& node = tree.nodes[n];
     if (n == root) continue;  // rays must get in to meet the rest
-    if (n % 3 == 2) std::fill(std::begin(node.box), std::end(node.box), std::numeric_limits<float>::quiet_NaN());
+    if (n % 3 == 2) std::fill(std::begin(node.origin), std::end(node.origin), std::numeric_limits<float>::quiet_NaN());
     if (n % 3 == 1) {
       node.child[1] = root;  // back up to the root: a cycle
-      for (int k = 6; k < 12; ++k) node.box[k] = k < 9 ? -1e30f : 1e30f;  // and always entered
+      // and always entered: child 1 spans 255 steps of 2^100 from -1e30 on every axis
+      std::fill(std::begin(node.origin), std::end(node.origin), -1e30f);
+      node.scale = (227u << 16) | (227u << 8) | 227u;
+      node.quant[1] = (node.quant[1] & 0x0000ffffu);  // child 1's lo x, y at 0
+      node.quant[2] = 0xffffff00u;                    // child 1's lo z at 0, hi xyz at 255
     }
   }
   vk::upload(context(), renderer.blas()->nodes, tree.nodes.data(), tree.nodes.size() * sizeof(gpu::BvhNode));

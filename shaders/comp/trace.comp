@@ -7,14 +7,16 @@
 #extension GL_GOOGLE_include_directive : require
 #include "../shared/bvh.h"
 #include "../shared/trace.h"
+#include "bvh/bvh_node.glsl"
 
 layout(local_size_x = 64) in;  // one kTraceTile x kTraceTile tile of pixels
 layout(push_constant) uniform Push { TracePush pc; };
 
-layout(std430, binding = kTraceBindingTlasNodes) readonly buffer TlasNodes { BvhNode tlasNodes[]; };
+// Nodes are 40 bytes: read as five 8-byte words rather than ten 4-byte ones.
+layout(std430, binding = kTraceBindingTlasNodes) readonly buffer TlasNodes { uvec2 tlasWords[]; };
 layout(std430, binding = kTraceBindingTlasGroups) readonly buffer TlasGroups { BvhGroup tlasGroups[]; };
 layout(std430, binding = kTraceBindingInstances) readonly buffer Instances { GpuInstance instances[]; };
-layout(std430, binding = kTraceBindingBlasNodes) readonly buffer BlasNodes { BvhNode blasNodes[]; };
+layout(std430, binding = kTraceBindingBlasNodes) readonly buffer BlasNodes { uvec2 blasWords[]; };
 layout(std430, binding = kTraceBindingBlasGroups) readonly buffer BlasGroups { BvhGroup blasGroups[]; };
 layout(std430, binding = kTraceBindingPositions) readonly buffer Positions { float positions[]; };
 layout(std430, binding = kTraceBindingNormals) readonly buffer Normals { float normals[]; };
@@ -110,11 +112,35 @@ float intersectTriangle(ShearedRay r, uint tri, float tMax, out vec3 bary) {
   return T * inv;
 }
 
+BvhNode nodeFromWords(uvec2 w0, uvec2 w1, uvec2 w2, uvec2 w3, uvec2 w4) {
+  BvhNode n;
+  n.origin = float[3](uintBitsToFloat(w0.x), uintBitsToFloat(w0.y), uintBitsToFloat(w1.x));
+  n.scale = w1.y;
+  n.quant = uint[3](w2.x, w2.y, w3.x);
+  n.child = uint[2](w3.y, w4.x);
+  n.parent = w4.y;
+  return n;
+}
+
+BvhNode tlasNode(uint i) {
+  uint w = 5u * i;
+  return nodeFromWords(tlasWords[w], tlasWords[w + 1u], tlasWords[w + 2u], tlasWords[w + 3u], tlasWords[w + 4u]);
+}
+
+BvhNode blasNode(uint i) {
+  uint w = 5u * i;
+  return nodeFromWords(blasWords[w], blasWords[w + 1u], blasWords[w + 2u], blasWords[w + 3u], blasWords[w + 4u]);
+}
+
 // Pushes the children the ray enters before tMax, the nearer on top. A full
 // stack drops them (only a corrupted tree is that deep): the ray still ends.
 void pushChildren(BvhNode node, ShearedRay r, float tMax, inout uint sp) {
-  float t0 = enterBox(r, vec3(node.box[0], node.box[1], node.box[2]), vec3(node.box[3], node.box[4], node.box[5]), tMax);
-  float t1 = enterBox(r, vec3(node.box[6], node.box[7], node.box[8]), vec3(node.box[9], node.box[10], node.box[11]), tMax);
+  vec3 lo0, hi0, lo1, hi1;
+  decodeChild(node, 0u, lo0, hi0);
+  decodeChild(node, 1u, lo1, hi1);
+  // An empty child (its triangles dropped as non-finite) is never entered.
+  float t0 = lo0.x <= hi0.x ? enterBox(r, lo0, hi0, tMax) : kInf;
+  float t1 = lo1.x <= hi1.x ? enterBox(r, lo1, hi1, tMax) : kInf;
   bool swapOrder = t1 < t0;
   uint nearRef = swapOrder ? node.child[1] : node.child[0], farRef = swapOrder ? node.child[0] : node.child[1];
   if (max(t0, t1) < kInf && sp < kStackSize) stack[sp++] = farRef;
@@ -150,7 +176,7 @@ void traverseBlas(uint instance, vec3 origin, vec3 dir, uint skipPrim, float tMi
       continue;
     }
     if (ref < group.first || ref + 1u >= end) continue;
-    pushChildren(blasNodes[ref], r, hit.t, sp);
+    pushChildren(blasNode(ref), r, hit.t, sp);
   }
 }
 
@@ -177,7 +203,7 @@ Hit traceClosest(vec3 origin, vec3 dir, uint skipInstance, uint skipPrim, float 
       continue;
     }
     if (ref >= nodeEnd) continue;
-    pushChildren(tlasNodes[ref], r, hit.t, sp);
+    pushChildren(tlasNode(ref), r, hit.t, sp);
   }
   return hit;
 }

@@ -23,6 +23,8 @@ SNELL_GPU_BEGIN
 SNELL_CONST kBvhLeafBit = 0x80000000u;
 SNELL_CONST kBvhNone = 0xffffffffu;  // no parent (a group's root), no root (an empty group), no cluster
 SNELL_CONST kBvhParentRight = 0x80000000u;  // in BvhNode::parent: the node is its parent's child 1
+// In BvhNode::scale: flips at each arrival of a refit; clear between refits.
+SNELL_CONST kBvhArrivalBit = 0x01000000u;
 SNELL_CONST kBvhMaxPrimitives = 0x7fffffffu;
 // Morton codes use 10 bits per axis; the build entry of a primitive sits above
 // them in the sort key, so one sort orders every group of a build.
@@ -57,6 +59,7 @@ SNELL_CONST kBvhBindingInstances = 15;    // GpuInstance[instanceCount]
 SNELL_CONST kBvhBindingBlasGroups = 16;   // BvhGroup[] of the bottom level
 SNELL_CONST kBvhBindingCounters = 17;     // uint[nodes]: arrivals of the restructuring pass
 SNELL_CONST kBvhBindingNodeStats = 18;    // uvec2[nodes]: subtree cost and leaf count (restructuring)
+SNELL_CONST kBvhBindingExactBoxes = 19;   // float[6 * nodes]: each node's exact box during a refit
 
 SNELL_CONST kBvhSpecWorkgroupSize = 0;
 SNELL_CONST kBvhSpecSlots = 1;  // H-PLOC: window slots per invocation, window / smallest subgroup
@@ -65,12 +68,19 @@ SNELL_CONST kBvhSpecTeams = 2;  // H-PLOC: subgroups per workgroup at the smalle
 SNELL_CONST kBvhFlagInstances = 1u;  // leaves are instances (top level), else triangles
 SNELL_CONST kBvhFlagKeys32 = 2u;     // sort keys are 32-bit
 
-// 64 bytes, total: 64 bytes
+// A node holds its two children's boxes quantised to 8 bits per coordinate
+// within its own box (Ylitie, Karras and Laine 2017 do the same for wide
+// nodes): the box's low corner in float, a power-of-two step per axis, and
+// for each child the number of steps to its box's faces, rounded outwards,
+// so a decoded box always holds what it bounds. A child whose low step on x
+// exceeds its high one is empty.
+// 40 bytes, total: 40 bytes
 struct BvhNode {
-  float box[12];   // 48: child 0 lo xyz, hi xyz; child 1 lo xyz, hi xyz
-  uint child[2];   // 8: node index, or a leaf reference
-  uint parent;     // 4: kBvhNone at a group's root; else the parent's slot, kBvhParentRight set when this is its child 1
-  uint arrivals;   // 4: refit arrivals; even between refits (a build zeroes it)
+  float origin[3];  // 12: the node box's low corner
+  uint scale;       // 4: bits 0-23: the biased exponent of each axis's step (x, y, z); bit 24: refit arrivals (kBvhArrivalBit)
+  uint quant[3];    // 12: bytes 0-5: child 0's lo xyz, hi xyz in steps; bytes 6-11: child 1's
+  uint child[2];    // 8: node index, or a leaf reference
+  uint parent;      // 4: kBvhNone at a group's root; else the parent's slot, kBvhParentRight set when this is its child 1
 };
 
 // 64 bytes, total: 64 bytes

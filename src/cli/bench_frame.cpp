@@ -50,7 +50,7 @@ double median(std::vector<double> v) {
 }
 
 bool refractionPass(const std::string& name) {
-  return name == "deform" || name == "blas refit" || name == "blas build" || name == "tlas" || name == "trace";
+  return name == "deform" || name == "blas refit" || name == "blas build" || name == "tlas" || name == "trace list" || name == "trace";
 }
 
 std::string jsonEscape(const std::string& s) {

@@ -125,7 +125,7 @@ std::vector<uint64_t> parseList(const std::string& option, const std::string& va
 }
 
 bool refractionPass(const std::string& name) {
-  return name == "deform" || name == "blas refit" || name == "blas build" || name == "tlas" || name == "trace";
+  return name == "deform" || name == "blas refit" || name == "blas build" || name == "tlas" || name == "trace list" || name == "trace";
 }
 
 CrowdRow measureCrowd(vk::Context& context, uint32_t characters, uint32_t width, uint32_t height, uint32_t frames) {
@@ -279,7 +279,6 @@ int runBenchScale(const Args& args) {
     row.scratchPerTriangle = double(builder.scratchBytes()) / triangles;
     if (triangles <= sahLimit) {
       render::BvhSnapshot snapshot = builder.download(bvh);
-      render::BvhSnapshot::TreeBoxes tree = snapshot.treeBoxes(0);
       std::vector<ref::Aabb> boxes(triangles);
       for (uint32_t t = 0; t < triangles; ++t) {
         for (int k = 0; k < 3; ++k) {
@@ -287,6 +286,10 @@ int runBenchScale(const Args& args) {
           boxes[t].extend(glm::dvec3(p[0], p[1], p[2]));
         }
       }
+      render::BvhSnapshot::TreeBoxes tree = snapshot.exactTreeBoxes(0, [&](uint32_t t) {
+        const ref::Aabb& b = boxes[t];
+        return render::BoxFloats{float(b.lo.x), float(b.lo.y), float(b.lo.z), float(b.hi.x), float(b.hi.y), float(b.hi.z)};
+      });
       row.sahRatio = ref::sahCost(tree.internal, tree.leaves) / ref::binnedSahCost(boxes);
     }
     rows.push_back(row);

@@ -39,11 +39,11 @@ uint32_t handOffWorkgroup(const vk::Context& context) {
 
 }  // namespace
 
-uint64_t Bvh::treeBytes() const {
+uint64_t Bvh::treeBytes() const { return nodes.size() + groups.size(); }
+
+uint64_t Bvh::workBytes() const {
   uint64_t bytes = 0;
-  for (const vk::Buffer* b : {&nodes, &groups, &stats, &buildEntries, &refitEntries}) {
-    bytes += b->size();
-  }
+  for (const vk::Buffer* b : {&stats, &dropped, &buildEntries, &refitEntries, &exactBoxes}) bytes += b->size();
   return bytes;
 }
 
@@ -253,7 +253,7 @@ void BvhBuilder::recordRestructure(vk::Commands& commands, Bvh& bvh, uint32_t en
 }
 
 void BvhBuilder::recordRefit(vk::Commands& commands, Bvh& bvh, const BvhInputs& inputs,
-                             std::span<const uint32_t> groups, vk::UploadArena& arena) const {
+                             std::span<const uint32_t> groups, vk::UploadArena& arena) {
   std::vector<uint32_t> all;
   if (groups.empty()) {
     all.resize(bvh.groupCount());
@@ -269,6 +269,9 @@ void BvhBuilder::recordRefit(vk::Commands& commands, Bvh& bvh, const BvhInputs& 
     threads += std::max(size - 1, 1u);  // one per node slot, or the lone leaf
   }
   if (entries.empty()) return;
+  if (!bvh.exactBoxes.handle()) {
+    bvh.exactBoxes = deviceBuffer(context_, uint64_t(bvh.primitiveCount) * 24, bvh.name + " refit boxes");
+  }
   arena.copy(commands, entries, bvh.refitEntries);
   commands.fillBuffer(bvh.stats, 0);
   commands.transferToCompute();
@@ -282,6 +285,7 @@ void BvhBuilder::recordRefit(vk::Commands& commands, Bvh& bvh, const BvhInputs& 
                            {gpu::kBvhBindingInstances, instances ? inputs.instances : &placeholder_},
                            {gpu::kBvhBindingBlasGroups, instances ? &inputs.blas->groups : &placeholder_},
                            {gpu::kBvhBindingNodes, &bvh.nodes},
+                           {gpu::kBvhBindingExactBoxes, &bvh.exactBoxes},
                            {gpu::kBvhBindingGroups, &bvh.groups},
                            {gpu::kBvhBindingStats, &bvh.stats},
                            {gpu::kBvhBindingDropped, &bvh.dropped}},
@@ -309,6 +313,21 @@ double BvhBuilder::sahCost(const glm::uvec4& stats) {
   return sum * std::max(double(buildArea), 1e-30) / double(rootArea);
 }
 
+BoxFloats BvhSnapshot::childBox(const gpu::BvhNode& node, int c) {
+  auto byte = [&](int i) { return (node.quant[i / 4] >> (8 * (i % 4))) & 0xffu; };
+  BoxFloats box;
+  if (byte(6 * c) > byte(6 * c + 3)) {  // an empty child
+    box = {INFINITY, INFINITY, INFINITY, -INFINITY, -INFINITY, -INFINITY};
+    return box;
+  }
+  for (int k = 0; k < 3; ++k) {
+    float step = std::bit_cast<float>(((node.scale >> (8 * k)) & 0xffu) << 23);
+    box[size_t(k)] = node.origin[k] + float(byte(6 * c + k)) * step;
+    box[size_t(k) + 3] = node.origin[k] + float(byte(6 * c + 3 + k)) * step;
+  }
+  return box;
+}
+
 BvhSnapshot::TreeBoxes BvhSnapshot::treeBoxes(uint32_t group) const {
   const gpu::BvhGroup& g = groups.at(group);
   TreeBoxes boxes;
@@ -327,8 +346,7 @@ BvhSnapshot::TreeBoxes BvhSnapshot::treeBoxes(uint32_t group) const {
     if (n >= nodes.size()) break;
     const gpu::BvhNode& node = nodes[n];
     for (int c = 0; c < 2; ++c) {
-      BoxFloats b;
-      std::copy_n(&node.box[6 * c], 6, b.begin());
+      BoxFloats b = childBox(node, c);
       if (node.child[c] & gpu::kBvhLeafBit) {
         boxes.leaves.push_back(b);
       } else {
@@ -337,6 +355,34 @@ BvhSnapshot::TreeBoxes BvhSnapshot::treeBoxes(uint32_t group) const {
       }
     }
   }
+  return boxes;
+}
+
+BvhSnapshot::TreeBoxes BvhSnapshot::exactTreeBoxes(
+    uint32_t group, const std::function<BoxFloats(uint32_t prim)>& primitiveBox) const {
+  const gpu::BvhGroup& g = groups.at(group);
+  TreeBoxes boxes;
+  if (g.root == gpu::kBvhNone) return boxes;
+  boxes.internal.emplace_back();  // the root's, filled in at the end
+  size_t visited = 0;
+  // Bounded by the node count, so a corrupted tree cannot recurse forever.
+  std::function<BoxFloats(uint32_t)> subtree = [&](uint32_t ref) {
+    if (ref & gpu::kBvhLeafBit) return primitiveBox(ref & ~gpu::kBvhLeafBit);
+    BoxFloats box{INFINITY, INFINITY, INFINITY, -INFINITY, -INFINITY, -INFINITY};
+    if (ref >= nodes.size() || ++visited > nodes.size()) return box;
+    for (int c = 0; c < 2; ++c) {
+      uint32_t child = nodes[ref].child[c];
+      BoxFloats b = subtree(child);
+      (child & gpu::kBvhLeafBit ? boxes.leaves : boxes.internal).push_back(b);
+      for (size_t k = 0; k < 3; ++k) {
+        box[k] = std::min(box[k], b[k]);
+        box[k + 3] = std::max(box[k + 3], b[k + 3]);
+      }
+    }
+    return box;
+  };
+  boxes.internal.front() = subtree(g.root);
+  if (g.root & gpu::kBvhLeafBit) boxes.leaves.push_back(boxes.internal.front());
   return boxes;
 }
 

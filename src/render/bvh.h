@@ -24,6 +24,7 @@
 
 #include <array>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <span>
 #include <string>
@@ -48,10 +49,13 @@ struct Bvh {
   vk::Buffer stats;    ///< uvec4 per group: its last refit's SAH (BvhBuilder::sahCost reads it)
   vk::Buffer dropped;  ///< uint: non-finite triangles the box passes met since the caller last zeroed it
   vk::Buffer buildEntries, refitEntries;  ///< this forest's lists, copied in per build or refit
+  vk::Buffer exactBoxes;  ///< float[6] per node slot: a refit's exact boxes on their way up (made by the first refit)
 
   uint32_t groupCount() const { return static_cast<uint32_t>(groupSizes.size()); }
-  /// Memory the trees keep between frames: nodes, groups, statistics, lists.
+  /// Memory of the trees the trace reads: nodes and group records.
   uint64_t treeBytes() const;
+  /// Memory a refit works in besides the trees (exact boxes), and the per-group tables and lists.
+  uint64_t workBytes() const;
 };
 
 /// A box as six floats: lo xyz, hi xyz.
@@ -60,11 +64,16 @@ using BoxFloats = std::array<float, 6>;
 /// A forest brought back to the host, for tests and the quality benchmark.
 struct BvhSnapshot {
   /// Group g's boxes: the root's first, then every internal node's, and every
-  /// leaf's, as the parents' child slots hold them (what the SAH prices).
+  /// leaf's (what the SAH prices): as the parents' child slots store them
+  /// (quantised, so what a ray tests), or, given each primitive's box, the
+  /// exact boxes of the tree's topology (what the build chose).
   struct TreeBoxes {
     std::vector<BoxFloats> internal, leaves;
   };
   TreeBoxes treeBoxes(uint32_t group) const;
+  TreeBoxes exactTreeBoxes(uint32_t group, const std::function<BoxFloats(uint32_t prim)>& primitiveBox) const;
+  /// Child c's box as `node` stores it, decoded as the trace decodes it.
+  static BoxFloats childBox(const gpu::BvhNode& node, int c);
 
   std::vector<gpu::BvhNode> nodes;
   std::vector<gpu::BvhGroup> groups;
@@ -106,7 +115,7 @@ class BvhBuilder {
   /// Records a refit of the listed groups (every group when empty): new boxes,
   /// the same topology, and each tree's SAH in Bvh::stats.
   void recordRefit(vk::Commands& commands, Bvh& bvh, const BvhInputs& inputs, std::span<const uint32_t> groups,
-                   vk::UploadArena& arena) const;
+                   vk::UploadArena& arena);
 
   /// Reads a forest back (waits for the GPU).
   BvhSnapshot download(const Bvh& bvh) const;

@@ -30,8 +30,8 @@ static_assert(sizeof(DeformJob) == 48 && offsetof(DeformJob, outputFirst) == 12 
 // deform.comp reads these as std430 uvec4[], vec4[] and mat4[].
 static_assert(sizeof(glm::uvec4) == 16 && sizeof(glm::vec4) == 16 && sizeof(glm::mat4) == 64);
 
-static_assert(sizeof(BvhNode) == 64 && offsetof(BvhNode, child) == 48 && offsetof(BvhNode, parent) == 56 &&
-              offsetof(BvhNode, arrivals) == 60);
+static_assert(sizeof(BvhNode) == 40 && offsetof(BvhNode, scale) == 12 && offsetof(BvhNode, quant) == 16 &&
+              offsetof(BvhNode, child) == 28 && offsetof(BvhNode, parent) == 36);
 static_assert(sizeof(BvhGroup) == 64 && offsetof(BvhGroup, boxHi) == 12 && offsetof(BvhGroup, root) == 24 &&
               offsetof(BvhGroup, first) == 28 && offsetof(BvhGroup, count) == 32 && offsetof(BvhGroup, buildArea) == 36);
 static_assert(sizeof(BvhBuildEntry) == 48 && offsetof(BvhBuildEntry, base) == 12 &&

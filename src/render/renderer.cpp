@@ -187,7 +187,9 @@ void Renderer::prepareTrees() {
 
 uint64_t Renderer::memoryBytes() const {
   uint64_t bytes = scene_.bytes + deform_->bytes() + instances_.size() + lights_.size();
-  if (blas_) bytes += blas_->treeBytes() + tlas_->treeBytes() + builder_->scratchBytes();
+  if (blas_) {
+    bytes += blas_->treeBytes() + tlas_->treeBytes() + blas_->workBytes() + tlas_->workBytes() + builder_->scratchBytes();
+  }
   return bytes;
 }
 
@@ -467,12 +469,14 @@ void Renderer::recordTrace(vk::Commands& commands, const ViewRequest& request, V
     commands.transferToCompute();
     gpu::TraceCompactPush compact{settings.width, settings.height, push.tilesX, push.pixelsPerGroup};
     uint64_t tiles = uint64_t(push.tilesX) * tilesY;
-    commands.beginPass("trace");
+    commands.beginPass("trace list");
     compact_->dispatchGroups(commands,
                              {{gpu::kTraceBindingMask, nullptr, &images.mask},
                               {gpu::kTraceBindingPixels, &images.pixels}},
                              compact, (tiles + gpu::kTraceCompactTiles - 1) / gpu::kTraceCompactTiles);
+    commands.endPass();
     commands.computeToIndirect();
+    commands.beginPass("trace");
   } else {
     commands.computeToCompute();
     commands.beginPass("trace");

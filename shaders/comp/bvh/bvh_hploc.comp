@@ -23,6 +23,7 @@
 #extension GL_KHR_shader_subgroup_basic : require
 #extension GL_KHR_shader_subgroup_ballot : require
 #include "bvh_common.glsl"
+#include "bvh_node.glsl"
 
 layout(constant_id = kBvhSpecSlots) const uint kSlots = 1u;
 layout(constant_id = kBvhSpecTeams) const uint kTeams = 1u;
@@ -216,16 +217,10 @@ void mergeRange(uint L, uint R, uint split, bool final, uint e) {
       if (mutual && i < j) {
         uint node = entry.first + (max(first[k], sFirst[w0 + j]) - entry.base) - 1u;
         BvhNode n;
-        for (uint c = 0u; c < 3u; ++c) {
-          n.box[c] = lo[k][c];
-          n.box[3u + c] = hi[k][c];
-          n.box[6u + c] = sLo[w0 + j][c];
-          n.box[9u + c] = sHi[w0 + j][c];
-        }
+        encodeNode(n, lo[k], hi[k], sLo[w0 + j], sHi[w0 + j]);
         n.child[0] = ref[k];
         n.child[1] = sRef[w0 + j];
         n.parent = kBvhNone;
-        n.arrivals = 0u;
         nodes[node] = n;
         setParent(ref[k], node);
         setParent(sRef[w0 + j], node | kBvhParentRight);

@@ -18,6 +18,7 @@
 #extension GL_GOOGLE_include_directive : require
 #extension GL_KHR_memory_scope_semantics : require
 #include "bvh_common.glsl"
+#include "bvh_node.glsl"
 
 layout(std430, binding = kBvhBindingBuildEntries) readonly buffer Entries { BvhBuildEntry entries[]; };
 layout(std430, binding = kBvhBindingNodes) coherent buffer Nodes { BvhNode nodes[]; };
@@ -35,10 +36,9 @@ const uint kTreeletInternal = kTreeletLeaves - 1u;
 // A treelet is only rebuilt when that saves more than rounding could fake.
 const float kMinGain = 1e-5;
 
+// A child's box as the node stores it (quantised: it holds the exact box).
 void slotBox(uint node, uint slot, out vec3 lo, out vec3 hi) {
-  uint o = slot * 6u;
-  lo = vec3(nodes[node].box[o], nodes[node].box[o + 1u], nodes[node].box[o + 2u]);
-  hi = vec3(nodes[node].box[o + 3u], nodes[node].box[o + 4u], nodes[node].box[o + 5u]);
+  decodeChild(nodes[node], slot, lo, hi);
 }
 
 // The treelet under construction: its leaves (subtrees kept whole) and the
@@ -154,11 +154,13 @@ void rewire(uint leaves) {
       }
       nodes[node].child[c] = ref;
       setParent(ref, node | (c == 1u ? kBvhParentRight : 0u));
-      for (uint k = 0u; k < 3u; ++k) {
-        nodes[node].box[6u * c + k] = subsetLo[side][k];
-        nodes[node].box[6u * c + 3u + k] = subsetHi[side][k];
-      }
     }
+    // Unions of boxes that hold their subtrees hold the new ones too.
+    BvhNode n = nodes[node];
+    encodeNode(n, subsetLo[sides[0]], subsetHi[sides[0]], subsetLo[sides[1]], subsetHi[sides[1]]);
+    nodes[node].origin = n.origin;
+    nodes[node].scale = n.scale;
+    nodes[node].quant = n.quant;
     uint below = 0u;
     for (uint j = 0u; j < leaves; ++j) {
       if ((s & (1u << j)) != 0u) below += refLeaves(leafRef[j]);
