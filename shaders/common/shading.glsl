@@ -9,8 +9,9 @@
 
 const float kPi = 3.14159265358979;
 
-vec3 srgbToLinear(vec3 c) {
-  return mix(c / 12.92, pow((c + 0.055) / 1.055, vec3(2.4)), greaterThan(c, vec3(0.04045)));
+vec3 srgbToLinear(uint rgba) {
+  return vec3(uintBitsToFloat(texels[rgba & 0xffu]), uintBitsToFloat(texels[(rgba >> 8) & 0xffu]),
+              uintBitsToFloat(texels[(rgba >> 16) & 0xffu]));
 }
 
 int wrapIndex(int i, int size, uint mode) {
@@ -26,8 +27,7 @@ int wrapIndex(int i, int size, uint mode) {
 vec3 texel(GpuTexture tex, int x, int y) {
   x = wrapIndex(x, int(tex.width), tex.flags & 3u);
   y = wrapIndex(y, int(tex.height), (tex.flags >> 2) & 3u);
-  uint rgba = texels[tex.firstTexel + uint(y) * tex.width + uint(x)];
-  return srgbToLinear(unpackUnorm4x8(rgba).rgb);
+  return srgbToLinear(texels[tex.firstTexel + uint(y) * tex.width + uint(x)]);
 }
 
 vec3 sampleTexture(uint index, vec2 uv) {

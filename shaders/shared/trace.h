@@ -95,9 +95,14 @@ struct GpuMaterial {
   uvec4 textures;        // 16: base texture, its texCoord, emissive texture, its texCoord
 };
 
+// The texel buffer starts with this many words: the linear value of each sRGB
+// byte as float bits (the reference's double, rounded once), so a texel decodes
+// by lookup, as the CPU reference does, rather than by a float pow.
+SNELL_CONST kSrgbDecodeWords = 256;
+
 // 16 bytes, total: 16 bytes
 struct GpuTexture {
-  uint firstTexel;  // 4: into the texel buffer, RGBA8 sRGB
+  uint firstTexel;  // 4: into the texel buffer, RGBA8 sRGB (after the decode table)
   uint width;       // 4
   uint height;      // 4
   uint flags;       // 4: bits 0-1 wrap S, 2-3 wrap T, 4 nearest
@@ -145,7 +150,7 @@ SNELL_CONST kTraceBindingTexcoords = 7;   // vec4[vertexCount]: uv0, uv1
 SNELL_CONST kTraceBindingIndices = 8;     // uint[3 * triangleCount], absolute
 SNELL_CONST kTraceBindingMaterials = 9;   // GpuMaterial[]
 SNELL_CONST kTraceBindingTextures = 10;   // GpuTexture[]
-SNELL_CONST kTraceBindingTexels = 11;     // uint[]: RGBA8
+SNELL_CONST kTraceBindingTexels = 11;     // uint[]: the sRGB decode table, then RGBA8 texels
 SNELL_CONST kTraceBindingLights = 12;     // GpuLight[]
 SNELL_CONST kTraceBindingImage = 13;      // rgba16f storage image
 SNELL_CONST kTraceBindingAov = 14;        // TraceAov[width * height]

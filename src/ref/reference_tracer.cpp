@@ -51,11 +51,6 @@ struct LinearTexture {
   bool nearest = false;
 };
 
-double srgbToLinear(uint8_t value) {
-  double c = double(value) / 255.0;
-  return c <= 0.04045 ? c / 12.92 : std::pow((c + 0.055) / 1.055, 2.4);
-}
-
 uint32_t wrapMode(bool repeat, bool mirror) {
   if (mirror) return gpu::kWrapMirror;
   return repeat ? gpu::kWrapRepeat : gpu::kWrapClamp;
@@ -66,7 +61,7 @@ LinearTexture decode(const scene::Texture& t) {
   const size_t count = size_t(t.width) * t.height;
   if (count == 0 || t.rgba.size() < count * 4) return out;  // unusable: sampled as white
   double table[256];
-  for (int v = 0; v < 256; ++v) table[v] = srgbToLinear(uint8_t(v));
+  for (int v = 0; v < 256; ++v) table[v] = scene::srgbToLinear(uint8_t(v));
   out.width = t.width;
   out.height = t.height;
   out.texels.resize(count);

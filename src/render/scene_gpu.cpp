@@ -28,6 +28,16 @@ vk::Buffer uploaded(vk::Context& context, const std::vector<T>& data, const std:
   return buffer;
 }
 
+// The head of the texel buffer (kSrgbDecodeWords): float bits of each sRGB byte's linear value.
+std::vector<uint32_t> srgbDecodeTable() {
+  std::vector<uint32_t> table(gpu::kSrgbDecodeWords);
+  for (uint32_t v = 0; v < gpu::kSrgbDecodeWords; ++v) {
+    float linear = static_cast<float>(scene::srgbToLinear(static_cast<uint8_t>(v)));
+    std::memcpy(&table[v], &linear, sizeof linear);
+  }
+  return table;
+}
+
 uint32_t wrapMode(bool repeat, bool mirror) {
   return mirror ? gpu::kWrapMirror : repeat ? gpu::kWrapRepeat : gpu::kWrapClamp;
 }
@@ -117,7 +127,7 @@ SceneGpu uploadScene(vk::Context& context, const scene::Scene& scene, const scen
   materials.push_back(packMaterial(scene::Material{}, scene));  // for shapes without one
 
   std::vector<gpu::GpuTexture> textures;
-  std::vector<uint32_t> texels;
+  std::vector<uint32_t> texels = srgbDecodeTable();
   for (const scene::Texture& t : scene.textures) {
     gpu::GpuTexture g{static_cast<uint32_t>(texels.size()), t.width, t.height,
                       wrapMode(t.repeatS, t.mirrorS) | (wrapMode(t.repeatT, t.mirrorT) << 2) | (t.linearFilter ? 0u : 16u)};

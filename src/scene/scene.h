@@ -7,6 +7,7 @@
 #include <glm/glm.hpp>
 #include <glm/gtc/quaternion.hpp>
 
+#include <cmath>
 #include <cstdint>
 #include <limits>
 #include <optional>
@@ -24,6 +25,13 @@ struct Texture {
   bool repeatS = true, repeatT = true, mirrorS = false, mirrorT = false;
   bool linearFilter = true;
 };
+
+/// The linear value of an 8-bit sRGB channel (IEC 61966-2-1), exact in double:
+/// the reference decodes with it and the GPU looks up its float rounding.
+inline double srgbToLinear(uint8_t value) {
+  double c = double(value) / 255.0;
+  return c <= 0.04045 ? c / 12.92 : std::pow((c + 0.055) / 1.055, 2.4);
+}
 
 /// A material's use of a texture: which one, which UV set, and the
 /// KHR_texture_transform applied to the UVs.
