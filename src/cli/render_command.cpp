@@ -55,6 +55,9 @@ options:
                          snell-view shows)
   --no-refraction        with --viewport: see through glass without bending
   --wireframe            with --viewport: draw triangle edges over the image
+  --stats                print each frame's work: what was deformed, refit,
+                         rebuilt or skipped, pixels traced, dispatches, and the
+                         GPU time of each pass
 )";
 
 struct Options {
@@ -72,6 +75,7 @@ struct Options {
   scene::LoadOptions load;
   bool reference = false;
   bool viewport = false;
+  bool stats = false;
   render::RasterOptions raster;
 };
 
@@ -100,6 +104,7 @@ Options parse(const Args& args) {
     if (a == "--viewport") { o.viewport = true; continue; }
     if (a == "--no-refraction") { o.raster.refraction = false; continue; }
     if (a == "--wireframe") { o.raster.wireframe = true; continue; }
+    if (a == "--stats") { o.stats = true; continue; }
     if (!a.empty() && a[0] != '-') {
       if (!o.input.empty()) throw UsageError{"render: more than one scene given ('" + o.input + "', '" + a + "')"};
       o.input = a;
@@ -147,6 +152,7 @@ Options parse(const Args& args) {
   }
   if (o.input.empty() && !o.eye) throw UsageError{"render: give a scene file (or --eye)"};
   if (!o.input.empty() && o.eye) throw UsageError{"render: give a scene file or --eye, not both"};
+  if (o.stats && o.reference) throw UsageError{"render: --stats counts GPU work; the reference (--reference) has none"};
   if (o.output.empty()) throw UsageError{"render: give the output image with -o FILE.png or FILE.exr"};
   if (o.viewport && o.reference) {
     throw UsageError{"render: --viewport is drawn on the GPU; the reference traces (--reference) without it"};
@@ -183,6 +189,26 @@ void progress(long done, long total, double seconds) {
                "..............................", done, total, seconds);
   if (done == total) std::fputc('\n', stderr);
   std::fflush(stderr);
+}
+
+// One frame's counters and pass times, for --stats: what a pipeline engineer
+// reads to see that a still frame skipped its work.
+void printStats(long frameNumber, const render::FrameStats& s, const std::vector<vk::PassTime>& passes) {
+  std::printf("frame %ld: deformed %u (skipped %u); trees built %u, refit %u, skipped %u; triangles built %llu, "
+              "refit %llu; top level built %u, refit %u, skipped %u; trace dispatches %u, pixels traced %llu; "
+              "dispatches %u, draws %u",
+              frameNumber, s.itemsDeformed, s.itemsDeformSkipped, s.treesBuilt, s.treesRefit, s.treesSkipped,
+              static_cast<unsigned long long>(s.trianglesBuilt), static_cast<unsigned long long>(s.trianglesRefit),
+              s.topLevelBuilt, s.topLevelRefit, s.topLevelSkipped, s.traceDispatches,
+              static_cast<unsigned long long>(s.pixelsTraced), s.dispatches, s.draws);
+  if (s.droppedTriangles) std::printf("; non-finite triangles dropped %u", s.droppedTriangles);
+  std::printf("\n  GPU ms:");
+  double total = 0;
+  for (const vk::PassTime& p : passes) {
+    std::printf(" %s %.3f,", p.name.c_str(), p.milliseconds);
+    total += p.milliseconds;
+  }
+  std::printf(" total %.3f\n", total);
 }
 
 }  // namespace
@@ -244,10 +270,14 @@ int runRender(const Args& args) {
       glm::dvec3 lo, hi;
       scene::sceneBounds(scene, pose, lo, hi);
       render::fitDepthRange(view, lo, hi, o.raster);
-      image.rgba = render::renderComposite(*context, *renderer, pose, settings, o.raster, false, true).rgba;
+      render::CompositeFrame frame = render::renderComposite(*context, *renderer, pose, settings, o.raster, false, true);
+      image.rgba = std::move(frame.rgba);
+      if (o.stats) printStats(frames[i].first, frame.trace.stats, frame.trace.passes);
     } else {
       render::FrameSettings settings{o.width, o.height, view, o.background, o.maxInterfaces};
-      image.rgba = render::renderFrame(*context, *renderer, pose, settings).rgba;
+      render::RenderedFrame frame = render::renderFrame(*context, *renderer, pose, settings);
+      image.rgba = std::move(frame.rgba);
+      if (o.stats) printStats(frames[i].first, frame.stats, frame.passes);
     }
     std::string path = o.frames ? framePath(o.output, frames[i].first) : o.output;
     writeImage(path, image);

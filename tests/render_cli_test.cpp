@@ -1,0 +1,40 @@
+// `snell render` as a pipeline engineer runs it: what --stats prints.
+#include "command_run.h"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <regex>
+#include <string>
+
+namespace snell::test {
+namespace {
+
+namespace fs = std::filesystem;
+
+CommandRun snell(const std::string& arguments) { return runCommand(std::string(SNELL_BINARY) + " " + arguments); }
+
+// The first frame of a run builds every tree; --stats says so and counts the
+// glass pixels that the masked viewport trace covered.
+TEST(RenderCommand, StatsReportTheFirstFramesBuildAndTracedPixels) {
+  fs::path out = fs::temp_directory_path() / "snell_render_stats.png";
+  CommandRun run = snell("render --eye --viewport --size 96x72 --stats -o " + shellQuoted(out.string()));
+  fs::remove(out);
+  ASSERT_EQ(run.exitCode, 0) << run.output;
+  std::smatch m;
+  ASSERT_TRUE(std::regex_search(run.output, m, std::regex("trees built ([0-9]+)"))) << run.output;
+  EXPECT_GT(std::stoul(m[1]), 0u) << run.output;
+  ASSERT_TRUE(std::regex_search(run.output, m, std::regex("pixels traced ([0-9]+)"))) << run.output;
+  EXPECT_GT(std::stoul(m[1]), 0u) << run.output;
+  EXPECT_LT(std::stoul(m[1]), 96u * 72u) << "the masked trace covers the glass, not the image: " << run.output;
+  EXPECT_NE(run.output.find("GPU ms:"), std::string::npos) << run.output;
+}
+
+TEST(RenderCommand, StatsWithTheCpuReferenceIsAUsageError) {
+  CommandRun run = snell("render --eye --reference --stats -o /tmp/never_written.png");
+  EXPECT_EQ(run.exitCode, 2) << run.output;
+  EXPECT_FALSE(fs::exists("/tmp/never_written.png"));
+}
+
+}  // namespace
+}  // namespace snell::test
