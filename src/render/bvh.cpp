@@ -60,12 +60,12 @@ BvhBuilder::BvhBuilder(vk::Context& context, BvhTuning tuning)
   };
   boxes_ = program("bvh build boxes", kSpvBvhBuildBoxes, {{gpu::kBvhSpecWorkgroupSize, 64}});
   morton_ = program("bvh morton", kSpvBvhMorton, {{gpu::kBvhSpecWorkgroupSize, 64}});
-  // H-PLOC's teams are subgroups, each clustering one window; several per
-  // workgroup for occupancy, but one where lavapipe needs it (above).
+  // H-PLOC's teams are subgroups, each clustering one window. One team per
+  // workgroup: lavapipe needs it (above), and on an H100 a 1M-triangle sphere
+  // built in 1.13 ms with 32 invocations against 1.22 ms with 128, 10M in 8.3
+  // against 8.9 ms (same run, bench/results/scale.md).
   const vk::DeviceCaps& caps = context.caps();
-  uint32_t hplocWidth = tuning.hplocWorkgroup                                   ? tuning.hplocWorkgroup
-                        : context.facts().type == VK_PHYSICAL_DEVICE_TYPE_CPU ? caps.maxSubgroupSize
-                                                                              : std::max(caps.maxSubgroupSize, 128u);
+  uint32_t hplocWidth = tuning.hplocWorkgroup ? tuning.hplocWorkgroup : caps.maxSubgroupSize;
   hploc_ = std::make_unique<vk::ComputeProgram>(
       context, vk::ComputeProgramDesc{"bvh hploc",
                                       kSpvBvhHploc,
