@@ -6,6 +6,7 @@
 # the Vulkan loader in .gl/; the shared glTF assets in .assets/.
 #   bench/run_frame_on_device.sh tests   # the suite, validation on
 #   bench/run_frame_on_device.sh bench   # bench scale, frame and bvh
+#   bench/run_frame_on_device.sh methods # bench methods at 1920x1080, its chart
 # Results land in $OUT.
 set -uo pipefail
 for f in .gl/*.deb; do dpkg -x "$f" /; done
@@ -42,4 +43,8 @@ if [[ $step == all || $step == bench ]]; then
     $s bench bvh --eye-resolution 256 "${assets[@]}" --json "$json/bvh.json"
   } 2>&1 | tee "$OUT/bench.log"
   tar -C "$json" -cf "$OUT/results.tar" .
+fi
+if [[ $step == all || $step == methods ]]; then
+  .carry/snell bench methods --size 1920x1080 --frames 24 --json "$OUT/methods.json" --svg "$OUT/methods.svg" \
+    2>&1 | tee "$OUT/methods.log"
 fi

@@ -48,6 +48,19 @@ TEST(Viewer, ThirtyFramesUnderXvfbMatchTheViewportRender) {
   EXPECT_LE(result.maxDifference, 1);
 }
 
+// A method picked on the command line is what `snell render --method` draws.
+TEST(Viewer, AScreenSpaceMethodMatchesTheRenderOfTheSameMethod) {
+  fs::path dir = scratchDir("viewer-method");
+  std::string shot = (dir / "viewer.png").string(), render = (dir / "render.png").string();
+  CommandRun run = view("--frames 3 --size 160x120 --hide-ui --method normal-offset --screenshot " + shellQuoted(shot));
+  ASSERT_EQ(run.exitCode, 0) << run.output;
+  CommandRun reference = runCommand(std::string(SNELL_BINARY) +
+                                    " render --eye --method normal-offset --size 160x120 -o " + shellQuoted(render));
+  ASSERT_EQ(reference.exitCode, 0) << reference.output;
+  Comparison result = compare(cli::readRgb8(shot), cli::readRgb8(render));
+  EXPECT_EQ(result.withinOne, result.pixels) << result.firstMismatches;
+}
+
 // Resize (down to 1x1), orbit, pan, dolly, refraction off and on, wireframe,
 // heat map, scrubbing and playing, two viewports, the film back's pan and
 // zoom, a glTF camera, minimise and restore: the viewer stays alive, recreates

@@ -5,6 +5,7 @@
 
 #include <cstdio>
 #include <exception>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -23,6 +24,9 @@ options:
   --time T            start T seconds into the animation
   --play              start playing
   --split             two viewports side by side
+  --method M          how glass is drawn (default masked): trace, trace-1,
+                      masked, iris-plane, normal-offset, none (the overlay's
+                      drop-down switches it)
   --no-vsync          present as fast as the GPU renders
   --frames N          render N frames, then exit (0 when all went well)
   --screenshot FILE   with --frames: write the last frame to FILE (PNG)
@@ -30,7 +34,7 @@ options:
                       (what 'snell render --viewport' writes)
   --script FILE       scripted input, one '<frame> <action> [args]' per line
                       (resize, orbit, pan, dolly, filmpan, filmzoom, frame,
-                      camera, play, pause, scrub, refraction, wireframe,
+                      camera, play, pause, scrub, refraction, method, wireframe,
                       heatmap, gate, split, ui, minimise, restore, load, quit)
   --offscreen         no window: the same frame code into an image (needs
                       --frames; for machines without a display)
@@ -69,6 +73,10 @@ snell::viewer::ViewerOptions parse(const std::vector<std::string>& args) {
     const std::string& v = args[++i];
     if (a == "--size") {
       snell::cli::parseSize(a, v, o.width, o.height);
+    } else if (a == "--method") {
+      std::optional<snell::render::Method> m = snell::render::methodFromName(v);
+      if (!m) throw UsageError{"snell-view: --method takes one of " + snell::render::methodNames() + ", got '" + v + "'"};
+      o.method = *m;
     } else if (a == "--camera") {
       o.camera = int(std::min<unsigned long long>(snell::cli::parseCount(a, v), 1u << 20));
     } else if (a == "--time") {

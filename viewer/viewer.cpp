@@ -9,6 +9,7 @@
 #include "cli/cli.h"
 #include "cli/image_file.h"
 #include "render/raster_pass.h"
+#include "render/method.h"
 #include "render/renderer.h"
 #include "scene/evaluate.h"
 #include "scene/procedural_eye.h"
@@ -49,6 +50,7 @@ struct Viewport {
 };
 
 struct Toggles {
+  render::Method method = render::Method::Masked;  ///< how glass is drawn while refraction is on
   bool refraction = true, wireframe = false, heatMap = false, gate = true, split = false, ui = true;
   bool playing = false, loop = true, filmMode = false, vsync = true;
   float heatMax = 128.0f;
@@ -137,6 +139,8 @@ Viewer::Viewer(const ViewerOptions& options) : options_(options) {
   toggles_.ui = !options.hideUi;
   toggles_.gate = !options.hideUi;
   toggles_.playing = options.play;
+  toggles_.refraction = options.method != render::Method::None;
+  if (toggles_.refraction) toggles_.method = options.method;
   toggles_.vsync = options.vsync;
   time_ = options.time;
   if (!options.script.empty()) script_ = loadScript(options.script);
@@ -474,6 +478,13 @@ void Viewer::applyScript(uint64_t frame) {
       toggles_.loop = on(0);
     } else if (a.action == "refraction") {
       toggles_.refraction = on(0);
+    } else if (a.action == "method") {
+      std::optional<render::Method> m = a.args.empty() ? std::nullopt : render::methodFromName(a.args[0]);
+      if (m) {
+        toggles_.method = *m;
+      } else {
+        message_ = "script line " + std::to_string(a.line) + ": method takes one of " + render::methodNames();
+      }
     } else if (a.action == "wireframe") {
       toggles_.wireframe = on(0) && context_->caps().fillModeNonSolid;
     } else if (a.action == "heatmap") {
@@ -571,6 +582,19 @@ void Viewer::drawUi(double frameSeconds) {
   }
   ImGui::Separator();
   ImGui::Checkbox("refraction (R)", &toggles_.refraction);
+  if (toggles_.refraction) {
+    const std::vector<render::MethodInfo>& all = render::methods();
+    int current = 0;
+    for (size_t i = 0; i < all.size(); ++i) current = all[i].method == toggles_.method ? int(i) : current;
+    if (ImGui::BeginCombo("method", all[size_t(current)].name)) {
+      for (size_t i = 0; i < all.size(); ++i) {
+        if (all[i].method == render::Method::None) continue;  // that is refraction off
+        if (ImGui::Selectable(all[i].name, int(i) == current)) toggles_.method = all[i].method;
+        if (ImGui::IsItemHovered()) ImGui::SetTooltip("%s", all[i].summary);
+      }
+      ImGui::EndCombo();
+    }
+  }
   if (context_->caps().fillModeNonSolid) ImGui::Checkbox("wireframe (W)", &toggles_.wireframe);
   ImGui::Checkbox("BVH cost heat map (H)", &toggles_.heatMap);
   if (toggles_.heatMap) ImGui::SliderFloat("hottest", &toggles_.heatMax, 8.0f, 1024.0f, "%.0f nodes");
@@ -604,14 +628,14 @@ render::FrameRequest Viewer::frameRequest(std::optional<uint32_t> swapImage, boo
   request.pose = &pose_;
   for (const Viewport& vp : viewports_) {
     if (!vp.width) continue;
-    render::ViewRequest view;
-    view.settings = {vp.width, vp.height, viewOf(vp), {0.02f, 0.02f, 0.025f}, gpu::kDefaultMaxInterfaces};
-    view.output = render::ViewOutput::Composite;
-    view.raster.refraction = toggles_.refraction;
-    view.raster.wireframe = toggles_.wireframe;
-    render::fitDepthRange(view.settings.view, boundsLo_, boundsHi_, view.raster);
+    render::FrameSettings settings{vp.width, vp.height, viewOf(vp), {0.02f, 0.02f, 0.025f}, gpu::kDefaultMaxInterfaces};
+    render::RasterOptions raster;
+    raster.wireframe = toggles_.wireframe;
+    render::fitDepthRange(settings.view, boundsLo_, boundsHi_, raster);
+    render::ViewRequest view =
+        render::methodViewport(toggles_.refraction ? toggles_.method : render::Method::None, settings, raster);
     // The heat map counts nodes for every pixel, so it traces them all.
-    view.masked = !toggles_.heatMap;
+    view.masked = view.masked && !toggles_.heatMap;
     view.aov = toggles_.heatMap;
     request.views.push_back(view);
   }

@@ -4,6 +4,7 @@
 // kept for a screenshot). The same frame code runs with and without a window.
 #pragma once
 
+#include "render/method.h"
 #include "scene/gltf_loader.h"
 
 #include <cstdint>
@@ -26,6 +27,7 @@ struct ViewerOptions {
   bool play = false;
   int camera = -1;                 ///< glTF camera; -1: camera 0 if any, else the orbit rig framing the scene
   double time = 0.0;
+  render::Method method = render::Method::Masked;  ///< how glass is drawn (render/method.h)
 };
 
 /// Runs the viewer; returns the process exit code (non-zero when the

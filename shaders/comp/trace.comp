@@ -318,7 +318,8 @@ void tracePixel(uvec2 pixel) {
       c = -dot(dir, n);
     }
     float k = 1.0 - eta * eta * (1.0 - c * c);
-    dir = normalize(k < 0.0 ? dir + 2.0 * c * n : eta * dir + (eta * c - sqrt(k)) * n);
+    // Past maxBends the ray crosses glass straight (an approximation's path, not physics).
+    if (interfaces < pc.maxBends) dir = normalize(k < 0.0 ? dir + 2.0 * c * n : eta * dir + (eta * c - sqrt(k)) * n);
     throughput *= baseColour(m, s.uvs);
     ++interfaces;
     origin = offsetRay(s.position, dot(dir, s.ng) > 0.0 ? s.ng : -s.ng);

@@ -1,6 +1,8 @@
 // Opaque fragments: Phong, exactly the trace's shading of a primary hit.
 // Transmissive fragments: the trace image at this pixel. The compute pass wrote
-// it before a barrier; it never leaves the GPU.
+// it before a barrier; it never leaves the GPU. With a screen-space method
+// the "trace image" is the picture of what lies behind the glass, read at a
+// pixel displaced the way the method says, and tinted by the glass once.
 #version 460
 #extension GL_GOOGLE_include_directive : require
 #include "../shared/raster.h"
@@ -12,6 +14,7 @@ layout(std430, binding = kRasterBindingTextures) readonly buffer Textures { GpuT
 layout(std430, binding = kRasterBindingTexels) readonly buffer Texels { uint texels[]; };
 layout(std430, binding = kRasterBindingLights) readonly buffer Lights { GpuLight lights[]; };
 layout(binding = kRasterBindingTraceImage, rgba16f) uniform readonly image2D traceImage;
+layout(binding = kRasterBindingBehindDepth, r32ui) uniform readonly uimage2D behindDepth;
 
 #include "../common/shading.glsl"
 
@@ -26,19 +29,58 @@ layout(location = 4) flat in uint inMaterial;
 
 layout(location = 0) out vec4 outColour;
 
+// A point relative to the frame origin to its pixel (the vertex shader's projection).
+vec2 pixelOf(vec3 p, vec2 size) {
+  vec3 rel = p - pc.eye.xyz;
+  bool ortho = (pc.flags & kRasterFlagOrthographic) != 0u;
+  float w = ortho ? 1.0 : dot(rel, pc.forward.xyz);
+  float x = (dot(rel, pc.right.xyz) - pc.shiftX * w) * pc.right.w / w;
+  float y = -(dot(rel, pc.up.xyz) - pc.shiftY * w) * pc.up.w / w;
+  return (vec2(x, y) * 0.5 + 0.5) * size;
+}
+
+// Where the refracted ray meets the plane facing the camera through what lies
+// straight behind this pixel: the game engines' iris plane, placed from the
+// picture behind the glass rather than from an eye rig.
+vec2 irisPlaneLookup(vec3 dir, vec3 ns, float ior, vec2 size) {
+  uint bits = imageLoad(behindDepth, ivec2(gl_FragCoord.xy)).r;
+  if (bits == 0u) return gl_FragCoord.xy;  // nothing behind: the background either way
+  bool ortho = (pc.flags & kRasterFlagOrthographic) != 0u;
+  float behind = uintBitsToFloat(bits) - (ortho ? 1.0 - pc.forward.w : 0.0);
+  vec3 n = dot(ns, dir) > 0.0 ? -ns : ns;
+  vec3 t = refract(dir, n, 1.0 / ior);
+  float along = dot(t, pc.forward.xyz);
+  float gap = behind - dot(inPosition - pc.eye.xyz, pc.forward.xyz);
+  if (dot(t, t) == 0.0 || along <= 0.0 || gap <= 0.0) return gl_FragCoord.xy;
+  return pixelOf(inPosition + t * (gap / along), size);
+}
+
 void main() {
   if ((pc.flags & kRasterFlagWireframe) != 0u) {
     outColour = pc.wireColor;
     return;
   }
   GpuMaterial m = materials[inMaterial];
-  if (m.emissiveFactor.w > 0.0) {
-    outColour = vec4(imageLoad(traceImage, ivec2(gl_FragCoord.xy)).rgb, 1.0);
-    return;
-  }
   vec3 ng = normalize(inGeometricNormal);
   vec3 ns = dot(inNormal, inNormal) > 0.0 ? normalize(inNormal) : ng;
   if (dot(ns, ng) < 0.0) ns = -ns;
   vec3 dir = (pc.flags & kRasterFlagOrthographic) != 0u ? pc.forward.xyz : normalize(inPosition - pc.eye.xyz);
+  if (m.emissiveFactor.w > 0.0) {
+    if ((pc.flags & (kRasterFlagNormalOffset | kRasterFlagIrisPlane)) == 0u) {
+      outColour = vec4(imageLoad(traceImage, ivec2(gl_FragCoord.xy)).rgb, 1.0);
+      return;
+    }
+    vec2 size = vec2(imageSize(traceImage));
+    vec2 at = gl_FragCoord.xy;
+    if ((pc.flags & kRasterFlagNormalOffset) != 0u) {
+      // Refraction bends the view towards the inward normal: look up against the normal's screen direction.
+      at -= pc.offsetStrength * size.y * vec2(dot(ns, pc.right.xyz), -dot(ns, pc.up.xyz));
+    } else {
+      at = irisPlaneLookup(dir, ns, m.baseUvRow0.w, size);
+    }
+    ivec2 texel = clamp(ivec2(floor(at)), ivec2(0), ivec2(size) - 1);
+    outColour = vec4(imageLoad(traceImage, texel).rgb * baseColour(m, inUvs), 1.0);
+    return;
+  }
   outColour = vec4(phong(inPosition, ns, inUvs, m, dir, pc.lightCount, pc.forward.xyz), 1.0);
 }

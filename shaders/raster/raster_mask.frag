@@ -1,7 +1,8 @@
 // The depth pre-pass of a masked composite: visibility, and a mask of where
 // the visible face is transmissive, which the masked trace compacts into its
 // pixel list. Depth-tested like the pre-pass, so each pixel keeps the mask of
-// its nearest face.
+// its nearest face. With kRasterFlagBehindDepth (glass left out) it keeps the
+// nearest face's view depth instead, which the iris-plane lookup starts from.
 #version 460
 #extension GL_GOOGLE_include_directive : require
 #include "../shared/raster.h"
@@ -9,6 +10,7 @@
 
 layout(early_fragment_tests) in;
 
+layout(push_constant) uniform Push { RasterPush pc; };
 layout(std430, binding = kRasterBindingMaterials) readonly buffer Materials { GpuMaterial materials[]; };
 
 layout(location = 0) in vec3 inPosition;
@@ -19,4 +21,14 @@ layout(location = 4) flat in uint inMaterial;
 
 layout(location = 0) out uint outMask;
 
-void main() { outMask = materials[inMaterial].emissiveFactor.w > 0.0 ? 1u : 0u; }
+void main() {
+  if ((pc.flags & kRasterFlagBehindDepth) != 0u) {
+    bool ortho = (pc.flags & kRasterFlagOrthographic) != 0u;
+    // Perspective depth is positive in front of the eye; orthographic depth
+    // may not be, so it is kept as the distance from the near plane.
+    float z = dot(inPosition - pc.eye.xyz, pc.forward.xyz);
+    outMask = floatBitsToUint(max(ortho ? z - pc.forward.w + 1.0 : z, 1e-30));
+    return;
+  }
+  outMask = materials[inMaterial].emissiveFactor.w > 0.0 ? 1u : 0u;
+}

@@ -13,6 +13,13 @@ SNELL_GPU_BEGIN
 
 SNELL_CONST kRasterFlagOrthographic = 1u;
 SNELL_CONST kRasterFlagWireframe = 4u;     // the wireframe overlay: one flat colour
+// Screen-space refraction (no trace): a transmissive fragment reads the image
+// of what lies behind the glass (drawn first, glass left out) at a displaced pixel.
+SNELL_CONST kRasterFlagNormalOffset = 8u;  // displaced by the shading normal times offsetStrength (GPU Gems 2, ch. 19)
+SNELL_CONST kRasterFlagIrisPlane = 16u;    // where the refracted ray meets the plane through what lies straight behind
+// The pre-pass's uint attachment takes the view depth's float bits of the
+// nearest face (0: nothing), for kRasterFlagIrisPlane, instead of the transmissive mask.
+SNELL_CONST kRasterFlagBehindDepth = 32u;
 
 // Binding slots of set 0 (the same buffers the trace binds).
 SNELL_CONST kRasterBindingInstances = 0;  // GpuInstance[]
@@ -24,11 +31,12 @@ SNELL_CONST kRasterBindingMaterials = 5;  // GpuMaterial[]
 SNELL_CONST kRasterBindingTextures = 6;   // GpuTexture[]
 SNELL_CONST kRasterBindingTexels = 7;     // uint[]: RGBA8
 SNELL_CONST kRasterBindingLights = 8;     // GpuLight[]
-SNELL_CONST kRasterBindingTraceImage = 9; // rgba16f storage image, read at the fragment's pixel
+SNELL_CONST kRasterBindingTraceImage = 9; // rgba16f storage image, read at the fragment's pixel (or displaced)
+SNELL_CONST kRasterBindingBehindDepth = 10;  // r32ui storage image: view depth bits behind the glass (kRasterFlagIrisPlane)
 
 // One draw per draw item: gl_InstanceIndex is the item, gl_VertexIndex / 3
 // the absolute triangle. Vectors are relative to the frame's origin.
-// 96 bytes, total: 96 bytes
+// 112 bytes, total: 112 bytes
 struct RasterPush {
   vec4 right;      // 16: xyz; w: 1 / half width of the view (at unit distance, or of the ortho view)
   vec4 up;         // 16: xyz; w: 1 / half height
@@ -39,6 +47,10 @@ struct RasterPush {
   uint lightCount; // 4: 0: the headlight
   float shiftX;    // 4: the film back's offset (View::shift)
   float shiftY;    // 4
+  float offsetStrength;  // 4: kRasterFlagNormalOffset's displacement per unit of normal, in image heights
+  uint pad0;       // 4
+  uint pad1;       // 4
+  uint pad2;       // 4
 };
 
 SNELL_GPU_END

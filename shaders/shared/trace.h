@@ -130,6 +130,7 @@ struct TraceAov {
 };
 
 SNELL_CONST kNoHit = 0xffffffffu;
+SNELL_CONST kAllBends = 0xffffffffu;  // TracePush::maxBends: refraction at every interface (physics)
 SNELL_CONST kTraceFlagAov = 1u;
 SNELL_CONST kTraceFlagOrthographic = 2u;
 SNELL_CONST kTraceFlagRayList = 4u;  // primary rays from kTraceBindingRays, not the camera
@@ -183,7 +184,7 @@ struct TracePush {
   float shiftX;     // 4: the film back's offset (View::shift)
   float shiftY;     // 4
   uint pixelsPerGroup;  // 4: with kTraceFlagPixelList, listed pixels per workgroup
-  uint pad0;        // 4
+  uint maxBends;    // 4: interfaces that refract; later ones are crossed straight (kAllBends: every one)
   uint pad1;        // 4
   uint pad2;        // 4
 };

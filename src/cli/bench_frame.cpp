@@ -44,24 +44,8 @@ options:
   --json FILE         write the results as JSON too
 )";
 
-double median(std::vector<double> v) {
-  if (v.empty()) return 0;
-  std::sort(v.begin(), v.end());
-  return v.size() % 2 ? v[v.size() / 2] : 0.5 * (v[v.size() / 2 - 1] + v[v.size() / 2]);
-}
-
 bool refractionPass(const std::string& name) {
   return name == "deform" || name == "blas refit" || name == "blas build" || name == "tlas" || name == "trace list" || name == "trace";
-}
-
-std::string jsonEscape(const std::string& s) {
-  std::string out;
-  for (char c : s) {
-    if (c == '"' || c == '\\') out += '\\';
-    if (static_cast<unsigned char>(c) < 0x20) continue;
-    out += c;
-  }
-  return out;
 }
 
 }  // namespace

@@ -86,12 +86,6 @@ Mesh uvSphere(uint64_t triangles) {
   return m;
 }
 
-double median(std::vector<double> v) {
-  if (v.empty()) return 0;
-  std::sort(v.begin(), v.end());
-  return v.size() % 2 ? v[v.size() / 2] : 0.5 * (v[v.size() / 2 - 1] + v[v.size() / 2]);
-}
-
 struct Row {
   uint64_t triangles = 0;
   double buildMs = 0, refitMs = 0, bytesPerTriangle = 0, scratchPerTriangle = 0, sahRatio = 0;

@@ -25,6 +25,7 @@ int runBenchBvh(const Args& args);
 int runBenchFrame(const Args& args);
 int runBenchStress(const Args& args);
 int runBenchScale(const Args& args);
+int runBenchMethods(const Args& args);
 
 /// A context on the device snell picks; SNELL_VALIDATION=1 turns on the
 /// validation layer, synchronization checks included.
@@ -35,5 +36,11 @@ void parseSize(const std::string& option, const std::string& value, uint32_t& wi
 
 /// Parses an unsigned integer option value or throws UsageError naming the option.
 unsigned long long parseCount(const std::string& option, const std::string& value);
+
+/// The median of `values` (0 when empty), for benchmark tables.
+double median(std::vector<double> values);
+
+/// `text` as the inside of a JSON string.
+std::string jsonEscape(const std::string& text);
 
 }  // namespace snell::cli

@@ -1,6 +1,7 @@
 // Option parsing and the device choice shared by `snell` and `snell-view`.
 #include "cli/cli.h"
 
+#include <algorithm>
 #include <charconv>
 #include <cstdlib>
 
@@ -32,6 +33,23 @@ void parseSize(const std::string& option, const std::string& value, uint32_t& wi
   }
   width = uint32_t(w);
   height = uint32_t(h);
+}
+
+double median(std::vector<double> values) {
+  if (values.empty()) return 0;
+  std::sort(values.begin(), values.end());
+  size_t n = values.size();
+  return n % 2 ? values[n / 2] : 0.5 * (values[n / 2 - 1] + values[n / 2]);
+}
+
+std::string jsonEscape(const std::string& text) {
+  std::string out;
+  for (char c : text) {
+    if (c == '"' || c == '\\') out += '\\';
+    if (static_cast<unsigned char>(c) < 0x20) continue;
+    out += c;
+  }
+  return out;
 }
 
 }  // namespace snell::cli

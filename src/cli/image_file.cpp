@@ -129,4 +129,10 @@ Rgb8Image readRgb8(const std::string& path) {
   return image;
 }
 
+void writeTextFile(const std::string& path, const std::string& text) {
+  writeAtomically(path, [&](const std::string& temp) {
+    writeBytes(path, temp, std::vector<uint8_t>(text.begin(), text.end()));
+  });
+}
+
 }  // namespace snell::cli

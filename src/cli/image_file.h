@@ -23,6 +23,9 @@ uint8_t linearToSrgb8(float linear);
 /// std::runtime_error naming the file and the problem; leaves no file then.
 void writeImage(const std::string& path, const LinearImage& image);
 
+/// Writes `text` to `path` the same way: complete, or not at all.
+void writeTextFile(const std::string& path, const std::string& text);
+
 /// Reads an 8-bit-per-channel image (a golden PNG) as RGB bytes.
 struct Rgb8Image {
   uint32_t width = 0, height = 0;

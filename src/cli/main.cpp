@@ -25,6 +25,7 @@ commands:
   bench frame [options] per-pass GPU time of a frame of the eye
   bench stress          GPU against the CPU reference on the numerical stability grid
   bench scale [options] BVH build and refit times from 1e4 to 1e7 triangles
+  bench methods [SCENE] run time against error of each way of drawing refraction
   help                  show this text
 
 environment:
@@ -35,11 +36,12 @@ environment:
 
 int runBench(const Args& args) {
   if (args.empty() || args[0] == "--help" || args[0] == "-h") {
-    std::printf("usage: snell bench sort|bvh|frame|stress|scale [options]\n\nbenchmarks:\n  sort   GPU radix sort, pairs per second\n"
+    std::printf("usage: snell bench sort|bvh|frame|stress|scale|methods [options]\n\nbenchmarks:\n  sort   GPU radix sort, pairs per second\n"
                 "  bvh    SAH cost of the GPU trees against a CPU binned-SAH build\n"
                 "  frame  per-pass GPU time of the eye's frame\n"
                 "  stress GPU against the CPU reference on the numerical stability grid\n"
-                "  scale  BVH build and refit times from 1e4 to 1e7 triangles\n");
+                "  scale  BVH build and refit times from 1e4 to 1e7 triangles\n"
+                "  methods run time against error of each way of drawing refraction\n");
     return args.empty() ? 2 : 0;
   }
   Args rest(args.begin() + 1, args.end());
@@ -48,7 +50,8 @@ int runBench(const Args& args) {
   if (args[0] == "frame") return runBenchFrame(rest);
   if (args[0] == "stress") return runBenchStress(rest);
   if (args[0] == "scale") return runBenchScale(rest);
-  throw UsageError{"unknown benchmark '" + args[0] + "' (try: sort, bvh, frame, stress, scale)"};
+  if (args[0] == "methods") return runBenchMethods(rest);
+  throw UsageError{"unknown benchmark '" + args[0] + "' (try: sort, bvh, frame, stress, scale, methods)"};
 }
 
 }  // namespace

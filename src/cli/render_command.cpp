@@ -5,6 +5,7 @@
 
 #include "cli/image_file.h"
 #include "ref/reference_tracer.h"
+#include "render/method.h"
 #include "render/raster_pass.h"
 #include "render/renderer.h"
 #include "scene/evaluate.h"
@@ -17,6 +18,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <optional>
 #include <sstream>
 
 namespace snell::cli {
@@ -49,11 +51,18 @@ options:
   --ignore-extension E   load a file that requires extension E anyway
   --reference            render with the CPU double-precision reference instead
                          of the GPU (slow; golden images are made this way)
+  --method M             how refraction is drawn (default trace): trace,
+                         trace-1 (bends at the first interface only), masked
+                         (the viewport: raster, glass pixels traced),
+                         iris-plane and normal-offset (raster, no trace),
+                         none (glass seen straight through)
+  --offset-strength S    normal-offset's displacement in image heights (0.02)
   --viewport             write the viewport's composite instead of the trace
                          alone: every face rasterized and Phong-shaded, and
                          transmissive faces showing the traced image (what
-                         snell-view shows)
+                         snell-view shows); the same as --method masked
   --no-refraction        with --viewport: see through glass without bending
+                         (--method none)
   --wireframe            with --viewport: draw triangle edges over the image
   --stats                print each frame's work: what was deformed, refit,
                          rebuilt or skipped, pixels traced, dispatches, and the
@@ -75,6 +84,7 @@ struct Options {
   scene::LoadOptions load;
   bool reference = false;
   bool viewport = false;
+  std::optional<render::Method> method;
   bool stats = false;
   render::RasterOptions raster;
 };
@@ -137,6 +147,16 @@ Options parse(const Args& args) {
     } else if (a == "--fps") {
       o.fps = parseNumbers(a, v, 1)[0];
       if (!(o.fps > 0.0)) throw UsageError{"--fps must be positive, got " + v};
+    } else if (a == "--method") {
+      o.method = render::methodFromName(v);
+      if (!o.method) throw UsageError{"render: --method takes one of " + render::methodNames() + ", got '" + v + "'"};
+    } else if (a == "--offset-strength") {
+      char* end = nullptr;
+      double strength = std::strtod(v.c_str(), &end);
+      if (v.empty() || *end != '\0' || !std::isfinite(strength)) {
+        throw UsageError{"render: --offset-strength expects a number, got '" + v + "'"};
+      }
+      o.raster.offsetStrength = float(strength);
     } else if (a == "--max-interfaces") {
       o.maxInterfaces = uint32_t(std::min<unsigned long long>(parseCount(a, v), 1024));
     } else if (a == "--background") {
@@ -157,8 +177,24 @@ Options parse(const Args& args) {
   if (o.viewport && o.reference) {
     throw UsageError{"render: --viewport is drawn on the GPU; the reference traces (--reference) without it"};
   }
-  if (!o.viewport && (!o.raster.refraction || o.raster.wireframe)) {
-    throw UsageError{"render: --no-refraction and --wireframe need --viewport"};
+  if (o.method && o.reference) {
+    throw UsageError{"render: --method draws on the GPU; the reference (--reference) is the physics they approximate"};
+  }
+  if (o.method && o.viewport && !render::drawsComposite(*o.method)) {
+    throw UsageError{std::string("render: --method ") + render::methodName(*o.method) +
+                     " draws the trace image, not the viewport (--viewport)"};
+  }
+  if (!o.method) {
+    o.method = !o.viewport ? render::Method::Trace : o.raster.refraction ? render::Method::Masked : render::Method::None;
+  } else if (!o.raster.refraction) {
+    if (*o.method != render::Method::None && render::drawsComposite(*o.method)) {
+      throw UsageError{"render: --no-refraction is --method none; it cannot go with --method " +
+                       std::string(render::methodName(*o.method))};
+    }
+    o.method = render::Method::None;
+  }
+  if (!render::drawsComposite(*o.method) && (!o.raster.refraction || o.raster.wireframe)) {
+    throw UsageError{"render: --no-refraction and --wireframe need --viewport (or a viewport --method)"};
   }
   std::string ext = std::filesystem::path(o.output).extension().string();
   if (ext != ".png" && ext != ".exr" && ext != ".PNG" && ext != ".EXR") {
@@ -265,19 +301,21 @@ int runRender(const Args& args) {
       ref::ReferenceImage r = ref::renderReference(scene, pose, settings);
       image.rgba.reserve(r.color.size());
       for (const glm::dvec3& c : r.color) image.rgba.emplace_back(glm::vec3(c), 1.0f);
-    } else if (o.viewport) {
-      render::FrameSettings settings{o.width, o.height, view, o.background, o.maxInterfaces};
-      glm::dvec3 lo, hi;
-      scene::sceneBounds(scene, pose, lo, hi);
-      render::fitDepthRange(view, lo, hi, o.raster);
-      render::CompositeFrame frame = render::renderComposite(*context, *renderer, pose, settings, o.raster, false, true);
-      image.rgba = std::move(frame.rgba);
-      if (o.stats) printStats(frames[i].first, frame.trace.stats, frame.trace.passes);
     } else {
       render::FrameSettings settings{o.width, o.height, view, o.background, o.maxInterfaces};
-      render::RenderedFrame frame = render::renderFrame(*context, *renderer, pose, settings);
-      image.rgba = std::move(frame.rgba);
-      if (o.stats) printStats(frames[i].first, frame.stats, frame.passes);
+      render::RasterOptions raster = o.raster;
+      glm::dvec3 lo, hi;
+      scene::sceneBounds(scene, pose, lo, hi);
+      render::fitDepthRange(view, lo, hi, raster);
+      render::ViewRequest request = render::methodView(*o.method, settings, raster);
+      request.readback = true;
+      render::FrameRequest frame;
+      frame.pose = &pose;
+      frame.views.push_back(request);
+      const render::FrameResult& result = renderer->wait(renderer->submit(frame));
+      const render::ViewPixels& pixels = result.views.at(0);
+      image.rgba = render::drawsComposite(*o.method) ? pixels.composite : pixels.trace;
+      if (o.stats) printStats(frames[i].first, result.stats, result.passes);
     }
     std::string path = o.frames ? framePath(o.output, frames[i].first) : o.output;
     writeImage(path, image);
@@ -287,7 +325,11 @@ int runRender(const Args& args) {
     } else {
       std::printf("wrote %s: %ux%u, %s, %s, %.2f s\n", path.c_str(), o.width, o.height, view.description.c_str(),
                   o.reference ? "CPU reference" : context->facts().name.c_str(), seconds);
-      if (o.viewport) std::printf("  viewport composite: raster + trace on transmissive faces\n");
+      if (!o.reference) {
+        for (const render::MethodInfo& m : render::methods()) {
+          if (m.method == *o.method) std::printf("  method %s: %s\n", m.name, m.summary);
+        }
+      }
     }
   }
   if (context && context->validationMessageCount() > 0) {

@@ -17,6 +17,9 @@ struct FrameSettings {
   scene::View view;
   glm::vec3 background{0.02f, 0.02f, 0.025f};
   uint32_t maxInterfaces = gpu::kDefaultMaxInterfaces;
+  /// Interfaces that bend the ray; past them it crosses glass straight
+  /// (1: the talk's single bend towards the iris; 0: refraction off).
+  uint32_t maxBends = gpu::kAllBends;
   /// When not empty: width * height primary rays in world space, pixel i
   /// (row-major) tracing rays[i] instead of the camera's ray through it.
   std::vector<scene::Ray> rays;

@@ -83,6 +83,9 @@ gpu::RasterPush RasterPass::push(const RasterScene& scene, const FrameSettings& 
   push.lightCount = scene.lightCount;
   push.shiftX = float(v.shift.x);
   push.shiftY = float(v.shift.y);
+  if (options.refraction && options.screenSpace == ScreenSpace::NormalOffset) push.flags |= gpu::kRasterFlagNormalOffset;
+  if (options.refraction && options.screenSpace == ScreenSpace::IrisPlane) push.flags |= gpu::kRasterFlagIrisPlane;
+  push.offsetStrength = options.offsetStrength;
   return push;
 }
 
@@ -102,12 +105,18 @@ void RasterPass::drawItems(vk::Commands& commands, const vk::GraphicsProgram& pr
 void RasterPass::recordDepth(vk::Commands& commands, const RasterScene& scene, const FrameSettings& settings,
                              const RasterOptions& options, const vk::Image& depth, const vk::Image* mask,
                              const vk::Image& colorTarget) const {
+  recordDepthPass(commands, scene, settings, options, depth, mask, colorTarget, 0u, "raster depth");
+}
+
+void RasterPass::recordDepthPass(vk::Commands& commands, const RasterScene& scene, const FrameSettings& settings,
+                                 const RasterOptions& options, const vk::Image& depth, const vk::Image* mask,
+                                 const vk::Image& colorTarget, uint32_t extraFlags, const char* passName) const {
   for (const vk::Image* image : {&depth, mask, &colorTarget}) {
     if (image && (image->width() != settings.width || image->height() != settings.height)) {
       throw vk::VulkanError("raster pass: image '" + image->name() + "' is not the frame's size");
     }
   }
-  commands.beginPass("raster depth");
+  commands.beginPass(passName);
   VkRect2D area{{0, 0}, {settings.width, settings.height}};
   const float clearMask[4] = {0.0f, 0.0f, 0.0f, 0.0f};  // the uint attachment clears to 0
   {
@@ -121,16 +130,23 @@ void RasterPass::recordDepth(vk::Commands& commands, const RasterScene& scene, c
                                              {gpu::kRasterBindingMaterials, &s.materials}};
     static_assert(gpu::kRasterBindingInstances == 0 && gpu::kRasterBindingMaterials == gpu::kRasterBindingIndices + 1);
     // The mask's fragment shader also reads the materials.
-    drawItems(commands, mask ? *mask_ : *depth_, scene, options, push(scene, settings, options),
-              std::span(vertexStage).first(mask ? 6 : 5), area);
+    gpu::RasterPush p = push(scene, settings, options);
+    p.flags |= extraFlags;
+    drawItems(commands, mask ? *mask_ : *depth_, scene, options, p, std::span(vertexStage).first(mask ? 6 : 5), area);
   }
   commands.endPass();
 }
 
 void RasterPass::recordShading(vk::Commands& commands, const RasterScene& scene, const FrameSettings& settings,
                                const RasterOptions& options, const vk::Image& traceImage, const vk::Image& target,
-                               const vk::Image& depth) const {
-  for (const vk::Image* image : {&traceImage, &target, &depth}) {
+                               const vk::Image& depth, const vk::Image& behindDepth) const {
+  recordShadingPass(commands, scene, settings, options, traceImage, target, depth, behindDepth, "raster shading");
+}
+
+void RasterPass::recordShadingPass(vk::Commands& commands, const RasterScene& scene, const FrameSettings& settings,
+                                   const RasterOptions& options, const vk::Image& traceImage, const vk::Image& target,
+                                   const vk::Image& depth, const vk::Image& behindDepth, const char* passName) const {
+  for (const vk::Image* image : {&traceImage, &target, &depth, &behindDepth}) {
     if (image->width() != settings.width || image->height() != settings.height) {
       throw vk::VulkanError("raster pass: image '" + image->name() + "' is not the frame's size");
     }
@@ -143,7 +159,7 @@ void RasterPass::recordShading(vk::Commands& commands, const RasterScene& scene,
   commands.computeToGraphics();
   commands.barrier(VK_PIPELINE_STAGE_LATE_FRAGMENT_TESTS_BIT, VK_ACCESS_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT,
                    VK_PIPELINE_STAGE_EARLY_FRAGMENT_TESTS_BIT, VK_ACCESS_DEPTH_STENCIL_ATTACHMENT_READ_BIT);
-  commands.beginPass("raster shading");
+  commands.beginPass(passName);
   VkRect2D area{{0, 0}, {settings.width, settings.height}};
   float clear[4] = {settings.background.r, settings.background.g, settings.background.b, 1.0f};
   {
@@ -158,7 +174,8 @@ void RasterPass::recordShading(vk::Commands& commands, const RasterScene& scene,
                                            {gpu::kRasterBindingTextures, &s.textures},
                                            {gpu::kRasterBindingTexels, &s.texels},
                                            {gpu::kRasterBindingLights, scene.lights},
-                                           {gpu::kRasterBindingTraceImage, nullptr, &traceImage}};
+                                           {gpu::kRasterBindingTraceImage, nullptr, &traceImage},
+                                           {gpu::kRasterBindingBehindDepth, nullptr, &behindDepth}};
     gpu::RasterPush p = push(scene, settings, options);
     drawItems(commands, *fill_, scene, options, p, resources, area);
     if (options.wireframe) {
@@ -167,6 +184,24 @@ void RasterPass::recordShading(vk::Commands& commands, const RasterScene& scene,
     }
   }
   commands.endPass();
+}
+
+void RasterPass::recordBehind(vk::Commands& commands, const RasterScene& scene, const FrameSettings& settings,
+                              const RasterOptions& options, const vk::Image& depth, const vk::Image& behindDepth,
+                              const vk::Image& behind) const {
+  RasterOptions opaque = options;
+  opaque.refraction = false;  // glass left out: what lies behind it
+  opaque.wireframe = false;
+  recordDepthPass(commands, scene, settings, opaque, depth, &behindDepth, behind, gpu::kRasterFlagBehindDepth,
+                  "behind depth");
+  recordShadingPass(commands, scene, settings, opaque, behind, behind, depth, behindDepth, "behind shading");
+  // The picture and its depth become what the shading pass's fragments read;
+  // the depth attachment is cleared again by the next pre-pass.
+  commands.barrier(VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT | VK_PIPELINE_STAGE_LATE_FRAGMENT_TESTS_BIT,
+                   VK_ACCESS_COLOR_ATTACHMENT_WRITE_BIT | VK_ACCESS_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT,
+                   VK_PIPELINE_STAGE_FRAGMENT_SHADER_BIT | VK_PIPELINE_STAGE_EARLY_FRAGMENT_TESTS_BIT,
+                   VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_DEPTH_STENCIL_ATTACHMENT_READ_BIT |
+                       VK_ACCESS_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT);
 }
 
 }  // namespace snell::render

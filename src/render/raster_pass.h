@@ -28,10 +28,21 @@ inline constexpr VkFormat kCompositeFormat = VK_FORMAT_R16G16B16A16_SFLOAT;
 inline constexpr VkFormat kDepthFormat = VK_FORMAT_D32_SFLOAT;
 inline constexpr VkFormat kMaskFormat = VK_FORMAT_R32_UINT;
 
+/// How transmissive fragments find what they show, when nothing is traced.
+enum class ScreenSpace {
+  Off,           ///< the trace image at the fragment's own pixel
+  NormalOffset,  ///< the picture behind the glass, displaced by the shading normal (GPU Gems 2, ch. 19)
+  IrisPlane,     ///< the picture behind the glass where the refracted ray meets the plane through it
+};
+
 struct RasterOptions {
   /// Off: transmissive faces are left out, so glass is seen straight through
   /// (as IOR 1 would show it) and nothing is traced.
   bool refraction = true;
+  /// With refraction: a screen-space approximation instead of the trace.
+  ScreenSpace screenSpace = ScreenSpace::Off;
+  /// NormalOffset's displacement per unit of normal, in image heights.
+  float offsetStrength = 0.02f;
   /// Draws every triangle's edges over the shaded image.
   bool wireframe = false;
   glm::vec4 wireColor{0.95f, 0.8f, 0.3f, 0.35f};  ///< blended over the image by its alpha
@@ -68,13 +79,28 @@ class RasterPass {
                    const vk::Image& colorTarget) const;
   /// The shading pass into `target` (kCompositeFormat, GENERAL, cleared to the
   /// background) over the pre-pass's depth; transmissive fragments take
-  /// `traceImage`'s texel (rgba16f, GENERAL, written before a compute-to-graphics barrier).
+  /// `traceImage`'s texel (rgba16f, GENERAL, written before a compute-to-graphics
+  /// barrier), or with a screen-space method a displaced texel of the picture
+  /// recordBehind() drew there; `behindDepth` is that picture's depth.
   void recordShading(vk::Commands& commands, const RasterScene& scene, const FrameSettings& settings,
                      const RasterOptions& options, const vk::Image& traceImage, const vk::Image& target,
-                     const vk::Image& depth) const;
+                     const vk::Image& depth, const vk::Image& behindDepth) const;
+  /// For the screen-space methods: the picture behind the glass (every
+  /// opaque face, glass left out) into `behind` (rgba16f, colour attachment
+  /// and storage) and its view depth into `behindDepth` (kMaskFormat), using
+  /// `depth` as scratch; visible to the shading pass's fragment shaders after.
+  void recordBehind(vk::Commands& commands, const RasterScene& scene, const FrameSettings& settings,
+                    const RasterOptions& options, const vk::Image& depth, const vk::Image& behindDepth,
+                    const vk::Image& behind) const;
 
  private:
   gpu::RasterPush push(const RasterScene& scene, const FrameSettings& settings, const RasterOptions& options) const;
+  void recordDepthPass(vk::Commands& commands, const RasterScene& scene, const FrameSettings& settings,
+                       const RasterOptions& options, const vk::Image& depth, const vk::Image* mask,
+                       const vk::Image& colorTarget, uint32_t extraFlags, const char* passName) const;
+  void recordShadingPass(vk::Commands& commands, const RasterScene& scene, const FrameSettings& settings,
+                         const RasterOptions& options, const vk::Image& traceImage, const vk::Image& target,
+                         const vk::Image& depth, const vk::Image& behindDepth, const char* passName) const;
   void drawItems(vk::Commands& commands, const vk::GraphicsProgram& program, const RasterScene& scene,
                  const RasterOptions& options, const gpu::RasterPush& push, std::span<const vk::BufferBinding> resources,
                  VkRect2D area) const;

@@ -40,7 +40,8 @@ bool sameRequest(const ViewRequest& a, const ViewRequest& b) {
   const RasterOptions &r = a.raster, &q = b.raster;
   return s.width == t.width && s.height == t.height && sameView(s.view, t.view) && s.background == t.background &&
          s.maxInterfaces == t.maxInterfaces && s.rays.empty() && t.rays.empty() && a.output == b.output &&
-         a.masked == b.masked && a.aov == b.aov && r.refraction == q.refraction && r.wireframe == q.wireframe &&
+         s.maxBends == t.maxBends && a.masked == b.masked && a.aov == b.aov && r.refraction == q.refraction &&
+         r.screenSpace == q.screenSpace && r.offsetStrength == q.offsetStrength && r.wireframe == q.wireframe &&
          r.wireColor == q.wireColor && r.nearPlane == q.nearPlane && r.farPlane == q.farPlane;
 }
 
@@ -200,7 +201,8 @@ double Renderer::treeBytesPerTriangle() const {
 
 bool Renderer::viewNeedsTrees(const ViewRequest& request) const {
   if (request.output == ViewOutput::Trace) return true;
-  return request.raster.refraction && refractive_ && transmissiveInView(request.settings);
+  return request.raster.refraction && request.raster.screenSpace == ScreenSpace::Off && refractive_ &&
+         transmissiveInView(request.settings);
 }
 
 // A bounding sphere per refractive item against the view's frustum: no glass
@@ -448,6 +450,7 @@ void Renderer::recordTrace(vk::Commands& commands, const ViewRequest& request, V
   push.width = settings.width;
   push.height = settings.height;
   push.maxInterfaces = settings.maxInterfaces;
+  push.maxBends = settings.maxBends;
   push.lightCount = lightCount_;
   push.flags = (request.aov ? gpu::kTraceFlagAov : 0u) | (v.orthographic ? gpu::kTraceFlagOrthographic : 0u) |
                (settings.rays.empty() ? 0u : gpu::kTraceFlagRayList) | (masked ? gpu::kTraceFlagPixelList : 0u);
@@ -532,8 +535,14 @@ void Renderer::recordView(vk::Commands& commands, Slot& slot, size_t index, cons
     if (request.output == ViewOutput::Trace) {
       recordTrace(commands, request, view, false, stats);
     } else {
-      bool traces = request.raster.refraction && refractive_ && transmissiveInView(settings);
+      bool glass = request.raster.refraction && refractive_ && transmissiveInView(settings);
+      bool traces = glass && request.raster.screenSpace == ScreenSpace::Off;
       bool masked = traces && request.masked;
+      // A screen-space method draws what lies behind the glass first, into the trace image.
+      if (glass && !traces) {
+        raster_->recordBehind(commands, scene, settings, request.raster, view.images.depth, view.images.mask,
+                              view.images.trace);
+      }
       raster_->recordDepth(commands, scene, settings, request.raster, view.images.depth,
                            masked ? &view.images.mask : nullptr, view.images.composite);
       if (traces) {
@@ -541,7 +550,7 @@ void Renderer::recordView(vk::Commands& commands, Slot& slot, size_t index, cons
         if (masked) slot.maskedViews.push_back(index);
       }
       raster_->recordShading(commands, scene, settings, request.raster, view.images.trace, view.images.composite,
-                             view.images.depth);
+                             view.images.depth, view.images.mask);
     }
     view.rendered = true;
     view.version = sceneVersion_;
@@ -615,8 +624,11 @@ uint64_t Renderer::submit(const FrameRequest& request) {
     im.width = w;
     im.height = h;
     if (!im.trace.handle()) {
+      // A colour attachment too: the screen-space methods draw what lies behind the glass into it.
       im.trace = vk::Image(context_, {w, h, VK_FORMAT_R16G16B16A16_SFLOAT,
-                                      VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT, name + " trace"});
+                                      VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT |
+                                          VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT,
+                                      name + " trace"});
       v.fresh = true;
     }
     if (composite && !im.composite.handle()) {

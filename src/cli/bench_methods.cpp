@@ -1,0 +1,377 @@
+// `snell bench methods`: what each way of drawing refraction costs and how
+// wrong it is, on the same animated frames. Errors are against the CPU
+// double-precision reference of each frame, never against another GPU image.
+#include "cli/cli.h"
+
+#include "cli/image_file.h"
+#include "ref/reference_tracer.h"
+#include "render/method.h"
+#include "render/renderer.h"
+#include "scene/evaluate.h"
+#include "scene/gltf_loader.h"
+#include "scene/procedural_eye.h"
+#include "scene/view.h"
+
+#include <glm/gtc/constants.hpp>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <sstream>
+
+namespace snell::cli {
+
+namespace {
+
+constexpr const char* kHelp = R"(usage: snell bench methods [SCENE.glb] [options]
+
+Renders an animated sequence of the procedural eye (or SCENE) with every way
+snell can draw refraction and reports, per method, the median GPU time of its
+refraction work per frame and its error against the CPU double-precision
+reference of the same frames. The sequence plays the scene's animation (the
+eye looks around, squashes and dilates) while the camera orbits from the
+scene's own view to 80 degrees aside, a grazing view of the cornea.
+
+Refraction work is every pass but deform and the viewport's own raster depth
+and shading, which a viewport pays with or without glass; the first frame's
+tree build is a warm-up and not counted. Errors compare 8-bit sRGB pixels as
+a PNG would hold them: RMSE, the share of pixels over 1/255 and over 8/255,
+the largest difference, over the pixels whose first hit in the reference is
+transmissive, and over the whole image.
+
+methods: trace, trace-1, masked, iris-plane, normal-offset, none
+
+options:
+  --size WxH          image size (default 320x240)
+  --frames N          frames of the sequence (default 24)
+  --methods A,B,...   only these methods
+  --max-interfaces N  refractive faces a traced ray may cross (default 8)
+  --offset-strength S normal-offset's displacement in image heights (0.02)
+  --json FILE         write the results as JSON
+  --svg FILE          write a chart of time against error (log-log, the
+                      Pareto front drawn) that a browser opens
+  --images DIR        write the last (grazing) frame of each method and of the
+                      reference there as PNG (DIR/METHOD.png, DIR/reference.png)
+)";
+
+struct Error {
+  double sumSquares = 0;  ///< of channel differences, in 1/255 units
+  uint64_t channels = 0, pixels = 0, over1 = 0, over8 = 0;
+  int maximum = 0;
+  double rmse() const { return channels ? std::sqrt(sumSquares / double(channels)) / 255.0 : 0.0; }
+  double share(uint64_t n) const { return pixels ? double(n) / double(pixels) : 0.0; }
+};
+
+struct Frame {
+  double time = 0;
+  scene::Pose pose;
+  scene::View view;
+  Rgb8Image reference;
+  std::vector<bool> transmissive;  ///< the reference's first hit is a refractive face
+};
+
+struct MethodResult {
+  render::MethodInfo info;
+  std::vector<double> refractionMs;
+  Error glass, image;
+  double worstFrameWithin1 = 1.0;  ///< the lowest share of pixels within 1/255 of any frame
+  uint64_t memoryBytes = 0;
+};
+
+void accumulate(const Rgb8Image& got, const Frame& frame, Error& glass, Error& image, double& worstWithin1) {
+  Error frameError;
+  for (size_t i = 0; i < size_t(got.width) * got.height; ++i) {
+    int worst = 0;
+    double squares = 0;
+    for (int c = 0; c < 3; ++c) {
+      int d = std::abs(int(got.rgb[3 * i + c]) - int(frame.reference.rgb[3 * i + c]));
+      worst = std::max(worst, d);
+      squares += double(d) * d;
+    }
+    for (Error* e : {&image, &frameError, frame.transmissive[i] ? &glass : nullptr}) {
+      if (!e) continue;
+      e->sumSquares += squares;
+      e->channels += 3;
+      e->pixels += 1;
+      e->over1 += worst > 1;
+      e->over8 += worst > 8;
+      e->maximum = std::max(e->maximum, worst);
+    }
+  }
+  worstWithin1 = std::min(worstWithin1, 1.0 - frameError.share(frameError.over1));
+}
+
+// The camera swings about the view's up axis around the scene's centre.
+scene::View orbitView(const scene::Scene& scene, const scene::Pose& pose, const scene::View& start, double angle) {
+  glm::dvec3 lo, hi;
+  scene::sceneBounds(scene, pose, lo, hi);
+  glm::dvec3 centre = 0.5 * (lo + hi);
+  double distance = glm::length(start.eye - centre);
+  glm::dvec3 back = -start.forward;
+  scene::ViewRequest request;
+  request.lookAt = scene::LookAt{centre + distance * (std::cos(angle) * back + std::sin(angle) * start.right), centre,
+                                 start.up};
+  request.yfov = 2.0 * std::atan(start.halfHeight);
+  return scene::resolveView(scene, pose, request);
+}
+
+std::vector<std::string> splitList(const std::string& value) {
+  std::vector<std::string> parts;
+  std::stringstream in(value);
+  std::string part;
+  while (std::getline(in, part, ',')) parts.push_back(part);
+  return parts;
+}
+
+// ------------------------------------------------------------------ chart
+
+std::string xmlEscape(const std::string& text) {
+  std::string out;
+  for (char c : text) {
+    if (c == '&') out += "&amp;";
+    else if (c == '<') out += "&lt;";
+    else if (c == '>') out += "&gt;";
+    else if (c == '"') out += "&quot;";
+    else out += c;
+  }
+  return out;
+}
+
+double niceFloor(double v) { return std::pow(10.0, std::floor(std::log10(v))); }
+double niceCeil(double v) { return std::pow(10.0, std::ceil(std::log10(v))); }
+
+// Time against transmissive-pixel RMSE, log-log. A method with no refraction
+// work (or no error) sits on the axis floor, labelled so.
+std::string chartSvg(const std::vector<MethodResult>& results, const std::string& title) {
+  const double width = 720, height = 480, left = 80, right = 200, top = 50, bottom = 60;
+  double minX = std::numeric_limits<double>::infinity(), maxX = 0, minY = minX, maxY = 0;
+  for (const MethodResult& r : results) {
+    double x = median(r.refractionMs), y = r.glass.rmse();
+    if (x > 0) minX = std::min(minX, x), maxX = std::max(maxX, x);
+    if (y > 0) minY = std::min(minY, y), maxY = std::max(maxY, y);
+  }
+  if (!(maxX > 0)) minX = 1e-3, maxX = 1.0;
+  if (!(maxY > 0)) minY = 1e-4, maxY = 1e-1;
+  double x0 = niceFloor(minX / 2), x1 = niceCeil(maxX * 1.5), y0 = niceFloor(minY / 2), y1 = niceCeil(maxY * 1.5);
+  auto px = [&](double x) { return left + (std::log10(std::max(x, x0)) - std::log10(x0)) / (std::log10(x1) - std::log10(x0)) * (width - left - right); };
+  auto py = [&](double y) { return height - bottom - (std::log10(std::max(y, y0)) - std::log10(y0)) / (std::log10(y1) - std::log10(y0)) * (height - top - bottom); };
+  std::ostringstream svg;
+  svg << "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n"
+      << "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" << width << "\" height=\"" << height
+      << "\" viewBox=\"0 0 " << width << " " << height << "\" font-family=\"sans-serif\" font-size=\"12\">\n"
+      << "<rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n"
+      << "<text x=\"" << left << "\" y=\"24\" font-size=\"15\">" << xmlEscape(title) << "</text>\n";
+  for (double x = x0; x <= x1 * 1.001; x *= 10) {
+    svg << "<line x1=\"" << px(x) << "\" y1=\"" << top << "\" x2=\"" << px(x) << "\" y2=\"" << height - bottom
+        << "\" stroke=\"#ddd\"/><text x=\"" << px(x) << "\" y=\"" << height - bottom + 16
+        << "\" text-anchor=\"middle\">" << x << "</text>\n";
+  }
+  for (double y = y0; y <= y1 * 1.001; y *= 10) {
+    svg << "<line x1=\"" << left << "\" y1=\"" << py(y) << "\" x2=\"" << width - right << "\" y2=\"" << py(y)
+        << "\" stroke=\"#ddd\"/><text x=\"" << left - 6 << "\" y=\"" << py(y) + 4 << "\" text-anchor=\"end\">" << y
+        << "</text>\n";
+  }
+  svg << "<text x=\"" << (left + width - right) / 2 << "\" y=\"" << height - 18
+      << "\" text-anchor=\"middle\">refraction work per frame, ms (median, log)</text>\n"
+      << "<text transform=\"translate(18," << (top + height - bottom) / 2
+      << ") rotate(-90)\" text-anchor=\"middle\">RMSE on glass pixels against the CPU reference (log)</text>\n";
+  // The Pareto front: no other method is both faster and more accurate.
+  std::vector<const MethodResult*> sorted;
+  for (const MethodResult& r : results) sorted.push_back(&r);
+  std::sort(sorted.begin(), sorted.end(), [](const MethodResult* a, const MethodResult* b) {
+    double ta = median(a->refractionMs), tb = median(b->refractionMs);
+    return ta != tb ? ta < tb : a->glass.rmse() < b->glass.rmse();
+  });
+  std::string front;
+  double best = std::numeric_limits<double>::infinity();
+  for (const MethodResult* r : sorted) {
+    if (r->glass.rmse() >= best) continue;
+    best = r->glass.rmse();
+    front += (front.empty() ? "" : " ") + std::to_string(px(median(r->refractionMs))) + "," +
+             std::to_string(py(r->glass.rmse()));
+  }
+  svg << "<polyline points=\"" << front << "\" fill=\"none\" stroke=\"#c33\" stroke-width=\"1.5\" stroke-dasharray=\"5,3\"/>\n";
+  for (const MethodResult& r : results) {
+    double t = median(r.refractionMs), e = r.glass.rmse();
+    std::string label = r.info.name;
+    if (t <= 0) label += " (no work)";
+    if (e <= 0) label += " (exact)";
+    svg << "<circle cx=\"" << px(t) << "\" cy=\"" << py(e) << "\" r=\"5\" fill=\"#2468a8\"><title>"
+        << xmlEscape(r.info.summary) << "</title></circle><text x=\"" << px(t) + 8 << "\" y=\"" << py(e) - 6
+        << "\">" << xmlEscape(label) << "</text>\n";
+  }
+  svg << "<text x=\"" << width - right + 10 << "\" y=\"" << top + 10
+      << "\" fill=\"#c33\">- - Pareto front</text>\n</svg>\n";
+  return svg.str();
+}
+
+}  // namespace
+
+int runBenchMethods(const Args& args) {
+  uint32_t width = 320, height = 240, frameCount = 24, maxInterfaces = gpu::kDefaultMaxInterfaces;
+  float offsetStrength = render::RasterOptions{}.offsetStrength;
+  std::string file, json, svg, images;
+  std::vector<render::MethodInfo> chosen = render::methods();
+  for (size_t i = 0; i < args.size(); ++i) {
+    const std::string& a = args[i];
+    if (a == "--help" || a == "-h") {
+      std::fputs(kHelp, stdout);
+      return 0;
+    }
+    if (!a.empty() && a[0] != '-') {
+      file = a;
+      continue;
+    }
+    if (i + 1 >= args.size()) throw UsageError{"bench methods: " + a + " needs a value (or is unknown)"};
+    const std::string& v = args[++i];
+    if (a == "--size") {
+      parseSize(a, v, width, height);
+    } else if (a == "--frames") {
+      frameCount = std::max<uint32_t>(1, uint32_t(parseCount(a, v)));
+    } else if (a == "--max-interfaces") {
+      maxInterfaces = uint32_t(std::min<unsigned long long>(parseCount(a, v), 1024));
+    } else if (a == "--offset-strength") {
+      char* end = nullptr;
+      offsetStrength = std::strtof(v.c_str(), &end);
+      if (v.empty() || *end != '\0' || !std::isfinite(offsetStrength)) {
+        throw UsageError{"bench methods: --offset-strength expects a number, got '" + v + "'"};
+      }
+    } else if (a == "--methods") {
+      chosen.clear();
+      for (const std::string& name : splitList(v)) {
+        std::optional<render::Method> m = render::methodFromName(name);
+        if (!m) throw UsageError{"bench methods: unknown method '" + name + "' (" + render::methodNames() + ")"};
+        for (const render::MethodInfo& info : render::methods()) {
+          if (info.method == *m) chosen.push_back(info);
+        }
+      }
+    } else if (a == "--json") {
+      json = v;
+    } else if (a == "--svg") {
+      svg = v;
+    } else if (a == "--images") {
+      images = v;
+    } else {
+      throw UsageError{"bench methods: unknown option " + a};
+    }
+  }
+  scene::Scene scene = file.empty() ? scene::makeEye() : scene::loadGltf(file);
+  std::string label = file.empty() ? std::string("procedural eye") : file;
+  auto context = vk::Context::create(contextDescFromEnvironment());
+  render::checkImageSize(*context, width, height);
+  std::printf("device: %s\nscene: %s, %ux%u, %u frames\n", context->facts().name.c_str(), label.c_str(), width, height,
+              frameCount);
+
+  // The sequence and its reference images, once for every method.
+  double duration = scene::animationDuration(scene);
+  scene::Pose first = scene::evaluate(scene, 0.0);
+  scene::View start = scene::resolveView(scene, first, scene::ViewRequest{});
+  std::vector<Frame> frames(frameCount);
+  auto began = std::chrono::steady_clock::now();
+  for (uint32_t f = 0; f < frameCount; ++f) {
+    Frame& frame = frames[f];
+    double along = frameCount > 1 ? double(f) / double(frameCount - 1) : 0.0;
+    frame.time = duration * along;
+    frame.pose = scene::evaluate(scene, frame.time);
+    frame.view = orbitView(scene, frame.pose, start, glm::radians(80.0) * along);
+    ref::ReferenceSettings settings;
+    settings.width = width;
+    settings.height = height;
+    settings.view = frame.view;
+    settings.maxInterfaces = maxInterfaces;
+    ref::ReferenceImage reference = ref::renderReference(scene, frame.pose, settings);
+    LinearImage linear{width, height, {}};
+    frame.transmissive.resize(reference.color.size());
+    for (size_t i = 0; i < reference.color.size(); ++i) {
+      linear.rgba.emplace_back(glm::vec3(reference.color[i]), 1.0f);
+      int item = reference.instance[i];
+      if (item < 0) continue;
+      int shape = frame.pose.items[size_t(item)].shape;
+      int material = scene.shapes[size_t(shape)].material;
+      frame.transmissive[i] = material >= 0 && scene.materials[size_t(material)].refractive();
+    }
+    frame.reference = toSrgb8(linear);
+    if (!images.empty() && f + 1 == frameCount) writeImage(images + "/reference.png", linear);
+    double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - began).count();
+    std::fprintf(stderr, "\rCPU reference: frame %u/%u, %.1f s", f + 1, frameCount, seconds);
+  }
+  std::fputc('\n', stderr);
+
+  std::vector<MethodResult> results;
+  for (const render::MethodInfo& info : chosen) {
+    MethodResult result{info, {}, {}, {}, 1.0, 0};
+    render::Renderer renderer(*context, scene, first);
+    for (uint32_t f = 0; f <= frameCount; ++f) {
+      // One warm-up frame first: it builds the trees and the pipelines.
+      const Frame& frame = frames[f == 0 ? 0 : f - 1];
+      render::FrameSettings settings{width, height, frame.view, glm::vec3(0.02f, 0.02f, 0.025f), maxInterfaces};
+      render::RasterOptions raster;
+      raster.offsetStrength = offsetStrength;
+      glm::dvec3 lo, hi;
+      scene::sceneBounds(scene, frame.pose, lo, hi);
+      render::fitDepthRange(frame.view, lo, hi, raster);
+      render::ViewRequest view = render::methodView(info.method, settings, raster);
+      view.readback = true;
+      render::FrameRequest request;
+      request.pose = &frame.pose;
+      request.views.push_back(view);
+      const render::FrameResult& out = renderer.wait(renderer.submit(request));
+      if (f == 0) continue;
+      double ms = 0;
+      for (const vk::PassTime& p : out.passes) ms += render::isRefractionPass(p.name) ? p.milliseconds : 0.0;
+      result.refractionMs.push_back(ms);
+      const render::ViewPixels& pixels = out.views.at(0);
+      LinearImage image{width, height, render::drawsComposite(info.method) ? pixels.composite : pixels.trace};
+      accumulate(toSrgb8(image), frame, result.glass, result.image, result.worstFrameWithin1);
+      if (!images.empty() && f == frameCount) writeImage(images + "/" + info.name + ".png", image);
+    }
+    result.memoryBytes = renderer.memoryBytes();
+    results.push_back(result);
+  }
+
+  std::printf("\n%-14s %10s %10s %9s %9s %5s %10s %9s %9s %12s %10s\n", "method", "refract ms", "glass RMSE",
+              ">1/255", ">8/255", "max", "image RMSE", ">1/255", ">8/255", "worst frame", "GPU MiB");
+  for (const MethodResult& r : results) {
+    std::printf("%-14s %10.4f %10.5f %8.3f%% %8.3f%% %5d %10.5f %8.3f%% %8.3f%% %11.3f%% %10.2f\n", r.info.name,
+                median(r.refractionMs), r.glass.rmse(), 100 * r.glass.share(r.glass.over1),
+                100 * r.glass.share(r.glass.over8), r.glass.maximum, r.image.rmse(), 100 * r.image.share(r.image.over1),
+                100 * r.image.share(r.image.over8), 100 * r.worstFrameWithin1, double(r.memoryBytes) / 1048576.0);
+  }
+  std::printf("(glass: pixels whose first hit in the reference is transmissive; worst frame: the lowest share of a\n"
+              " frame's pixels within 1/255; GPU MiB: geometry, trees and per-frame tables, not the images)\n");
+
+  std::string title = "snell bench methods: " + label + ", " + std::to_string(width) + "x" + std::to_string(height) +
+                      ", " + std::to_string(frameCount) + " frames, " + context->facts().name;
+  if (!json.empty()) {
+    std::ostringstream out;
+    auto errorJson = [](const Error& e) {
+      std::ostringstream o;
+      o << "{\"pixels\": " << e.pixels << ", \"rmse\": " << e.rmse() << ", \"share_over_1\": " << e.share(e.over1)
+        << ", \"share_over_8\": " << e.share(e.over8) << ", \"max\": " << e.maximum << "}";
+      return o.str();
+    };
+    out << "{\n  \"device\": \"" << jsonEscape(context->facts().name) << "\",\n  \"scene\": \"" << jsonEscape(label)
+        << "\",\n  \"width\": " << width << ",\n  \"height\": " << height << ",\n  \"frames\": " << frameCount
+        << ",\n  \"methods\": [\n";
+    for (size_t i = 0; i < results.size(); ++i) {
+      const MethodResult& r = results[i];
+      out << "    {\"method\": \"" << r.info.name << "\", \"summary\": \"" << jsonEscape(r.info.summary)
+          << "\", \"refraction_median_ms\": " << median(r.refractionMs) << ", \"glass\": " << errorJson(r.glass)
+          << ", \"image\": " << errorJson(r.image) << ", \"worst_frame_within_1\": " << r.worstFrameWithin1
+          << ", \"memory_bytes\": " << r.memoryBytes << "}" << (i + 1 < results.size() ? "," : "") << "\n";
+    }
+    out << "  ]\n}\n";
+    writeTextFile(json, out.str());
+  }
+  if (!svg.empty()) writeTextFile(svg, chartSvg(results, title));
+  if (context->validationMessageCount() > 0) {
+    std::fprintf(stderr, "snell: the validation layer reported %llu message(s)\n",
+                 static_cast<unsigned long long>(context->validationMessageCount()));
+    return 1;
+  }
+  return 0;
+}
+
+}  // namespace snell::cli

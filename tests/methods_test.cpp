@@ -1,0 +1,162 @@
+// The ways of drawing refraction (render/method.h): each is a real path
+// through the renderer, and each approximation reduces to what it claims to
+// approximate where its assumption holds exactly.
+#include "command_run.h"
+#include "golden_support.h"
+#include "gpu_test.h"
+
+#include "render/method.h"
+#include "render/renderer.h"
+#include "scene/evaluate.h"
+#include "scene/view.h"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <regex>
+#include <sstream>
+
+namespace snell::test {
+namespace {
+
+using render::Method;
+
+constexpr uint32_t kWidth = 160, kHeight = 120;
+
+struct Shot {
+  cli::Rgb8Image image;
+  render::FrameStats stats;
+  std::vector<std::string> passes;
+};
+
+// One frame of `s` at time 0 from its own camera (or `camera`), drawn by `method`.
+Shot draw(vk::Context& context, const scene::Scene& s, Method method, float offsetStrength = 0.02f,
+          const scene::ViewRequest& camera = {}) {
+  scene::Pose pose = scene::evaluate(s, 0.0);
+  scene::View view = scene::resolveView(s, pose, camera);
+  render::Renderer renderer(context, s, pose);
+  render::FrameSettings settings{kWidth, kHeight, view, {0.02f, 0.02f, 0.025f}, gpu::kDefaultMaxInterfaces};
+  render::RasterOptions raster;
+  raster.offsetStrength = offsetStrength;
+  glm::dvec3 lo, hi;
+  scene::sceneBounds(s, pose, lo, hi);
+  render::fitDepthRange(view, lo, hi, raster);
+  render::FrameRequest request;
+  request.pose = &pose;
+  request.views.push_back(render::methodView(method, settings, raster));
+  request.views.back().readback = true;
+  const render::FrameResult& result = renderer.wait(renderer.submit(request));
+  const render::ViewPixels& pixels = result.views.at(0);
+  Shot shot;
+  shot.image = cli::toSrgb8({kWidth, kHeight, render::drawsComposite(method) ? pixels.composite : pixels.trace});
+  shot.stats = result.stats;
+  for (const vk::PassTime& p : result.passes) shot.passes.push_back(p.name);
+  return shot;
+}
+
+double shareWithinOne(const cli::Rgb8Image& got, const cli::Rgb8Image& want) {
+  Comparison c = compare(got, want);
+  return double(c.withinOne) / double(c.pixels);
+}
+
+TEST(Methods, EveryMethodHasAUniqueNameThatParsesBack) {
+  for (const render::MethodInfo& m : render::methods()) {
+    ASSERT_TRUE(render::methodFromName(m.name).has_value()) << m.name;
+    EXPECT_EQ(*render::methodFromName(m.name), m.method);
+  }
+  EXPECT_FALSE(render::methodFromName("raytrace").has_value());
+}
+
+// The eye's rays cross one interface, the cornea, before the iris: bending
+// only there is the whole physics.
+TEST_F(GpuTest, TraceOnceIsTheFullTraceWhereRaysCrossOneInterface) {
+  scene::Scene eye = eyeWith(1.376f);
+  Comparison c = compare(draw(context(), eye, Method::TraceOnce).image, draw(context(), eye, Method::Trace).image);
+  EXPECT_EQ(c.withinOne, c.pixels) << c.firstMismatches;
+}
+
+// Through a prism a ray crosses two faces; bending at the first alone must show.
+TEST_F(GpuTest, TraceOnceDiffersFromTheFullTraceThroughAPrism) {
+  scene::Scene prism = prismScene();
+  scene::ViewRequest camera;  // the golden image's view: light reflected inside the prism
+  camera.lookAt = scene::LookAt{{0.6, 0.3, -6.0}, {0.6, 0.0, 0.0}, {0.0, 1.0, 0.0}};
+  camera.yfov = 0.6;
+  EXPECT_LT(shareWithinOne(draw(context(), prism, Method::TraceOnce, 0.02f, camera).image,
+                           draw(context(), prism, Method::Trace, 0.02f, camera).image),
+            0.95);
+}
+
+TEST_F(GpuTest, ScreenSpaceMethodsBuildNoTreeAndDispatchNoTrace) {
+  scene::Scene eye = eyeWith(1.376f);
+  for (Method m : {Method::IrisPlane, Method::NormalOffset}) {
+    Shot shot = draw(context(), eye, m);
+    EXPECT_EQ(shot.stats.treesBuilt, 0u) << render::methodName(m);
+    EXPECT_EQ(shot.stats.traceDispatches, 0u) << render::methodName(m);
+    EXPECT_NE(std::find(shot.passes.begin(), shot.passes.end(), "behind shading"), shot.passes.end())
+        << render::methodName(m) << " draws what lies behind the glass first";
+  }
+}
+
+// With no displacement the lookup behind the glass is the straight-through
+// view: exactly what `none` draws (the eye's glass is untinted).
+TEST_F(GpuTest, NormalOffsetOfStrengthZeroSeesStraightThrough) {
+  scene::Scene eye = eyeWith(1.376f);
+  Comparison c = compare(draw(context(), eye, Method::NormalOffset, 0.0f).image, draw(context(), eye, Method::None).image);
+  EXPECT_EQ(c.withinOne, c.pixels) << c.firstMismatches;
+}
+
+// At IOR 1 the refracted ray is the view ray, so the point where it meets the
+// plane behind projects back onto the fragment's own pixel.
+TEST_F(GpuTest, IrisPlaneAtIorOneSeesStraightThrough) {
+  scene::Scene eye = eyeWith(1.0f);
+  EXPECT_GE(shareWithinOne(draw(context(), eye, Method::IrisPlane).image, draw(context(), eye, Method::None).image),
+            0.999);
+}
+
+TEST_F(GpuTest, IrisPlaneBendsTheViewAtTheCorneasIor) {
+  scene::Scene eye = eyeWith(1.376f);
+  EXPECT_LT(shareWithinOne(draw(context(), eye, Method::IrisPlane).image, draw(context(), eye, Method::None).image),
+            0.99);
+}
+
+double jsonNumber(const std::string& json, const std::string& method, const std::string& path) {
+  std::smatch m;
+  std::regex pattern("\"method\": \"" + method + "\".*?" + path + "\": ([0-9.e+-]+)");
+  if (!std::regex_search(json, m, pattern)) return -1.0;
+  return std::stod(m[1]);
+}
+
+TEST(BenchMethods, WritesJsonAndAChartWithOnePointPerMethodAndRefractionMatters) {
+  namespace fs = std::filesystem;
+  fs::path dir = fs::temp_directory_path() / "snell_bench_methods";
+  fs::create_directories(dir);
+  fs::path json = dir / "methods.json", svg = dir / "methods.svg";
+  CommandRun run = runCommand(std::string(SNELL_BINARY) + " bench methods --size 96x72 --frames 3 --json " +
+                              shellQuoted(json.string()) + " --svg " + shellQuoted(svg.string()));
+  ASSERT_EQ(run.exitCode, 0) << run.output;
+  std::ifstream in(json);
+  std::stringstream text;
+  text << in.rdbuf();
+  std::string j = text.str();
+  for (const render::MethodInfo& m : render::methods()) {
+    EXPECT_NE(j.find("\"method\": \"" + std::string(m.name) + "\""), std::string::npos) << m.name;
+  }
+  double traceError = jsonNumber(j, "trace", "\"glass\": \\{\"pixels\": [0-9]+, \"rmse");
+  double noneError = jsonNumber(j, "none", "\"glass\": \\{\"pixels\": [0-9]+, \"rmse");
+  ASSERT_GE(traceError, 0.0) << j;
+  EXPECT_GT(noneError, 10.0 * traceError) << "seeing straight through the cornea is visibly wrong: " << j;
+  CommandRun lint = runCommand("xmllint --noout " + shellQuoted(svg.string()));
+  EXPECT_EQ(lint.exitCode, 0) << lint.output;
+  std::ifstream chart(svg);
+  std::stringstream svgText;
+  svgText << chart.rdbuf();
+  std::string s = svgText.str();
+  size_t circles = 0;
+  for (size_t at = s.find("<circle"); at != std::string::npos; at = s.find("<circle", at + 1)) ++circles;
+  EXPECT_EQ(circles, render::methods().size());
+  fs::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace snell::test
