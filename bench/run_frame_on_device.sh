@@ -22,7 +22,7 @@ step=${1:-all}
 if [[ $step == all || $step == tests ]]; then
   echo "== tests on the GPU, validation on (not the ones that run the CLI, the viewer or node)"
   SNELL_VALIDATION=1 .carry/snell_tests --gtest_brief=1 \
-    --gtest_filter='-SceneInfoCommand.*:RenderCommand.*:Viewer.*:ProceduralEye.PassesTheKhronos*' > "$OUT/tests.log" 2>&1
+    --gtest_filter='-SceneInfoCommand.*:RenderCommand.*:BenchMethods.*:Viewer.*:ProceduralEye.PassesTheKhronos*' > "$OUT/tests.log" 2>&1
   echo "tests exit $?"; grep -E "FAILED|PASSED|tests ran" "$OUT/tests.log" | tail -12
 fi
 if [[ $step == all || $step == bench ]]; then
@@ -45,6 +45,25 @@ if [[ $step == all || $step == bench ]]; then
   tar -C "$json" -cf "$OUT/results.tar" .
 fi
 if [[ $step == all || $step == methods ]]; then
-  .carry/snell bench methods --size 1920x1080 --frames 24 --json "$OUT/methods.json" --svg "$OUT/methods.svg" \
-    2>&1 | tee "$OUT/methods.log"
+  s=.carry/snell
+  json=$(mktemp -d)
+  $s bench methods --size 1920x1080 --frames 24 --json "$json/methods.json" --svg "$OUT/methods.svg" 2>&1 |
+    tee "$OUT/methods.log"
+  {
+    echo "== scaling, trace against driver-rt, same frames: image size (eye 64)"
+    for size in 640x360 1920x1080 3840x2160; do
+      $s bench methods --methods trace,driver-rt --no-reference --frames 8 --size $size --json "$json/scale-size-$size.json"
+    done
+    echo "== triangles (eye resolution 64 to 2048), 1920x1080"
+    for r in 64 256 1024 2048; do
+      $s bench methods --methods trace,driver-rt --no-reference --frames 8 --eye-resolution $r --json "$json/scale-eye-$r.json" \
+        --size 1920x1080
+    done
+    echo "== characters, 3840x2160"
+    for c in 1 10 100; do
+      $s bench methods --methods trace,driver-rt --no-reference --frames 8 --crowd $c --size 3840x2160 \
+        --json "$json/scale-crowd-$c.json"
+    done
+  } 2>&1 | grep -v "CPU reference" | tee "$OUT/methods-scaling.log"
+  tar -C "$json" -cf "$OUT/methods-results.tar" .
 fi

@@ -158,6 +158,7 @@ SNELL_CONST kTraceBindingAov = 14;        // TraceAov[width * height]
 SNELL_CONST kTraceBindingRays = 15;       // GpuRay[width * height], with kTraceFlagRayList
 SNELL_CONST kTraceBindingPixels = 16;     // TracePixelList, with kTraceFlagPixelList
 SNELL_CONST kTraceBindingMask = 17;       // r32ui image: non-zero where a transmissive face is visible (compaction)
+SNELL_CONST kTraceBindingGeometryFirst = 18;  // uint[geometryCount]: first triangle (driver-rt pipeline only)
 
 // A primary ray from a list, relative to the frame origin like everything the trace sees.
 // 32 bytes, total: 32 bytes

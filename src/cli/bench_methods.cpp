@@ -19,6 +19,8 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <map>
+#include <memory>
 #include <sstream>
 
 namespace snell::cli {
@@ -36,12 +38,21 @@ scene's own view to 80 degrees aside, a grazing view of the cornea.
 
 Refraction work is every pass but deform and the viewport's own raster depth
 and shading, which a viewport pays with or without glass; the first frame's
-tree build is a warm-up and not counted. Errors compare 8-bit sRGB pixels as
+tree build is a warm-up and not counted. Times are medians over three passes
+through the sequence after one to warm up, every method drawing each frame in
+turn (so the GPU's clock changes fall on all alike), two frames in flight and
+nothing read back; the errors come from one more pass that reads every frame
+back. Errors compare 8-bit sRGB pixels as
 a PNG would hold them: RMSE, the share of pixels over 1/255 and over 8/255,
 the largest difference, over the pixels whose first hit in the reference is
 transmissive, and over the whole image.
 
-methods: trace, trace-1, masked, iris-plane, normal-offset, none
+methods: trace, trace-1, masked, iris-plane, normal-offset, none, and
+driver-rt, the peer: the same rays and shading code with the hits found by
+the driver's own ray tracing (VK_KHR_ray_tracing_pipeline), where the device
+has it (not lavapipe: reported unsupported). For it the table adds the share
+of pixels whose first hit (instance, triangle) agrees with trace's, and its
+build (first frame), update and trace times.
 
 options:
   --size WxH          image size (default 320x240)
@@ -49,12 +60,18 @@ options:
   --methods A,B,...   only these methods
   --max-interfaces N  refractive faces a traced ray may cross (default 8)
   --offset-strength S normal-offset's displacement in image heights (0.02)
+  --eye-resolution N  segments of the procedural eye (default 64)
+  --crowd N           N characters' eye pairs instead of one eye
+  --no-reference      time only: no CPU reference, no errors (for scaling runs)
   --json FILE         write the results as JSON
   --svg FILE          write a chart of time against error (log-log, the
                       Pareto front drawn) that a browser opens
   --images DIR        write the last (grazing) frame of each method and of the
                       reference there as PNG (DIR/METHOD.png, DIR/reference.png)
 )";
+
+// Times of each method come from this many passes over the sequence.
+constexpr uint32_t kTimingRounds = 3;
 
 struct Error {
   double sumSquares = 0;  ///< of channel differences, in 1/255 units
@@ -74,7 +91,11 @@ struct Frame {
 
 struct MethodResult {
   render::MethodInfo info;
+  std::string unsupported;  ///< why the method did not run here (empty: it ran)
   std::vector<double> refractionMs;
+  std::map<std::string, std::vector<double>> passMs;  ///< per pass, measured frames
+  std::map<std::string, double> firstFrameMs;         ///< per pass, the warm-up frame (builds)
+  uint64_t hitsCompared = 0, hitsAgreeing = 0;        ///< first hits against trace's (driver-rt)
   Error glass, image;
   double worstFrameWithin1 = 1.0;  ///< the lowest share of pixels within 1/255 of any frame
   uint64_t memoryBytes = 0;
@@ -148,6 +169,7 @@ std::string chartSvg(const std::vector<MethodResult>& results, const std::string
   const double width = 720, height = 480, left = 80, right = 200, top = 50, bottom = 60;
   double minX = std::numeric_limits<double>::infinity(), maxX = 0, minY = minX, maxY = 0;
   for (const MethodResult& r : results) {
+    if (!r.unsupported.empty()) continue;
     double x = median(r.refractionMs), y = r.glass.rmse();
     if (x > 0) minX = std::min(minX, x), maxX = std::max(maxX, x);
     if (y > 0) minY = std::min(minY, y), maxY = std::max(maxY, y);
@@ -179,7 +201,9 @@ std::string chartSvg(const std::vector<MethodResult>& results, const std::string
       << ") rotate(-90)\" text-anchor=\"middle\">RMSE on glass pixels against the CPU reference (log)</text>\n";
   // The Pareto front: no other method is both faster and more accurate.
   std::vector<const MethodResult*> sorted;
-  for (const MethodResult& r : results) sorted.push_back(&r);
+  for (const MethodResult& r : results) {
+    if (r.unsupported.empty()) sorted.push_back(&r);
+  }
   std::sort(sorted.begin(), sorted.end(), [](const MethodResult* a, const MethodResult* b) {
     double ta = median(a->refractionMs), tb = median(b->refractionMs);
     return ta != tb ? ta < tb : a->glass.rmse() < b->glass.rmse();
@@ -193,14 +217,24 @@ std::string chartSvg(const std::vector<MethodResult>& results, const std::string
              std::to_string(py(r->glass.rmse()));
   }
   svg << "<polyline points=\"" << front << "\" fill=\"none\" stroke=\"#c33\" stroke-width=\"1.5\" stroke-dasharray=\"5,3\"/>\n";
+  std::vector<std::pair<double, double>> placed;  // labels already drawn, so close points' labels stack
   for (const MethodResult& r : results) {
+    if (!r.unsupported.empty()) continue;
     double t = median(r.refractionMs), e = r.glass.rmse();
     std::string label = r.info.name;
     if (t <= 0) label += " (no work)";
     if (e <= 0) label += " (exact)";
+    double lx = px(t) + 8, ly = py(e) - 6;
+    for (bool moved = true; moved;) {
+      moved = false;
+      for (const auto& [x, y] : placed) {
+        if (std::abs(x - lx) < 90 && std::abs(y - ly) < 14) ly = y + 14, moved = true;
+      }
+    }
+    placed.emplace_back(lx, ly);
     svg << "<circle cx=\"" << px(t) << "\" cy=\"" << py(e) << "\" r=\"5\" fill=\"#2468a8\"><title>"
-        << xmlEscape(r.info.summary) << "</title></circle><text x=\"" << px(t) + 8 << "\" y=\"" << py(e) - 6
-        << "\">" << xmlEscape(label) << "</text>\n";
+        << xmlEscape(r.info.summary) << "</title></circle><text x=\"" << lx << "\" y=\"" << ly << "\">"
+        << xmlEscape(label) << "</text>\n";
   }
   svg << "<text x=\"" << width - right + 10 << "\" y=\"" << top + 10
       << "\" fill=\"#c33\">- - Pareto front</text>\n</svg>\n";
@@ -213,6 +247,8 @@ int runBenchMethods(const Args& args) {
   uint32_t width = 320, height = 240, frameCount = 24, maxInterfaces = gpu::kDefaultMaxInterfaces;
   float offsetStrength = render::RasterOptions{}.offsetStrength;
   std::string file, json, svg, images;
+  scene::EyeOptions eye;
+  bool reference = true;
   std::vector<render::MethodInfo> chosen = render::methods();
   for (size_t i = 0; i < args.size(); ++i) {
     const std::string& a = args[i];
@@ -222,6 +258,10 @@ int runBenchMethods(const Args& args) {
     }
     if (!a.empty() && a[0] != '-') {
       file = a;
+      continue;
+    }
+    if (a == "--no-reference") {
+      reference = false;
       continue;
     }
     if (i + 1 >= args.size()) throw UsageError{"bench methods: " + a + " needs a value (or is unknown)"};
@@ -247,6 +287,10 @@ int runBenchMethods(const Args& args) {
           if (info.method == *m) chosen.push_back(info);
         }
       }
+    } else if (a == "--eye-resolution") {
+      eye.resolution = uint32_t(parseCount(a, v));
+    } else if (a == "--crowd") {
+      eye.crowd = uint32_t(parseCount(a, v));
     } else if (a == "--json") {
       json = v;
     } else if (a == "--svg") {
@@ -257,9 +301,20 @@ int runBenchMethods(const Args& args) {
       throw UsageError{"bench methods: unknown option " + a};
     }
   }
-  scene::Scene scene = file.empty() ? scene::makeEye() : scene::loadGltf(file);
-  std::string label = file.empty() ? std::string("procedural eye") : file;
-  auto context = vk::Context::create(contextDescFromEnvironment());
+  try {
+    scene::checkEyeOptions(eye);
+  } catch (const std::invalid_argument& e) {
+    throw UsageError{std::string("bench methods: ") + e.what()};
+  }
+  scene::Scene scene = file.empty() ? scene::makeEye(eye) : scene::loadGltf(file);
+  std::string label = file;
+  if (file.empty()) {
+    label = eye.crowd ? "eye crowd of " + std::to_string(eye.crowd) : std::string("procedural eye");
+    label += " (resolution " + std::to_string(eye.resolution) + ")";
+  }
+  vk::ContextDesc desc = contextDescFromEnvironment();
+  desc.driverRayTracing = true;  // for driver-rt, where the device has it
+  auto context = vk::Context::create(desc);
   render::checkImageSize(*context, width, height);
   std::printf("device: %s\nscene: %s, %ux%u, %u frames\n", context->facts().name.c_str(), label.c_str(), width, height,
               frameCount);
@@ -276,6 +331,7 @@ int runBenchMethods(const Args& args) {
     frame.time = duration * along;
     frame.pose = scene::evaluate(scene, frame.time);
     frame.view = orbitView(scene, frame.pose, start, glm::radians(80.0) * along);
+    if (!reference) continue;
     ref::ReferenceSettings settings;
     settings.width = width;
     settings.height = height;
@@ -299,41 +355,111 @@ int runBenchMethods(const Args& args) {
   }
   std::fputc('\n', stderr);
 
-  std::vector<MethodResult> results;
-  for (const render::MethodInfo& info : chosen) {
-    MethodResult result{info, {}, {}, {}, 1.0, 0};
-    render::Renderer renderer(*context, scene, first);
-    for (uint32_t f = 0; f <= frameCount; ++f) {
-      // One warm-up frame first: it builds the trees and the pipelines.
-      const Frame& frame = frames[f == 0 ? 0 : f - 1];
-      render::FrameSettings settings{width, height, frame.view, glm::vec3(0.02f, 0.02f, 0.025f), maxInterfaces};
-      render::RasterOptions raster;
-      raster.offsetStrength = offsetStrength;
-      glm::dvec3 lo, hi;
-      scene::sceneBounds(scene, frame.pose, lo, hi);
-      render::fitDepthRange(frame.view, lo, hi, raster);
-      render::ViewRequest view = render::methodView(info.method, settings, raster);
-      view.readback = true;
-      render::FrameRequest request;
-      request.pose = &frame.pose;
-      request.views.push_back(view);
-      const render::FrameResult& out = renderer.wait(renderer.submit(request));
-      if (f == 0) continue;
-      double ms = 0;
-      for (const vk::PassTime& p : out.passes) ms += render::isRefractionPass(p.name) ? p.milliseconds : 0.0;
-      result.refractionMs.push_back(ms);
-      const render::ViewPixels& pixels = out.views.at(0);
-      LinearImage image{width, height, render::drawsComposite(info.method) ? pixels.composite : pixels.trace};
-      accumulate(toSrgb8(image), frame, result.glass, result.image, result.worstFrameWithin1);
-      if (!images.empty() && f == frameCount) writeImage(images + "/" + info.name + ".png", image);
+  // One renderer per method, all alive at once, so the timing can take the
+  // methods in turn on every frame: whatever the GPU's clocks do, they do it
+  // to every method alike, and the ratios stand.
+  std::vector<MethodResult> results(chosen.size());
+  std::vector<std::unique_ptr<render::Renderer>> renderers(chosen.size());
+  for (size_t m = 0; m < chosen.size(); ++m) {
+    results[m].info = chosen[m];
+    if (render::needsDriverRayTracing(chosen[m].method) && !context->caps().driverRayTracing) {
+      results[m].unsupported = "this device offers no ray tracing pipelines (VK_KHR_ray_tracing_pipeline)";
+      std::printf("%s: unsupported: %s\n", chosen[m].name, results[m].unsupported.c_str());
+      continue;
     }
-    result.memoryBytes = renderer.memoryBytes();
-    results.push_back(result);
+    renderers[m] = std::make_unique<render::Renderer>(*context, scene, first);
+  }
+  auto hitsOf = [](render::Method method) {
+    return method == render::Method::Trace || method == render::Method::DriverRt;
+  };
+  auto request = [&](render::Method method, const Frame& frame, bool readback) {
+    render::FrameSettings settings{width, height, frame.view, glm::vec3(0.02f, 0.02f, 0.025f), maxInterfaces};
+    render::RasterOptions raster;
+    raster.offsetStrength = offsetStrength;
+    glm::dvec3 lo, hi;
+    scene::sceneBounds(scene, frame.pose, lo, hi);
+    render::fitDepthRange(frame.view, lo, hi, raster);
+    render::ViewRequest view = render::methodView(method, settings, raster);
+    view.readback = readback;
+    view.aov = readback && hitsOf(method);
+    render::FrameRequest r;
+    r.pose = &frame.pose;
+    r.views.push_back(view);
+    return r;
+  };
+  auto timed = [](MethodResult& result, const render::FrameResult& out) {
+    double ms = 0;
+    std::map<std::string, double> frameMs;
+    for (const vk::PassTime& p : out.passes) {
+      ms += render::isRefractionPass(p.name) ? p.milliseconds : 0.0;
+      frameMs[p.name] += p.milliseconds;
+    }
+    for (const auto& [name, t] : frameMs) result.passMs[name].push_back(t);
+    result.refractionMs.push_back(ms);
+  };
+  // The first frame builds the trees and the pipelines: reported, not timed.
+  for (size_t m = 0; m < chosen.size(); ++m) {
+    if (!renderers[m]) continue;
+    for (const vk::PassTime& p : renderers[m]->wait(renderers[m]->submit(request(chosen[m].method, frames[0], false))).passes) {
+      results[m].firstFrameMs[p.name] += p.milliseconds;
+    }
+  }
+  // Timing: one round to warm up, then kTimingRounds measured, each frame
+  // drawn by every method in turn, two frames in flight per renderer and
+  // nothing read back, as a viewer runs.
+  std::vector<uint64_t> previous(chosen.size(), 0);
+  for (uint32_t round = 0; round <= kTimingRounds; ++round) {
+    for (uint32_t f = 0; f < frameCount; ++f) {
+      for (size_t m = 0; m < chosen.size(); ++m) {
+        if (!renderers[m]) continue;
+        uint64_t id = renderers[m]->submit(request(chosen[m].method, frames[f], false));
+        if (previous[m]) {
+          const render::FrameResult& out = renderers[m]->wait(previous[m]);
+          if (round > 0) timed(results[m], out);
+        }
+        previous[m] = id;
+      }
+    }
+  }
+  for (size_t m = 0; m < chosen.size(); ++m) {
+    if (renderers[m]) timed(results[m], renderers[m]->wait(previous[m]));
+  }
+  // Errors: every frame once more, read back.
+  std::vector<std::vector<std::pair<uint32_t, uint32_t>>> traceHits(frameCount);  // what driver-rt is checked against
+  for (size_t m = 0; m < chosen.size(); ++m) {
+    if (!renderers[m]) continue;
+    MethodResult& result = results[m];
+    render::Method method = chosen[m].method;
+    for (uint32_t f = 0; f < frameCount; ++f) {
+      const Frame& frame = frames[f];
+      const render::FrameResult& out = renderers[m]->wait(renderers[m]->submit(request(method, frame, true)));
+      const render::ViewPixels& pixels = out.views.at(0);
+      if (hitsOf(method)) {
+        std::vector<std::pair<uint32_t, uint32_t>>& mine = traceHits[f];
+        for (size_t i = 0; i < pixels.aov.size(); ++i) {
+          std::pair<uint32_t, uint32_t> hit{pixels.aov[i].instance, pixels.aov[i].primitive};
+          if (method == render::Method::Trace) {
+            mine.push_back(hit);
+          } else if (i < mine.size()) {
+            ++result.hitsCompared;
+            result.hitsAgreeing += mine[i] == hit;
+          }
+        }
+      }
+      LinearImage image{width, height, render::drawsComposite(method) ? pixels.composite : pixels.trace};
+      if (reference) accumulate(toSrgb8(image), frame, result.glass, result.image, result.worstFrameWithin1);
+      if (!images.empty() && f + 1 == frameCount) writeImage(images + "/" + result.info.name + ".png", image);
+    }
+    result.memoryBytes = renderers[m]->memoryBytes();
   }
 
   std::printf("\n%-14s %10s %10s %9s %9s %5s %10s %9s %9s %12s %10s\n", "method", "refract ms", "glass RMSE",
               ">1/255", ">8/255", "max", "image RMSE", ">1/255", ">8/255", "worst frame", "GPU MiB");
   for (const MethodResult& r : results) {
+    if (!r.unsupported.empty()) {
+      std::printf("%-14s unsupported here\n", r.info.name);
+      continue;
+    }
     std::printf("%-14s %10.4f %10.5f %8.3f%% %8.3f%% %5d %10.5f %8.3f%% %8.3f%% %11.3f%% %10.2f\n", r.info.name,
                 median(r.refractionMs), r.glass.rmse(), 100 * r.glass.share(r.glass.over1),
                 100 * r.glass.share(r.glass.over8), r.glass.maximum, r.image.rmse(), 100 * r.image.share(r.image.over1),
@@ -341,6 +467,41 @@ int runBenchMethods(const Args& args) {
   }
   std::printf("(glass: pixels whose first hit in the reference is transmissive; worst frame: the lowest share of a\n"
               " frame's pixels within 1/255; GPU MiB: geometry, trees and per-frame tables, not the images)\n");
+  if (!reference) std::printf("(--no-reference: errors not measured)\n");
+  // The peer side by side: per pass, the build on the first frame, medians after.
+  for (const MethodResult& r : results) {
+    bool peer = r.info.method == render::Method::Trace || r.info.method == render::Method::DriverRt;
+    if (!peer || !r.unsupported.empty()) continue;
+    std::printf("\n%s passes, ms (first frame / median of the others):", r.info.name);
+    std::map<std::string, int> names;  // every pass of any frame
+    for (const auto& entry : r.firstFrameMs) names[entry.first] = 1;
+    for (const auto& entry : r.passMs) names[entry.first] = 1;
+    for (const auto& entry : names) {
+      auto first = r.firstFrameMs.find(entry.first);
+      auto later = r.passMs.find(entry.first);
+      std::printf(" %s %.4f / %.4f,", entry.first.c_str(), first == r.firstFrameMs.end() ? 0.0 : first->second,
+                  later == r.passMs.end() ? 0.0 : median(later->second));
+    }
+    if (r.hitsCompared) {
+      std::printf("\n  first hits agreeing with trace's: %.4f%% of %llu pixels",
+                  100.0 * double(r.hitsAgreeing) / double(r.hitsCompared), static_cast<unsigned long long>(r.hitsCompared));
+    }
+  }
+  std::printf("\n");
+  const MethodResult *traced = nullptr, *driver = nullptr;
+  for (const MethodResult& r : results) {
+    if (r.info.method == render::Method::Trace) traced = &r;
+    if (r.info.method == render::Method::DriverRt && r.unsupported.empty()) driver = &r;
+  }
+  if (traced && driver) {
+    auto traceMs = [](const MethodResult& r, const char* pass) {
+      auto it = r.passMs.find(pass);
+      return it == r.passMs.end() ? 0.0 : median(it->second);
+    };
+    double ours = traceMs(*traced, "trace"), theirs = traceMs(*driver, "driver trace");
+    std::printf("rays per second, trace against driver-rt on the same frames: %.3fx (trace %.4f ms, driver %.4f ms)\n",
+                ours > 0 ? theirs / ours : 0.0, ours, theirs);
+  }
 
   std::string title = "snell bench methods: " + label + ", " + std::to_string(width) + "x" + std::to_string(height) +
                       ", " + std::to_string(frameCount) + " frames, " + context->facts().name;
@@ -357,7 +518,20 @@ int runBenchMethods(const Args& args) {
         << ",\n  \"methods\": [\n";
     for (size_t i = 0; i < results.size(); ++i) {
       const MethodResult& r = results[i];
-      out << "    {\"method\": \"" << r.info.name << "\", \"summary\": \"" << jsonEscape(r.info.summary)
+      if (!r.unsupported.empty()) {
+        out << "    {\"method\": \"" << r.info.name << "\", \"unsupported\": \"" << jsonEscape(r.unsupported) << "\"}"
+            << (i + 1 < results.size() ? "," : "") << "\n";
+        continue;
+      }
+      out << "    {\"method\": \"" << r.info.name << "\", \"passes_median_ms\": {";
+      bool comma = false;
+      for (const auto& [name, v] : r.passMs) out << (comma ? ", " : "") << "\"" << name << "\": " << median(v), comma = true;
+      out << "}, \"first_frame_ms\": {";
+      comma = false;
+      for (const auto& [name, v] : r.firstFrameMs) out << (comma ? ", " : "") << "\"" << name << "\": " << v, comma = true;
+      out << "}, \"first_hits_agreeing_with_trace\": "
+          << (r.hitsCompared ? double(r.hitsAgreeing) / double(r.hitsCompared) : -1.0);
+      out << ", \"summary\": \"" << jsonEscape(r.info.summary)
           << "\", \"refraction_median_ms\": " << median(r.refractionMs) << ", \"glass\": " << errorJson(r.glass)
           << ", \"image\": " << errorJson(r.image) << ", \"worst_frame_within_1\": " << r.worstFrameWithin1
           << ", \"memory_bytes\": " << r.memoryBytes << "}" << (i + 1 < results.size() ? "," : "") << "\n";

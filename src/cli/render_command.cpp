@@ -20,6 +20,7 @@
 #include <filesystem>
 #include <optional>
 #include <sstream>
+#include <stdexcept>
 
 namespace snell::cli {
 
@@ -55,7 +56,9 @@ options:
                          trace-1 (bends at the first interface only), masked
                          (the viewport: raster, glass pixels traced),
                          iris-plane and normal-offset (raster, no trace),
-                         none (glass seen straight through)
+                         none (glass seen straight through), driver-rt
+                         (the trace's rays through the driver's own ray
+                         tracing, where the GPU has it)
   --offset-strength S    normal-offset's displacement in image heights (0.02)
   --viewport             write the viewport's composite instead of the trace
                          alone: every face rasterized and Phong-shaded, and
@@ -272,7 +275,13 @@ int runRender(const Args& args) {
   std::unique_ptr<vk::Context> context;
   std::unique_ptr<render::Renderer> renderer;
   if (!o.reference) {
-    context = vk::Context::create(contextDescFromEnvironment());
+    vk::ContextDesc desc = contextDescFromEnvironment();
+    desc.driverRayTracing = render::needsDriverRayTracing(*o.method);
+    context = vk::Context::create(desc);
+    if (desc.driverRayTracing && !context->caps().driverRayTracing) {
+      throw std::runtime_error("render --method driver-rt: " + context->facts().name +
+                               " offers no ray tracing pipelines (VK_KHR_ray_tracing_pipeline)");
+    }
     try {
       render::checkImageSize(*context, o.width, o.height);
     } catch (const std::invalid_argument& e) {

@@ -10,6 +10,7 @@ const std::vector<MethodInfo>& methods() {
       {Method::IrisPlane, "iris-plane", "viewport: refracted once onto the plane behind the glass, no trace"},
       {Method::NormalOffset, "normal-offset", "viewport: picture behind the glass offset by the normal, no trace"},
       {Method::None, "none", "viewport: glass seen straight through"},
+      {Method::DriverRt, "driver-rt", "traced like trace, hits from the driver's ray tracing pipeline (the peer)"},
   };
   return all;
 }
@@ -34,7 +35,9 @@ std::string methodNames() {
   return names;
 }
 
-bool drawsComposite(Method method) { return method != Method::Trace && method != Method::TraceOnce; }
+bool drawsComposite(Method method) {
+  return method != Method::Trace && method != Method::TraceOnce && method != Method::DriverRt;
+}
 
 ViewRequest methodView(Method method, const FrameSettings& settings, const RasterOptions& raster) {
   ViewRequest view;
@@ -43,6 +46,7 @@ ViewRequest methodView(Method method, const FrameSettings& settings, const Raste
   view.raster.screenSpace = ScreenSpace::Off;
   switch (method) {
     case Method::Trace: break;
+    case Method::DriverRt: view.driverTrace = true; break;
     case Method::TraceOnce: view.settings.maxBends = 1; break;
     case Method::Masked: view.output = ViewOutput::Composite; break;
     case Method::IrisPlane:
@@ -63,7 +67,7 @@ ViewRequest methodView(Method method, const FrameSettings& settings, const Raste
 
 ViewRequest methodViewport(Method method, const FrameSettings& settings, const RasterOptions& raster) {
   ViewRequest view = methodView(method, settings, raster);
-  if (method == Method::Trace || method == Method::TraceOnce) {
+  if (method == Method::Trace || method == Method::TraceOnce || method == Method::DriverRt) {
     view.output = ViewOutput::Composite;
     view.masked = method == Method::TraceOnce;
   }

@@ -21,6 +21,7 @@ enum class Method {
   IrisPlane,     ///< raster: refracted once, met with the plane behind the glass (game engines' eyes)
   NormalOffset,  ///< raster: the picture behind the glass displaced by the normal (GPU Gems 2, ch. 19)
   None,          ///< raster, glass seen straight through
+  DriverRt,      ///< traced like `trace`, the hits found by the driver's own ray tracing (the peer)
 };
 
 struct MethodInfo {
@@ -29,12 +30,15 @@ struct MethodInfo {
   const char* summary;  ///< one line for --help and charts
 };
 
-/// Every method, cheapest last.
+/// Every method, cheapest last; driver-rt, the peer, after them.
 const std::vector<MethodInfo>& methods();
 const char* methodName(Method method);
 std::optional<Method> methodFromName(std::string_view name);
 /// "trace, trace-1, ..." for messages.
 std::string methodNames();
+
+/// Whether the method needs the driver's ray tracing (vk::ContextDesc::driverRayTracing).
+inline bool needsDriverRayTracing(Method method) { return method == Method::DriverRt; }
 
 /// Whether the method's image is the viewport composite (raster) rather than the trace image.
 bool drawsComposite(Method method);

@@ -40,7 +40,7 @@ bool sameRequest(const ViewRequest& a, const ViewRequest& b) {
   const RasterOptions &r = a.raster, &q = b.raster;
   return s.width == t.width && s.height == t.height && sameView(s.view, t.view) && s.background == t.background &&
          s.maxInterfaces == t.maxInterfaces && s.rays.empty() && t.rays.empty() && a.output == b.output &&
-         s.maxBends == t.maxBends && a.masked == b.masked && a.aov == b.aov && r.refraction == q.refraction &&
+         s.maxBends == t.maxBends && a.driverTrace == b.driverTrace && a.masked == b.masked && a.aov == b.aov && r.refraction == q.refraction &&
          r.screenSpace == q.screenSpace && r.offsetStrength == q.offsetStrength && r.wireframe == q.wireframe &&
          r.wireColor == q.wireColor && r.nearPlane == q.nearPlane && r.farPlane == q.farPlane;
 }
@@ -93,6 +93,7 @@ struct Renderer::View {
 struct Renderer::Update {
   bool work = false;  ///< any view: the frame's scene work runs
   bool trees = false;
+  bool driver = false;  ///< some view traces through the driver's ray tracing
   std::vector<uint32_t> deform;  ///< DeformPass outputs
   bool instancesChanged = false, lightsChanged = false;
   std::vector<gpu::GpuInstance> instances;
@@ -130,6 +131,7 @@ Renderer::Renderer(vk::Context& context, const scene::Scene& scene, const scene:
     itemDeformOutput_[size_t(deform_->outputs()[o].item)] = static_cast<uint32_t>(o);
   }
   geometryDirty_.assign(scene_.geometries.size(), 1);
+  driverMoved_.assign(scene_.geometries.size(), 0);
   baselineSah_.assign(scene_.geometries.size(), 0.0);
   queued_.assign(scene_.geometries.size(), 0);
   // Rest-pose bounding spheres per shape, and how far each morph target can move a vertex.
@@ -191,6 +193,7 @@ uint64_t Renderer::memoryBytes() const {
   if (blas_) {
     bytes += blas_->treeBytes() + tlas_->treeBytes() + blas_->workBytes() + tlas_->workBytes() + builder_->scratchBytes();
   }
+  if (driver_) bytes += driver_->bytes();
   return bytes;
 }
 
@@ -200,7 +203,7 @@ double Renderer::treeBytesPerTriangle() const {
 }
 
 bool Renderer::viewNeedsTrees(const ViewRequest& request) const {
-  if (request.output == ViewOutput::Trace) return true;
+  if (request.output == ViewOutput::Trace) return !request.driverTrace;
   return request.raster.refraction && request.raster.screenSpace == ScreenSpace::Off && refractive_ &&
          transmissiveInView(request.settings);
 }
@@ -293,7 +296,7 @@ Renderer::Update Renderer::planUpdate(const scene::Pose& pose, const std::vector
     u.deform.push_back(itemDeformOutput_[i]);
     ++stats.itemsDeformed;
     for (size_t g = 0; g < scene_.geometries.size(); ++g) {
-      if (scene_.geometries[g].item == int(i)) geometryDirty_[g] = 1;
+      if (scene_.geometries[g].item == int(i)) geometryDirty_[g] = driverMoved_[g] = 1;
     }
   }
 
@@ -338,6 +341,7 @@ Renderer::Update Renderer::planUpdate(const scene::Pose& pose, const std::vector
 
   // Trees, only when some view traces.
   for (const ViewRequest& v : views) u.trees = u.trees || viewNeedsTrees(v);
+  for (const ViewRequest& v : views) u.driver = u.driver || (v.output == ViewOutput::Trace && v.driverTrace);
   if (!u.trees) return u;
   prepareTrees();
   bool bottomChanged = false;
@@ -408,6 +412,24 @@ void Renderer::recordUpdate(vk::Commands& commands, Slot& slot, const scene::Pos
     deform_->record(commands, pose, slot.arena, u.deform);
     commands.endPass();
   }
+  if (u.driver) {
+    if (!driver_) {
+      std::vector<peer::DriverGeometry> geometries;
+      for (const GeometryRange& g : scene_.geometries) geometries.push_back({g.firstTriangle, g.triangleCount});
+      driver_ = std::make_unique<peer::DriverTracer>(context_, scene_.positions, scene_.vertexCount, scene_.indices,
+                                                     geometries, static_cast<uint32_t>(u.instances.size()));
+      std::fill(driverMoved_.begin(), driverMoved_.end(), 0);  // the first build sees them as they are
+    }
+    std::vector<uint32_t> moved;
+    for (uint32_t g = 0; g < driverMoved_.size(); ++g) {
+      if (driverMoved_[g]) moved.push_back(g);
+      driverMoved_[g] = 0;
+    }
+    driver_->recordUpdate(commands, slot.arena, u.instances, u.instancesChanged || driverInstancesStale_, moved);
+    driverInstancesStale_ = false;
+  } else {
+    driverInstancesStale_ = driverInstancesStale_ || u.instancesChanged;
+  }
   if (!u.trees) return;
   BvhInputs triangles{&scene_.positions, &scene_.indices, nullptr, nullptr};
   if (!u.build.empty()) {
@@ -436,8 +458,7 @@ void Renderer::recordUpdate(vk::Commands& commands, Slot& slot, const scene::Pos
   slot.topBuilt = u.buildTop;
 }
 
-void Renderer::recordTrace(vk::Commands& commands, const ViewRequest& request, View& view, bool masked,
-                           FrameStats& stats) {
+gpu::TracePush Renderer::tracePush(const ViewRequest& request, bool masked) const {
   const FrameSettings& settings = request.settings;
   const scene::View& v = settings.view;
   double aspect = double(settings.width) / double(settings.height);
@@ -457,6 +478,36 @@ void Renderer::recordTrace(vk::Commands& commands, const ViewRequest& request, V
   push.tilesX = (settings.width + gpu::kTraceTile - 1) / gpu::kTraceTile;
   push.shiftX = float(v.shift.x);
   push.shiftY = float(v.shift.y);
+  return push;
+}
+
+void Renderer::recordDriverTrace(vk::Commands& commands, const ViewRequest& request, View& view, FrameStats& stats) {
+  const FrameSettings& settings = request.settings;
+  ViewImages& images = view.images;
+  commands.computeToCompute();
+  driver_->recordTrace(commands,
+                       {{gpu::kTraceBindingInstances, &instances_},
+                        {gpu::kTraceBindingPositions, &scene_.positions},
+                        {gpu::kTraceBindingNormals, &scene_.normals},
+                        {gpu::kTraceBindingTexcoords, &scene_.texcoords},
+                        {gpu::kTraceBindingIndices, &scene_.indices},
+                        {gpu::kTraceBindingMaterials, &scene_.materials},
+                        {gpu::kTraceBindingTextures, &scene_.textures},
+                        {gpu::kTraceBindingTexels, &scene_.texels},
+                        {gpu::kTraceBindingLights, &lights_},
+                        {gpu::kTraceBindingImage, nullptr, &images.trace},
+                        {gpu::kTraceBindingAov, request.aov ? &images.aov : &placeholder_},
+                        {gpu::kTraceBindingRays, settings.rays.empty() ? &placeholder_ : &view.rays},
+                        {gpu::kTraceBindingGeometryFirst, &driver_->geometryFirst()}},
+                       tracePush(request, false));
+  stats.pixelsTraced += uint64_t(settings.width) * settings.height;
+  ++stats.traceDispatches;
+}
+
+void Renderer::recordTrace(vk::Commands& commands, const ViewRequest& request, View& view, bool masked,
+                           FrameStats& stats) {
+  const FrameSettings& settings = request.settings;
+  gpu::TracePush push = tracePush(request, masked);
   uint32_t tilesY = (settings.height + gpu::kTraceTile - 1) / gpu::kTraceTile;
   ViewImages& images = view.images;
   if (masked) {
@@ -532,7 +583,9 @@ void Renderer::recordView(vk::Commands& commands, Slot& slot, size_t index, cons
       }(), view.rays);
     if (!settings.rays.empty()) commands.transferToCompute();
     RasterScene scene{&scene_, &sceneModel_, &instances_, &lights_, lightCount_, origin_};
-    if (request.output == ViewOutput::Trace) {
+    if (request.output == ViewOutput::Trace && request.driverTrace) {
+      recordDriverTrace(commands, request, view, stats);
+    } else if (request.output == ViewOutput::Trace) {
       recordTrace(commands, request, view, false, stats);
     } else {
       bool glass = request.raster.refraction && refractive_ && transmissiveInView(settings);

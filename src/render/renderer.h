@@ -15,6 +15,7 @@
 // moved only when a camera gets far from it (so orbiting alone touches no tree).
 #pragma once
 
+#include "peer/driver_tracer.h"
 #include "render/bvh.h"
 #include "render/deform_pass.h"
 #include "render/frame_settings.h"
@@ -52,6 +53,9 @@ struct ViewRequest {
   /// Composite only: trace just the pixels whose visible face is transmissive
   /// (off: trace every pixel, so the trace image is whole, for tests).
   bool masked = true;
+  /// Trace output only: the closest hits come from the driver's own ray
+  /// tracing (the driver-rt peer; needs DeviceCaps::driverRayTracing).
+  bool driverTrace = false;
   bool aov = false;       ///< per-pixel gpu::TraceAov of the traced pixels
   bool readback = false;  ///< bring the images (and AOV) back with the frame
 };
@@ -176,6 +180,8 @@ class Renderer {
   void recordUpdate(vk::Commands& commands, Slot& slot, const scene::Pose& pose, const Update& update);
   void recordView(vk::Commands& commands, Slot& slot, size_t index, const ViewRequest& request, FrameStats& stats);
   void recordTrace(vk::Commands& commands, const ViewRequest& request, View& view, bool masked, FrameStats& stats);
+  gpu::TracePush tracePush(const ViewRequest& request, bool masked) const;
+  void recordDriverTrace(vk::Commands& commands, const ViewRequest& request, View& view, FrameStats& stats);
   void collect(Slot& slot);
   bool viewNeedsTrees(const ViewRequest& request) const;
   bool transmissiveInView(const FrameSettings& settings) const;
@@ -203,6 +209,9 @@ class Renderer {
   std::vector<uint32_t> itemDeformOutput_; ///< per pose item: its DeformPass output, or ~0
   std::vector<gpu::GpuInstance> uploadedInstances_;
   std::vector<gpu::GpuLight> uploadedLights_;
+  std::unique_ptr<peer::DriverTracer> driver_;  ///< the driver-rt peer, made when a view asks for it
+  std::vector<char> driverMoved_;  ///< per geometry: positions changed since the driver's structures saw them
+  bool driverInstancesStale_ = true;  ///< instances moved in frames the driver's top level did not see
   std::vector<char> geometryDirty_;  ///< per bottom-level group: positions changed since its tree last saw them
   bool treesBuilt_ = false, topDirty_ = true, topBuilt_ = false;
   bool originSet_ = false;

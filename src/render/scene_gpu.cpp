@@ -19,10 +19,16 @@ vk::Buffer uploaded(vk::Context& context, const std::vector<T>& data, const std:
     throw std::runtime_error(name + " needs " + std::to_string(size >> 20) + " MiB; the device binds at most " +
                              std::to_string(context.caps().maxStorageBufferRange >> 20) + " MiB in one buffer");
   }
+  // Where the driver's acceleration structures are on, they may read the
+  // triangles too (the driver-rt peer builds over these very buffers).
+  bool driver = context.caps().driverAccelerationStructures;
   vk::Buffer buffer(context, {std::max<VkDeviceSize>(size, 16),
                               VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT |
-                                  VK_BUFFER_USAGE_TRANSFER_DST_BIT | VK_BUFFER_USAGE_VERTEX_BUFFER_BIT,
-                              vk::MemoryDomain::Device, name});
+                                  VK_BUFFER_USAGE_TRANSFER_DST_BIT | VK_BUFFER_USAGE_VERTEX_BUFFER_BIT |
+                                  (driver ? VK_BUFFER_USAGE_ACCELERATION_STRUCTURE_BUILD_INPUT_READ_ONLY_BIT_KHR |
+                                                VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT
+                                          : 0u),
+                              vk::MemoryDomain::Device, name, driver});
   if (size) vk::upload(context, buffer, data.data(), size);
   bytes += buffer.size();
   return buffer;

@@ -224,8 +224,10 @@ std::unique_ptr<Context> Context::create(const ContextDesc& desc) {
   VkPhysicalDeviceVulkan12Features features12{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES};
   VkPhysicalDeviceAccelerationStructureFeaturesKHR accelerationFeatures{
       VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_ACCELERATION_STRUCTURE_FEATURES_KHR};
-  bool driverAcceleration = false;
-  if (desc.driverAccelerationStructures) {
+  VkPhysicalDeviceRayTracingPipelineFeaturesKHR rayTracingFeatures{
+      VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_RAY_TRACING_PIPELINE_FEATURES_KHR};
+  bool driverAcceleration = false, driverRayTracing = false;
+  if (desc.driverAccelerationStructures || desc.driverRayTracing) {
     uint32_t count = 0;
     VK_CHECK(vkEnumerateDeviceExtensionProperties(physical, nullptr, &count, nullptr));
     std::vector<VkExtensionProperties> available(count);
@@ -234,14 +236,18 @@ std::unique_ptr<Context> Context::create(const ContextDesc& desc) {
       return std::any_of(available.begin(), available.end(),
                          [&](const VkExtensionProperties& a) { return std::string(a.extensionName) == name; });
     };
+    VkPhysicalDeviceRayTracingPipelineFeaturesKHR supportedRayTracing{
+        VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_RAY_TRACING_PIPELINE_FEATURES_KHR};
     VkPhysicalDeviceAccelerationStructureFeaturesKHR supportedAcceleration{
-        VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_ACCELERATION_STRUCTURE_FEATURES_KHR};
+        VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_ACCELERATION_STRUCTURE_FEATURES_KHR, &supportedRayTracing};
     VkPhysicalDeviceVulkan12Features supported12{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES,
                                                  &supportedAcceleration};
     VkPhysicalDeviceFeatures2 probe{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2, &supported12};
     if (has(VK_KHR_ACCELERATION_STRUCTURE_EXTENSION_NAME) && has(VK_KHR_DEFERRED_HOST_OPERATIONS_EXTENSION_NAME)) {
       vkGetPhysicalDeviceFeatures2(physical, &probe);
       driverAcceleration = supportedAcceleration.accelerationStructure && supported12.bufferDeviceAddress;
+      driverRayTracing = desc.driverRayTracing && driverAcceleration &&
+                         has(VK_KHR_RAY_TRACING_PIPELINE_EXTENSION_NAME) && supportedRayTracing.rayTracingPipeline;
     }
     if (driverAcceleration) {
       extensions.push_back(VK_KHR_ACCELERATION_STRUCTURE_EXTENSION_NAME);
@@ -251,6 +257,12 @@ std::unique_ptr<Context> Context::create(const ContextDesc& desc) {
       features12.pNext = &accelerationFeatures;
       accelerationFeatures.pNext = features13.pNext;
       features13.pNext = &features12;
+    }
+    if (driverRayTracing) {
+      extensions.push_back(VK_KHR_RAY_TRACING_PIPELINE_EXTENSION_NAME);
+      rayTracingFeatures.rayTracingPipeline = VK_TRUE;
+      rayTracingFeatures.pNext = accelerationFeatures.pNext;
+      accelerationFeatures.pNext = &rayTracingFeatures;
     }
   }
 
@@ -269,6 +281,7 @@ std::unique_ptr<Context> Context::create(const ContextDesc& desc) {
   }
   c.initialise(physical, chosen, features13.dynamicRendering, features.features.fillModeNonSolid);
   c.caps_.driverAccelerationStructures = driverAcceleration;
+  c.caps_.driverRayTracing = driverRayTracing;
   c.caps_.bufferDeviceAddress = driverAcceleration;
   return context;
 }

@@ -34,6 +34,9 @@ struct ContextDesc {
   /// and buffer device addresses) where the device offers them, for the
   /// benchmarks' peer; DeviceCaps::driverAccelerationStructures says whether it is on.
   bool driverAccelerationStructures = false;
+  /// With driverAccelerationStructures: the driver's ray tracing pipelines too
+  /// (VK_KHR_ray_tracing_pipeline), for the driver-rt method; DeviceCaps::driverRayTracing.
+  bool driverRayTracing = false;
 };
 
 /// Handles a host application created; snell uses them and never destroys them.
@@ -71,6 +74,8 @@ struct DeviceCaps {
   bool fillModeNonSolid = false;
   /// VK_KHR_acceleration_structure is enabled (ContextDesc::driverAccelerationStructures asked for it).
   bool driverAccelerationStructures = false;
+  /// VK_KHR_ray_tracing_pipeline is enabled (ContextDesc::driverRayTracing asked for it).
+  bool driverRayTracing = false;
   /// Buffers may ask for device addresses (bufferDeviceAddress is enabled).
   bool bufferDeviceAddress = false;
 };
