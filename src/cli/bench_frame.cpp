@@ -3,6 +3,7 @@
 // over many frames, and what each frame did and skipped.
 #include "cli/cli.h"
 
+#include "render/method.h"
 #include "render/renderer.h"
 #include "scene/evaluate.h"
 #include "scene/gltf_loader.h"
@@ -44,9 +45,9 @@ options:
   --json FILE         write the results as JSON too
 )";
 
-bool refractionPass(const std::string& name) {
-  return name == "deform" || name == "blas refit" || name == "blas build" || name == "tlas" || name == "trace list" || name == "trace";
-}
+// The refraction work these tables quote: the refraction passes, and the
+// deform that trees and trace both wait for.
+bool refractionPass(const std::string& name) { return name == "deform" || render::isRefractionPass(name); }
 
 }  // namespace
 

@@ -9,6 +9,7 @@
 #include "peer/driver_bvh.h"
 #include "ref/sah_bvh.h"
 #include "render/bvh.h"
+#include "render/method.h"
 #include "render/renderer.h"
 #include "scene/evaluate.h"
 #include "scene/procedural_eye.h"
@@ -118,9 +119,9 @@ std::vector<uint64_t> parseList(const std::string& option, const std::string& va
   return out;
 }
 
-bool refractionPass(const std::string& name) {
-  return name == "deform" || name == "blas refit" || name == "blas build" || name == "tlas" || name == "trace list" || name == "trace";
-}
+// The refraction work these tables quote: the refraction passes, and the
+// deform that trees and trace both wait for.
+bool refractionPass(const std::string& name) { return name == "deform" || render::isRefractionPass(name); }
 
 CrowdRow measureCrowd(vk::Context& context, uint32_t characters, uint32_t width, uint32_t height, uint32_t frames) {
   scene::EyeOptions options;

@@ -155,6 +155,17 @@ VkAccelerationStructureGeometryKHR instanceGeometry(const vk::Buffer& instances)
   return geometry;
 }
 
+// A top-level build over `geometry`, as sized and as recorded.
+VkAccelerationStructureBuildGeometryInfoKHR topLevelInfo(const VkAccelerationStructureGeometryKHR& geometry) {
+  VkAccelerationStructureBuildGeometryInfoKHR info{VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_BUILD_GEOMETRY_INFO_KHR};
+  info.type = VK_ACCELERATION_STRUCTURE_TYPE_TOP_LEVEL_KHR;
+  info.flags = VK_BUILD_ACCELERATION_STRUCTURE_PREFER_FAST_TRACE_BIT_KHR;
+  info.mode = VK_BUILD_ACCELERATION_STRUCTURE_MODE_BUILD_KHR;
+  info.geometryCount = 1;
+  info.pGeometries = &geometry;
+  return info;
+}
+
 }  // namespace
 
 DriverTlas::DriverTlas(vk::Context& context, uint32_t capacity) : capacity_(std::max(capacity, 1u)) {
@@ -167,11 +178,7 @@ DriverTlas::DriverTlas(vk::Context& context, uint32_t capacity) : capacity_(std:
                                     kDriverInputUsage | VK_BUFFER_USAGE_TRANSFER_DST_BIT, vk::MemoryDomain::Device,
                                     "driver top-level instances", true});
   VkAccelerationStructureGeometryKHR geometry = instanceGeometry(instances_);
-  VkAccelerationStructureBuildGeometryInfoKHR info{VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_BUILD_GEOMETRY_INFO_KHR};
-  info.type = VK_ACCELERATION_STRUCTURE_TYPE_TOP_LEVEL_KHR;
-  info.flags = VK_BUILD_ACCELERATION_STRUCTURE_PREFER_FAST_TRACE_BIT_KHR;
-  info.geometryCount = 1;
-  info.pGeometries = &geometry;
+  VkAccelerationStructureBuildGeometryInfoKHR info = topLevelInfo(geometry);
   VkAccelerationStructureBuildSizesInfoKHR sizes{VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_BUILD_SIZES_INFO_KHR};
   sizesOf(context.device(), VK_ACCELERATION_STRUCTURE_BUILD_TYPE_DEVICE_KHR, &info, &capacity_, &sizes);
   structure_ = std::make_unique<DriverStructure>(context, VK_ACCELERATION_STRUCTURE_TYPE_TOP_LEVEL_KHR,
@@ -182,13 +189,8 @@ DriverTlas::DriverTlas(vk::Context& context, uint32_t capacity) : capacity_(std:
 void DriverTlas::recordBuild(vk::Commands& commands, uint32_t count) {
   if (count > capacity_) throw vk::VulkanError("driver top level: more instances than it was made for");
   VkAccelerationStructureGeometryKHR geometry = instanceGeometry(instances_);
-  VkAccelerationStructureBuildGeometryInfoKHR info{VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_BUILD_GEOMETRY_INFO_KHR};
-  info.type = VK_ACCELERATION_STRUCTURE_TYPE_TOP_LEVEL_KHR;
-  info.flags = VK_BUILD_ACCELERATION_STRUCTURE_PREFER_FAST_TRACE_BIT_KHR;
-  info.mode = VK_BUILD_ACCELERATION_STRUCTURE_MODE_BUILD_KHR;
+  VkAccelerationStructureBuildGeometryInfoKHR info = topLevelInfo(geometry);
   info.dstAccelerationStructure = structure_->handle();
-  info.geometryCount = 1;
-  info.pGeometries = &geometry;
   info.scratchData.deviceAddress = structure_->scratchAddress();
   VkAccelerationStructureBuildRangeInfoKHR range{count, 0, 0, 0};
   const VkAccelerationStructureBuildRangeInfoKHR* ranges = &range;

@@ -52,7 +52,8 @@ ViewRequest methodView(Method method, const FrameSettings& settings, const Raste
 ViewRequest methodViewport(Method method, const FrameSettings& settings, const RasterOptions& raster);
 
 /// The passes that draw refraction, as opposed to those every viewport pays
-/// (deform, the raster pass's own depth and shading).
+/// (deform, the raster pass's own depth and shading). The one list every
+/// benchmark sums; bench frame and bench scale add deform to it.
 bool isRefractionPass(const std::string& passName);
 
 }  // namespace snell::render

@@ -13,7 +13,8 @@ namespace snell::render {
 namespace {
 
 template <typename T>
-vk::Buffer uploaded(vk::Context& context, const std::vector<T>& data, const std::string& name, uint64_t& bytes) {
+vk::Buffer uploaded(vk::Context& context, const std::vector<T>& data, const std::string& name, uint64_t& bytes,
+                    bool triangles = false) {
   VkDeviceSize size = data.size() * sizeof(T);
   if (size > context.caps().maxStorageBufferRange) {
     throw std::runtime_error(name + " needs " + std::to_string(size >> 20) + " MiB; the device binds at most " +
@@ -21,7 +22,7 @@ vk::Buffer uploaded(vk::Context& context, const std::vector<T>& data, const std:
   }
   // Where the driver's acceleration structures are on, they may read the
   // triangles too (the driver-rt peer builds over these very buffers).
-  bool driver = context.caps().driverAccelerationStructures;
+  bool driver = triangles && context.caps().driverAccelerationStructures;
   vk::Buffer buffer(context, {std::max<VkDeviceSize>(size, 16),
                               VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT |
                                   VK_BUFFER_USAGE_TRANSFER_DST_BIT | VK_BUFFER_USAGE_VERTEX_BUFFER_BIT |
@@ -145,10 +146,10 @@ SceneGpu uploadScene(vk::Context& context, const scene::Scene& scene, const scen
   }
 
   const std::string& name = scene.source.empty() ? std::string("scene") : scene.source;
-  gpu.positions = uploaded(context, positions, name + " positions", gpu.bytes);
+  gpu.positions = uploaded(context, positions, name + " positions", gpu.bytes, true);
   gpu.normals = uploaded(context, normals, name + " normals", gpu.bytes);
   gpu.texcoords = uploaded(context, texcoords, name + " texcoords", gpu.bytes);
-  gpu.indices = uploaded(context, indices, name + " indices", gpu.bytes);
+  gpu.indices = uploaded(context, indices, name + " indices", gpu.bytes, true);
   gpu.materials = uploaded(context, materials, name + " materials", gpu.bytes);
   gpu.textures = uploaded(context, textures, name + " texture table", gpu.bytes);
   gpu.texels = uploaded(context, texels, name + " texels", gpu.bytes);
