@@ -2,6 +2,8 @@
 // viewport composite (viewport_test.cpp).
 #include "golden_support.h"
 
+#include <glm/gtc/matrix_transform.hpp>
+
 #include "assets.h"
 
 #include "ref/reference_tracer.h"
@@ -147,6 +149,98 @@ scene::Scene prismScene() {
   scene::Node lightNode;
   lightNode.light = 0;
   lightNode.rotation = glm::quat(glm::vec3(-0.8f, 0.4f, 0.0f));
+  s.nodes.push_back(lightNode);
+  s.roots.push_back(int(s.nodes.size()) - 1);
+  return s;
+}
+
+scene::Scene eyeWithAqueous() {
+  scene::EyeOptions options;
+  options.aqueous = true;
+  return scene::makeEye(options);
+}
+
+int addFlatShape(scene::Scene& s, const std::vector<glm::vec3>& positions, const std::vector<uint32_t>& indices,
+                 int material, const glm::mat4& world) {
+  scene::Shape shape;
+  shape.name = "shape" + std::to_string(s.shapes.size());
+  shape.material = material;
+  for (size_t t = 0; t + 2 < indices.size(); t += 3) {  // faces share no vertices: flat normals
+    glm::vec3 a = positions[indices[t]], b = positions[indices[t + 1]], c = positions[indices[t + 2]];
+    glm::vec3 n = glm::normalize(glm::cross(b - a, c - a));
+    for (glm::vec3 p : {a, b, c}) {
+      shape.indices.push_back(uint32_t(shape.positions.size()));
+      shape.positions.push_back(p);
+      shape.normals.push_back(n);
+      shape.texcoords0.push_back({p.x / 2.0f + 0.5f, p.y / 2.0f + 0.5f});
+    }
+  }
+  int index = int(s.shapes.size());
+  s.shapes.push_back(shape);
+  scene::Mesh mesh;
+  mesh.shapes = {index};
+  s.meshes.push_back(mesh);
+  scene::Node node;
+  node.mesh = int(s.meshes.size()) - 1;
+  node.matrix = world;
+  s.nodes.push_back(node);
+  s.roots.push_back(int(s.nodes.size()) - 1);
+  return index;
+}
+
+void boxTriangles(glm::vec3 lo, glm::vec3 hi, std::vector<glm::vec3>& positions, std::vector<uint32_t>& indices) {
+  uint32_t base = uint32_t(positions.size());
+  for (int i = 0; i < 8; ++i) positions.push_back({i & 1 ? hi.x : lo.x, i & 2 ? hi.y : lo.y, i & 4 ? hi.z : lo.z});
+  // Corner bits: x = 1, y = 2, z = 4; each face counter-clockwise seen from outside.
+  const uint32_t faces[6][4] = {{0, 4, 6, 2}, {1, 3, 7, 5}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 2, 3, 1}, {4, 5, 7, 6}};
+  for (const auto& f : faces) {
+    for (uint32_t k : {f[0], f[1], f[2], f[0], f[2], f[3]}) indices.push_back(base + k);
+  }
+}
+
+scene::Scene iorStepScene() {
+  scene::Scene s;
+  s.source = "IOR texture step";
+  scene::Texture step;  // left texel 0, right texel 255, nearest: a hard step at u = 0.5
+  step.name = "ior step";
+  step.width = 2;
+  step.height = 1;
+  step.rgba = {0, 0, 0, 255, 255, 255, 255, 255};
+  step.repeatS = step.repeatT = false;
+  step.linearFilter = false;
+  scene::Texture checker;
+  checker.name = "checker";
+  checker.width = checker.height = 8;
+  checker.repeatS = checker.repeatT = true;
+  checker.linearFilter = false;
+  for (uint32_t i = 0; i < 64; ++i) {
+    uint8_t v = ((i % 8) + (i / 8)) % 2 ? 230 : 40;
+    checker.rgba.insert(checker.rgba.end(), {v, uint8_t(v / 2), uint8_t(255 - v), 255});
+  }
+  s.textures = {step, checker};
+  scene::Material glass;
+  glass.name = "stepped glass";
+  glass.transmission = 1.0f;
+  glass.ior = 1.0f;
+  glass.iorTexture.texture = 0;
+  glass.iorScale = 0.5f;
+  scene::Material wall;
+  wall.name = "checker wall";
+  wall.baseColorFactor = {0, 0, 0, 1};
+  wall.emissiveFactor = glm::vec3(1.0f);
+  wall.emissiveTexture.texture = 1;
+  s.materials = {glass, wall};
+  std::vector<glm::vec3> p;
+  std::vector<uint32_t> idx;
+  boxTriangles({-1, -1, -0.3f}, {1, 1, 0.3f}, p, idx);
+  addFlatShape(s, p, idx, 0, glm::rotate(glm::mat4(1.0f), 0.5f, glm::vec3(0.3f, 1.0f, 0.0f)));
+  addFlatShape(s, {{-4, -4, -3}, {4, -4, -3}, {4, 4, -3}, {-4, 4, -3}}, {0, 1, 2, 0, 2, 3}, 1);
+  scene::Light light;  // shines from behind the wall: the wall shows only its own light
+  light.type = scene::LightType::Directional;
+  s.lights = {light};
+  scene::Node lightNode;
+  lightNode.light = 0;
+  lightNode.rotation = glm::angleAxis(3.14159265f, glm::vec3(0, 1, 0));
   s.nodes.push_back(lightNode);
   s.roots.push_back(int(s.nodes.size()) - 1);
   return s;

@@ -10,6 +10,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <string>
+#include <vector>
 
 namespace snell::test {
 
@@ -41,6 +42,17 @@ scene::Scene eyeWith(float ior);
 scene::Scene eyeWithoutCorneaTip();
 /// A right-angle glass prism showing total internal reflection, with coloured walls.
 scene::Scene prismScene();
+/// The eye with the aqueous humour behind the cornea (nested media).
+scene::Scene eyeWithAqueous();
+/// A tilted glass slab whose IOR texture steps from 1.0 (left) to 1.5 (right),
+/// before a self-lit checkerboard.
+scene::Scene iorStepScene();
+/// Adds a mesh of one shape (flat normals per face, uv u = x / 2 + 0.5, v = y / 2 + 0.5)
+/// under a root node of transform `world`; returns the shape's index.
+int addFlatShape(scene::Scene& s, const std::vector<glm::vec3>& positions, const std::vector<uint32_t>& indices,
+                 int material, const glm::mat4& world = glm::mat4(1.0f));
+/// An axis-aligned box's 12 triangles, wound to face out.
+void boxTriangles(glm::vec3 lo, glm::vec3 hi, std::vector<glm::vec3>& positions, std::vector<uint32_t>& indices);
 /// A model of ../shared/assets, its iridescence ignored.
 scene::Scene loadModel(const std::string& relative);
 

@@ -24,32 +24,76 @@ int wrapIndex(int i, int size, uint mode) {
   return ((i % size) + size) % size;
 }
 
-vec3 texel(GpuTexture tex, int x, int y) {
+// Colour textures are sRGB; data textures (the IOR's) are read as bytes / 255.
+vec3 texel(GpuTexture tex, int x, int y, bool srgb) {
   x = wrapIndex(x, int(tex.width), tex.flags & 3u);
   y = wrapIndex(y, int(tex.height), (tex.flags >> 2) & 3u);
-  return srgbToLinear(texels[tex.firstTexel + uint(y) * tex.width + uint(x)]);
+  uint rgba = texels[tex.firstTexel + uint(y) * tex.width + uint(x)];
+  return srgb ? srgbToLinear(rgba) : vec3(rgba & 0xffu, (rgba >> 8) & 0xffu, (rgba >> 16) & 0xffu) / 255.0;
 }
 
-vec3 sampleTexture(uint index, vec2 uv) {
+vec3 sampleTexture(uint index, vec2 uv, bool srgb) {
   GpuTexture tex = textures[index];
-  if ((tex.flags & 16u) != 0u) return texel(tex, int(floor(uv.x * float(tex.width))), int(floor(uv.y * float(tex.height))));
+  if ((tex.flags & 16u) != 0u) {
+    return texel(tex, int(floor(uv.x * float(tex.width))), int(floor(uv.y * float(tex.height))), srgb);
+  }
   vec2 p = uv * vec2(tex.width, tex.height) - 0.5;
   vec2 base = floor(p);
   vec2 f = p - base;
   int x = int(base.x), y = int(base.y);
-  vec3 top = mix(texel(tex, x, y), texel(tex, x + 1, y), f.x);
-  vec3 bottom = mix(texel(tex, x, y + 1), texel(tex, x + 1, y + 1), f.x);
+  vec3 top = mix(texel(tex, x, y, srgb), texel(tex, x + 1, y, srgb), f.x);
+  vec3 bottom = mix(texel(tex, x, y + 1, srgb), texel(tex, x + 1, y + 1, srgb), f.x);
   return mix(top, bottom, f.y);
 }
 
-vec3 textured(uint texture, vec4 uvs, uint texCoord, vec4 row0, vec4 row1) {
+vec3 textured(uint texture, vec4 uvs, uint texCoord, vec4 row0, vec4 row1, bool srgb) {
   if (texture == kNoTexture) return vec3(1.0);
   vec3 uv = vec3(texCoord == 1u ? uvs.zw : uvs.xy, 1.0);
-  return sampleTexture(texture, vec2(dot(row0.xyz, uv), dot(row1.xyz, uv)));
+  return sampleTexture(texture, vec2(dot(row0.xyz, uv), dot(row1.xyz, uv)), srgb);
+}
+
+vec3 textured(uint texture, vec4 uvs, uint texCoord, vec4 row0, vec4 row1) {
+  return textured(texture, uvs, texCoord, row0, row1, true);
 }
 
 vec3 baseColour(GpuMaterial m, vec4 uvs) {
   return m.baseColorFactor.rgb * textured(m.textures.x, uvs, m.textures.y, m.baseUvRow0, m.baseUvRow1);
+}
+
+// Light i as seen from `position` (camera-relative): the unit direction
+// towards it and the irradiance it brings; lightCount 0 means the headlight
+// shining along `headlight`. False where it has no direction (a light on the point).
+bool lightAt(uint i, uint lightCount, vec3 headlight, vec3 position, out vec3 l, out vec3 e) {
+  if (lightCount == 0u) {
+    l = -headlight;
+    e = vec3(kHeadlight);
+    return true;
+  }
+  GpuLight light = lights[i];
+  uint type = uint(light.positionType.w);
+  if (type == kLightDirectional) {
+    l = -light.direction.xyz;
+    e = light.radiance.rgb;
+    return true;
+  }
+  vec3 toLight = light.positionType.xyz - position;
+  float distance2 = dot(toLight, toLight);
+  if (!(distance2 > 0.0)) return false;
+  float distance = sqrt(distance2);
+  l = toLight / distance;
+  e = light.radiance.rgb / distance2;
+  float range = light.direction.w;
+  if (range > 0.0) {
+    float ratio = distance / range;
+    float window = clamp(1.0 - ratio * ratio * ratio * ratio, 0.0, 1.0);
+    e *= window * window;
+  }
+  if (type == kLightSpot) {
+    float cd = dot(light.direction.xyz, -l);
+    float s2 = clamp((cd - light.cone.y) / max(1e-4, light.cone.x - light.cone.y), 0.0, 1.0);
+    e *= s2 * s2;
+  }
+  return true;
 }
 
 // Lit colour of a surface point seen along `dir`: `position` camera-relative,
@@ -64,34 +108,7 @@ vec3 phong(vec3 position, vec3 ns, vec4 uvs, GpuMaterial m, vec3 dir, uint light
   uint count = max(lightCount, 1u);
   for (uint i = 0u; i < count; ++i) {
     vec3 l, e;
-    if (lightCount == 0u) {
-      l = -headlight;
-      e = vec3(kHeadlight);
-    } else {
-      GpuLight light = lights[i];
-      uint type = uint(light.positionType.w);
-      if (type == kLightDirectional) {
-        l = -light.direction.xyz;
-        e = light.radiance.rgb;
-      } else {
-        vec3 toLight = light.positionType.xyz - position;
-        float distance2 = dot(toLight, toLight);
-        float distance = sqrt(distance2);
-        l = toLight / distance;
-        e = light.radiance.rgb / distance2;
-        float range = light.direction.w;
-        if (range > 0.0) {
-          float ratio = distance / range;
-          float window = clamp(1.0 - ratio * ratio * ratio * ratio, 0.0, 1.0);
-          e *= window * window;
-        }
-        if (type == kLightSpot) {
-          float cd = dot(light.direction.xyz, -l);
-          float s2 = clamp((cd - light.cone.y) / max(1e-4, light.cone.x - light.cone.y), 0.0, 1.0);
-          e *= s2 * s2;
-        }
-      }
-    }
+    if (!lightAt(i, lightCount, headlight, position, l, e)) continue;
     float nl = dot(n, l);
     if (nl <= 0.0) continue;
     vec3 h = normalize(l + v);

@@ -26,6 +26,7 @@ layout(std430, binding = kTraceBindingMaterials) readonly buffer Materials { Gpu
 layout(std430, binding = kTraceBindingTextures) readonly buffer Textures { GpuTexture textures[]; };
 layout(std430, binding = kTraceBindingTexels) readonly buffer Texels { uint texels[]; };
 layout(std430, binding = kTraceBindingLights) readonly buffer Lights { GpuLight lights[]; };
+layout(std430, binding = kTraceBindingEnvironment) readonly buffer Environment { vec4 environment[]; };
 layout(binding = kTraceBindingImage, rgba16f) uniform writeonly image2D outImage;
 layout(std430, binding = kTraceBindingAov) writeonly buffer Aovs { TraceAov aovs[]; };
 layout(std430, binding = kTraceBindingRays) readonly buffer Rays { GpuRay rays[]; };

@@ -28,8 +28,11 @@ void main() {
   uint v = corner == 0u ? i0 : (corner == 1u ? i1 : i2);
   vec4 p = vec4(vertexAt(v), 1.0);
   precise vec3 world = vec3(dot(inst.objectToWorld[0], p), dot(inst.objectToWorld[1], p), dot(inst.objectToWorld[2], p));
-  // Normals by the inverse transpose, as the trace does: worldToObject's columns.
-  mat3 toWorldNormal = transpose(mat3(inst.worldToObject[0].xyz, inst.worldToObject[1].xyz, inst.worldToObject[2].xyz));
+  // Normals by the inverse transpose, as the trace does.
+  // worldToObject holds the rows of W^-1, and mat3() takes columns: this is
+  // (W^-1)^T. (It was transposed once more, which is right only when W is
+  // symmetric: rotated instances got their normals turned the wrong way.)
+  mat3 toWorldNormal = mat3(inst.worldToObject[0].xyz, inst.worldToObject[1].xyz, inst.worldToObject[2].xyz);
   vec3 p0 = vertexAt(i0), p1 = vertexAt(i1), p2 = vertexAt(i2);
   outGeometricNormal = toWorldNormal * cross(p1 - p0, p2 - p0);
   outNormal = toWorldNormal * vec3(normals[3u * v], normals[3u * v + 1u], normals[3u * v + 2u]);

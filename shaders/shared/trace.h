@@ -23,15 +23,62 @@
 //        flipped to Ng's side when dot(Ns, Ng) < 0.
 // Object-space normals go to world by the inverse transpose of the instance matrix.
 //
-// Refractive faces (material transmission > 0):
-//   entering = dot(d, Ng) < 0; n = entering ? Ns : -Ns; eta = entering ? 1 / ior : ior;
+// Refractive faces (material transmission > 0) are the boundaries of media
+// (Schmidt & Budge 2002, "Simple Nested Dielectrics in Ray Traced Images"):
+//   each ray carries the stack of media it is inside (kMaxMedia entries, the
+//   oldest dropped when full); the current medium is the entry of highest
+//   priority (GpuMaterial priority, larger wins; ties to the latest entered),
+//   air (IOR 1) when the stack is empty.
+//   entering = dot(d, Ng) < 0. Entering m: a true boundary unless the current
+//   medium's priority is higher than m's; m is pushed either way. Leaving m:
+//   m's latest entry is removed; a true boundary if it was the current medium
+//   (or m was not on the stack: a ray that started inside an open mesh).
+//   A false boundary is crossed straight and untinted (it still counts as an interface).
+//   At a true boundary n1 is the IOR on the ray's side, n2 the other:
+//   entering: n1 = current medium (before the push), n2 = ior(m);
+//   leaving: n1 = ior(m), n2 = current medium (after the removal).
+//   ior(m) = max(1, m.ior + iorOffset + iorScale * r) where m has an IOR texture (glTF
+//   extension SNELL_materials_ior_texture), r its red channel at the hit read as
+//   byte / 255 (no sRGB decode), else m.ior;
+//   for the medium being left or entered at this hit; a medium not at the hit
+//   (the other side) uses its base IOR. With dispersion D > 0 (KHR_materials_dispersion,
+//   D = 20 / Abbe number) the channels see ior - h, ior, ior + h (red, green,
+//   blue) with h = 0.025 D (ior - 1), the extension's own spread: the pixel is
+//   traced again once per channel from the camera, each keeping its channel.
+//   n = entering ? Ns : -Ns; eta = n1 / n2;
 //   c = -dot(d, n); if c <= 0 the shading normal faces away: n = entering ? Ng : -Ng, c = -dot(d, n);
 //   k = 1 - eta^2 (1 - c^2);
-//   k < 0: total internal reflection, d' = d + 2 c n;  else d' = eta d + (eta c - sqrt(k)) n;
-//   d' = normalize(d'); throughput *= base colour (factor times texture, linear);
-//   one interface crossed (refraction and internal reflection alike). A ray
-//   crosses at most maxInterfaces faces (default kDefaultMaxInterfaces): the
-//   refractive face after that ends it as a miss (outcome kOutcomeInterfaceLimit).
+//   k < 0: total internal reflection, d' = d + 2 c n, R = 1;
+//   else d' = eta d + (eta c - sqrt(k)) n, and with Fresnel on (kOpticsFresnel)
+//     R = (Rs + Rp) / 2, Rs = ((eta c - ct) / (eta c + ct))^2, Rp = ((eta ct - c) / (eta ct + c))^2, ct = sqrt(k),
+//     the unpolarised dielectric reflectance; T = 1 - R (off: R = 0, T = 1).
+//   d' = normalize(d'); a refracted ray's throughput *= T, total internal
+//   reflection keeps it; then throughput *= base colour (factor times texture,
+//   linear) at every true boundary. The (n2/n1)^2 radiance factor is not
+//   applied: it cancels on leaving a closed medium.
+//   The first `reflections` true boundaries of a path that refract (k >= 0)
+//   also add, where R > 0 and before this boundary's factors: throughput * (R * reflected + highlight):
+//     reflected: one ray along r = d + 2 c n from the hit; an opaque face it meets
+//       is shaded as below, otherwise (a miss or a refractive face) it sees the environment;
+//     highlight: sum over lights (as below) with nl = dot(n, l) > 0 of
+//       E * D(nh) * F(dot(v, h)) / (4 max(dot(n, v), 1e-4)), v = -d, h = normalize(l + v), nh = dot(n, h),
+//       skipped where nh <= 0 or dot(v, h) <= 0; D the GGX distribution, a = max(roughness^2, kMinAlpha):
+//       D = a^2 / (pi (nh^2 (a^2 - 1) + 1)^2); F the R above (with eta) at cosine dot(v, h).
+//     The catch light of an eye is this highlight on the cornea.
+//   Past maxBends the ray crosses straight (no Fresnel, no reflection).
+//   Volume (KHR_materials_volume, thickness > 0 and a finite attenuation
+//   distance): a segment of length t inside a current medium with one
+//   multiplies the throughput by attenuationColor^(t / attenuationDistance)
+//   (Beer-Lambert); the last segment of a ray leaving the scene is not
+//   attenuated. Thin-walled materials (thickness 0) have no volume.
+//   A ray crosses at most maxInterfaces true boundaries (refraction and
+//   internal reflection alike; default kDefaultMaxInterfaces): the one after
+//   that ends it as a miss (outcome kOutcomeInterfaceLimit).
+// The environment a reflected ray sees: the equirectangular map (kOpticsEnvironmentMap),
+//   u = 0.5 + atan(d.x, -d.z) / (2 pi), v = acos(clamp(d.y, -1, 1)) / pi (world +Y up,
+//   -Z at the centre), bilinear, repeating in u and clamped in v, texel centres at
+//   (i + 0.5) / W; or the studio gradient: y = d.y, y >= 0: mix(kStudioHorizon,
+//   kStudioZenith, y); y < 0: mix(kStudioHorizon, kStudioGround, min(1, -4 y)).
 // Opaque faces: colour = throughput * (emissive + kAmbient * base
 //                 + sum over lights E * max(dot(N, L), 0) * (base / pi + kSpecular * max(dot(N, H), 0)^kShininess))
 //   with N = Ns turned towards the viewer (flipped when dot(Ns, -d) < 0), V = -d,
@@ -43,7 +90,8 @@
 //     spot: as point times s^2, s = clamp((dot(direction, -L) - cos outer) / max(1e-4, cos inner - cos outer), 0, 1).
 //   No lights in the scene: one directional headlight along the camera's forward
 //   axis with E = (kHeadlight, kHeadlight, kHeadlight). No shadows.
-// Misses: colour = throughput * background. Alpha is 1 everywhere.
+// Misses: colour = throughput * background (primary and transmitted rays; only
+// reflected rays see the environment). Alpha is 1 everywhere.
 //
 // Textures. uv' = (T * vec3(uv, 1)).xy with T the KHR_texture_transform matrix;
 // x = u' W - 0.5, y = v' H - 0.5 (row 0 is the image's first row); texels are
@@ -67,7 +115,26 @@ const float kSpecular = 0.04;
 const float kShininess = 64.0;
 const float kHeadlight = 3.14159265;
 #endif
+// The smallest GGX width a highlight gets (roughness 0 would make a light a
+// point no pixel catches), and the default studio gradient's colours.
+#ifdef __cplusplus
+inline constexpr float kMinAlpha = 0.002f;
+inline constexpr float kStudioGround[3] = {0.02f, 0.02f, 0.02f};
+inline constexpr float kStudioHorizon[3] = {0.30f, 0.29f, 0.27f};
+inline constexpr float kStudioZenith[3] = {0.70f, 0.75f, 0.85f};
+#else
+const float kMinAlpha = 0.002;
+const vec3 kStudioGround = vec3(0.02, 0.02, 0.02);
+const vec3 kStudioHorizon = vec3(0.30, 0.29, 0.27);
+const vec3 kStudioZenith = vec3(0.70, 0.75, 0.85);
+#endif
 SNELL_CONST kDefaultMaxInterfaces = 8;
+SNELL_CONST kMaxMedia = 4;  // media one ray can be inside at once
+SNELL_CONST kDefaultReflections = 1;  // true boundaries per path that send a reflected ray
+
+// TracePush::optics bits.
+SNELL_CONST kOpticsFresnel = 1u;         // R and T at every boundary, reflections, highlights
+SNELL_CONST kOpticsEnvironmentMap = 2u;  // reflected rays read kTraceBindingEnvironment, not the studio gradient
 
 SNELL_CONST kLightDirectional = 0;
 SNELL_CONST kLightPoint = 1;
@@ -84,15 +151,19 @@ SNELL_CONST kOutcomeMiss = 0;
 SNELL_CONST kOutcomeOpaque = 1;
 SNELL_CONST kOutcomeInterfaceLimit = 2;  // more refractive faces than maxInterfaces
 
-// 112 bytes, total: 112 bytes
+// 176 bytes, total: 176 bytes
 struct GpuMaterial {
   vec4 baseColorFactor;  // 16
   vec4 emissiveFactor;   // 16: rgb, w: transmission factor (> 0: the face refracts)
   vec4 baseUvRow0;       // 16: KHR_texture_transform, first row (xyz); w: index of refraction
-  vec4 baseUvRow1;       // 16: second row (xyz)
-  vec4 emissiveUvRow0;   // 16
-  vec4 emissiveUvRow1;   // 16
+  vec4 baseUvRow1;       // 16: second row (xyz); w: roughness (the highlight's width)
+  vec4 emissiveUvRow0;   // 16: xyz; w: dispersion (20 / Abbe number; 0: none)
+  vec4 emissiveUvRow1;   // 16: xyz; w: priority among overlapping media (larger wins)
   uvec4 textures;        // 16: base texture, its texCoord, emissive texture, its texCoord
+  vec4 attenuation;      // 16: rgb attenuation colour; w: attenuation distance (0: no volume)
+  vec4 iorUvRow0;        // 16: the IOR texture's transform, first row; w: its scale
+  vec4 iorUvRow1;        // 16: second row; w: its offset
+  uvec4 iorTexture;      // 16: IOR texture (kNoTexture: none), its texCoord, unused, unused
 };
 
 // The texel buffer starts with this many words: the linear value of each sRGB
@@ -159,6 +230,7 @@ SNELL_CONST kTraceBindingRays = 15;       // GpuRay[width * height], with kTrace
 SNELL_CONST kTraceBindingPixels = 16;     // TracePixelList, with kTraceFlagPixelList
 SNELL_CONST kTraceBindingMask = 17;       // r32ui image: non-zero where a transmissive face is visible (compaction)
 SNELL_CONST kTraceBindingGeometryFirst = 18;  // uint[geometryCount]: first triangle (driver-rt pipeline only)
+SNELL_CONST kTraceBindingEnvironment = 19;    // vec4[]: (width, height, 0, 0), then width * height linear RGB texels, row 0 at +Y
 
 // A primary ray from a list, relative to the frame origin like everything the trace sees.
 // 32 bytes, total: 32 bytes
@@ -186,8 +258,8 @@ struct TracePush {
   float shiftY;     // 4
   uint pixelsPerGroup;  // 4: with kTraceFlagPixelList, listed pixels per workgroup
   uint maxBends;    // 4: interfaces that refract; later ones are crossed straight (kAllBends: every one)
-  uint pad1;        // 4
-  uint pad2;        // 4
+  uint optics;      // 4: kOptics* bits
+  uint reflections; // 4: true boundaries per path that send a reflected ray
 };
 
 // The masked trace's pixel list (shaders/comp/trace_compact.comp writes it,

@@ -29,6 +29,8 @@ options:
   --resolution N        segments around each part, 8-2048 (default 64; 256 gives
                         about 200 000 triangles)
   --crowd N             N characters' eye pairs in a grid, animation staggered
+  --aqueous             add the aqueous humour (IOR 1.336) behind the cornea: a
+                        closed volume the cornea hands over to (nested media)
 )";
 
 float parseNumber(const std::string& option, const std::string& value) {
@@ -50,6 +52,10 @@ int runEye(const Args& args) {
     if (a == "--help" || a == "-h") {
       std::fputs(kHelp, stdout);
       return 0;
+    }
+    if (a == "--aqueous") {
+      options.aqueous = true;
+      continue;
     }
     if (i + 1 >= args.size()) throw UsageError{"eye: " + a + " needs a value (or is unknown)"};
     const std::string& v = args[++i];

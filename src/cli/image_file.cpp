@@ -5,6 +5,7 @@
 #include "cli/image_file.h"
 
 #include "scene/gltf_writer.h"
+#include "scene/scene.h"
 
 #if SNELL_WITH_OPENIMAGEIO
 #include <OpenImageIO/imageio.h>
@@ -127,6 +128,77 @@ Rgb8Image readRgb8(const std::string& path) {
     for (int c = 0; c < 3; ++c) image.rgb[3 * i + size_t(c)] = decoded.image[size_t(decoded.component) * i + size_t(c)];
   }
   return image;
+}
+
+namespace {
+
+/// Box-filters the environment to half its size in each direction.
+void halve(scene::Environment& env) {
+  uint32_t w = std::max(1u, env.width / 2), h = std::max(1u, env.height / 2);
+  std::vector<glm::vec3> out(size_t(w) * h);
+  for (uint32_t y = 0; y < h; ++y) {
+    for (uint32_t x = 0; x < w; ++x) {
+      glm::vec3 sum(0.0f);
+      for (uint32_t dy = 0; dy < 2; ++dy) {
+        for (uint32_t dx = 0; dx < 2; ++dx) {
+          sum += env.texels[size_t(std::min(2 * y + dy, env.height - 1)) * env.width + std::min(2 * x + dx, env.width - 1)];
+        }
+      }
+      out[size_t(y) * w + x] = 0.25f * sum;
+    }
+  }
+  env.width = w;
+  env.height = h;
+  env.texels = std::move(out);
+}
+
+}  // namespace
+
+scene::Environment readEnvironment(const std::string& path) {
+  if (!fs::is_regular_file(path)) throw std::runtime_error(path + ": no such environment file");
+  scene::Environment env;
+  env.source = path;
+  std::string ext = lowerExtension(path);
+  if (ext == ".png") {
+    Rgb8Image image = readRgb8(path);
+    env.width = image.width;
+    env.height = image.height;
+    env.texels.resize(size_t(image.width) * image.height);
+    for (size_t i = 0; i < env.texels.size(); ++i) {
+      for (int c = 0; c < 3; ++c) env.texels[i][c] = float(scene::srgbToLinear(image.rgb[3 * i + size_t(c)]));
+    }
+  } else {
+#if SNELL_WITH_OPENIMAGEIO
+    auto in = OIIO::ImageInput::open(path);
+    if (!in) throw std::runtime_error(path + ": cannot read the environment (" + OIIO::geterror() + ")");
+    const OIIO::ImageSpec& spec = in->spec();
+    if (spec.width <= 0 || spec.height <= 0 || spec.nchannels < 1 || spec.width > 65536 || spec.height > 65536) {
+      throw std::runtime_error(path + ": an environment of " + std::to_string(spec.width) + "x" +
+                               std::to_string(spec.height) + " texels and " + std::to_string(spec.nchannels) +
+                               " channels cannot be used");
+    }
+    env.width = uint32_t(spec.width);
+    env.height = uint32_t(spec.height);
+    int channels = spec.nchannels;
+    std::vector<float> pixels(size_t(env.width) * env.height * size_t(channels));
+    if (!in->read_image(0, 0, 0, channels, OIIO::TypeDesc::FLOAT, pixels.data())) {
+      throw std::runtime_error(path + ": cannot read the environment's pixels (" + in->geterror() + ")");
+    }
+    env.texels.resize(size_t(env.width) * env.height);
+    for (size_t i = 0; i < env.texels.size(); ++i) {
+      for (int c = 0; c < 3; ++c) env.texels[i][c] = pixels[i * size_t(channels) + size_t(std::min(c, channels - 1))];
+    }
+#else
+    throw std::runtime_error(path + ": this build has no OpenImageIO, so only .png environments");
+#endif
+  }
+  for (const glm::vec3& t : env.texels) {
+    if (!(std::isfinite(t.r) && std::isfinite(t.g) && std::isfinite(t.b)) || t.r < 0.0f || t.g < 0.0f || t.b < 0.0f) {
+      throw std::runtime_error(path + ": the environment has a negative or non-finite texel");
+    }
+  }
+  while (env.width > kMaxEnvironmentWidth) halve(env);
+  return env;
 }
 
 void writeTextFile(const std::string& path, const std::string& text) {

@@ -29,8 +29,10 @@ namespace {
 constexpr const char* kHelp = R"(usage: snell render SCENE.glb|SCENE.gltf|--eye -o OUT.png|OUT.exr [options]
 
 Ray traces the scene on the GPU: one ray per pixel, refracted through every
-transmissive face (KHR_materials_transmission, KHR_materials_ior), Phong-shaded
-where it lands. PNG is written as 8-bit sRGB, EXR as linear half floats. The
+transmissive face (KHR_materials_transmission, KHR_materials_ior, _volume,
+_dispersion; overlapping glass by priority), Phong-shaded where it lands. Glass
+reflects by Fresnel: the lights as highlights (an eye's catch lights) and the
+environment. PNG is written as 8-bit sRGB, EXR as linear half floats. The
 file appears only once it is complete.
 
 options:
@@ -48,6 +50,10 @@ options:
   --fps N                frames per second for --frames
   --max-interfaces N     refractive faces a ray may cross (default 8)
   --background R,G,B     linear colour of misses (default 0.02,0.02,0.025)
+  --environment FILE     what glass reflects: an equirectangular HDR, EXR or PNG
+                         (+Y up, -Z in the middle; default: a studio gradient)
+  --reflections N        interfaces per ray that send a reflected ray (default 1)
+  --no-fresnel           glass transmits everything and reflects nothing
   --scene NAME|INDEX     which glTF scene of the file
   --ignore-extension E   load a file that requires extension E anyway
   --reference            render with the CPU double-precision reference instead
@@ -90,6 +96,8 @@ struct Options {
   std::optional<render::Method> method;
   bool stats = false;
   render::RasterOptions raster;
+  scene::Optics optics;
+  std::string environment;
 };
 
 std::vector<double> parseNumbers(const std::string& option, const std::string& value, size_t count) {
@@ -118,6 +126,7 @@ Options parse(const Args& args) {
     if (a == "--no-refraction") { o.raster.refraction = false; continue; }
     if (a == "--wireframe") { o.raster.wireframe = true; continue; }
     if (a == "--stats") { o.stats = true; continue; }
+    if (a == "--no-fresnel") { o.optics.fresnel = false; continue; }
     if (!a.empty() && a[0] != '-') {
       if (!o.input.empty()) throw UsageError{"render: more than one scene given ('" + o.input + "', '" + a + "')"};
       o.input = a;
@@ -165,6 +174,10 @@ Options parse(const Args& args) {
     } else if (a == "--background") {
       std::vector<double> n = parseNumbers(a, v, 3);
       o.background = glm::vec3(glm::dvec3(n[0], n[1], n[2]));
+    } else if (a == "--environment") {
+      o.environment = v;
+    } else if (a == "--reflections") {
+      o.optics.reflections = uint32_t(std::min<unsigned long long>(parseCount(a, v), 1024));
     } else if (a == "--scene") {
       o.load.scene = v;
     } else if (a == "--ignore-extension") {
@@ -260,6 +273,7 @@ int runRender(const Args& args) {
     }
   }
   Options o = parse(args);
+  if (!o.environment.empty()) o.optics.environment = std::make_shared<scene::Environment>(readEnvironment(o.environment));
   scene::Scene scene = o.eye ? scene::makeEye() : scene::loadGltf(o.input, o.load);
   if (o.eye) scene.source = "procedural eye";
   for (const std::string& w : scene.warnings) std::fprintf(stderr, "snell: note: %s\n", w.c_str());
@@ -307,11 +321,13 @@ int runRender(const Args& args) {
       settings.view = view;
       settings.background = glm::dvec3(o.background);
       settings.maxInterfaces = o.maxInterfaces;
+      settings.optics = o.optics;
       ref::ReferenceImage r = ref::renderReference(scene, pose, settings);
       image.rgba.reserve(r.color.size());
       for (const glm::dvec3& c : r.color) image.rgba.emplace_back(glm::vec3(c), 1.0f);
     } else {
       render::FrameSettings settings{o.width, o.height, view, o.background, o.maxInterfaces};
+      settings.optics = o.optics;
       render::RasterOptions raster = o.raster;
       glm::dvec3 lo, hi;
       scene::sceneBounds(scene, pose, lo, hi);

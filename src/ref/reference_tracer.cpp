@@ -47,6 +47,7 @@ glm::dvec3 unitOrZero(const glm::dvec3& v) {
 struct LinearTexture {
   uint32_t width = 0, height = 0;
   std::vector<glm::dvec3> texels;  // row 0 is the image's first row
+  std::vector<glm::dvec3> data;    // the same texels as bytes / 255 (data textures: the IOR's)
   uint32_t wrapS = gpu::kWrapRepeat, wrapT = gpu::kWrapRepeat;
   bool nearest = false;
 };
@@ -67,6 +68,10 @@ LinearTexture decode(const scene::Texture& t) {
   out.texels.resize(count);
   for (size_t i = 0; i < count; ++i) {
     out.texels[i] = {table[t.rgba[i * 4 + 0]], table[t.rgba[i * 4 + 1]], table[t.rgba[i * 4 + 2]]};
+  }
+  out.data.resize(count);
+  for (size_t i = 0; i < count; ++i) {
+    out.data[i] = glm::dvec3(t.rgba[i * 4 + 0], t.rgba[i * 4 + 1], t.rgba[i * 4 + 2]) / 255.0;
   }
   out.wrapS = wrapMode(t.repeatS, t.mirrorS);
   out.wrapT = wrapMode(t.repeatT, t.mirrorT);
@@ -90,10 +95,11 @@ int64_t floorIndex(double x) {
   return int64_t(std::floor(std::clamp(x, -1e15, 1e15)));
 }
 
-glm::dvec3 sample(const LinearTexture& t, const glm::dvec2& uv) {
+glm::dvec3 sample(const LinearTexture& t, const glm::dvec2& uv, bool srgb = true) {
   const int64_t w = t.width, h = t.height;
+  const std::vector<glm::dvec3>& texels = srgb ? t.texels : t.data;
   auto texel = [&](int64_t x, int64_t y) {
-    return t.texels[size_t(wrapIndex(y, h, t.wrapT) * w + wrapIndex(x, w, t.wrapS))];
+    return texels[size_t(wrapIndex(y, h, t.wrapT) * w + wrapIndex(x, w, t.wrapS))];
   };
   if (t.nearest) return texel(floorIndex(uv.x * double(w)), floorIndex(uv.y * double(h)));
   double x = uv.x * double(w) - 0.5, y = uv.y * double(h) - 0.5;
@@ -116,9 +122,15 @@ struct TextureUse {
 struct ResolvedMaterial {
   glm::dvec3 baseFactor{1.0};
   glm::dvec3 emissiveFactor{0.0};
-  TextureUse base, emissive;
+  TextureUse base, emissive, ior;
   bool refractive = false;
-  double ior = 1.5;
+  double baseIor = 1.5;
+  double iorScale = 1.0, iorOffset = 0.0;
+  double roughness = 1.0;
+  double dispersion = 0.0;
+  double priority = 0.0;
+  glm::dvec3 attenuationColor{1.0};
+  double attenuationDistance = 0.0;  // 0: no volume
 };
 
 struct ResolvedLight {
@@ -175,6 +187,7 @@ class PreparedScene {
   const ResolvedMaterial& material(int index) const {
     return index >= 0 && size_t(index) < materials_.size() ? materials_[size_t(index)] : defaultMaterial_;
   }
+  int materialCount() const { return int(materials_.size()); }
   const std::vector<ResolvedLight>& lights() const { return lights_; }
   double size() const { return size_; }
 
@@ -211,7 +224,15 @@ PreparedScene::PreparedScene(const scene::Scene& scene, const scene::Pose& pose,
     r.base = use(m.baseColorTexture);
     r.emissive = use(m.emissiveTexture);
     r.refractive = m.refractive();
-    r.ior = double(m.ior);
+    r.baseIor = double(m.ior);
+    r.ior = use(m.iorTexture);
+    r.iorScale = double(m.iorScale);
+    r.iorOffset = double(m.iorOffset);
+    r.roughness = double(m.roughness);
+    r.dispersion = double(m.dispersion);
+    r.priority = double(m.priority);
+    r.attenuationColor = glm::dvec3(m.attenuationColor);
+    r.attenuationDistance = m.attenuates() ? double(m.attenuationDistance) : 0.0;
     materials_.push_back(r);
   }
 
@@ -459,15 +480,8 @@ Hit PreparedScene::intersect(const glm::dvec3& origin, const glm::dvec3& directi
 // ---------------------------------------------------------------------------
 // Tracing
 
-struct PixelResult {
-  glm::dvec3 color{0.0};
-  double distance = kInfinity;
-  int32_t instance = -1, primitive = -1;
-  uint32_t interfaces = 0;
-  uint32_t outcome = gpu::kOutcomeMiss;
-};
-
-glm::dvec3 textureColor(const TextureUse& use, const TriangleData& tri, double b0, double b1, double b2) {
+glm::dvec3 textureColor(const TextureUse& use, const TriangleData& tri, double b0, double b1, double b2,
+                        bool srgb = true) {
   if (!use.texture) return glm::dvec3(1.0);
   glm::dvec2 uv(0.0);
   if (use.texCoord == 0 || use.texCoord == 1) {
@@ -475,7 +489,34 @@ glm::dvec3 textureColor(const TextureUse& use, const TriangleData& tri, double b
     uv = b0 * set[0] + b1 * set[1] + b2 * set[2];
   }
   glm::dvec3 transformed = use.transform * glm::dvec3(uv, 1.0);  // KHR_texture_transform
-  return sample(*use.texture, glm::dvec2(transformed));
+  return sample(*use.texture, glm::dvec2(transformed), srgb);
+}
+
+/// Light `light` as seen from p: the unit direction towards it and its
+/// irradiance; false where it has no direction (a light on the point).
+bool lightAt(const ResolvedLight& light, const glm::dvec3& p, glm::dvec3& l, glm::dvec3& e) {
+  if (light.type == scene::LightType::Directional) {
+    l = -light.direction;
+    e = light.radiance;
+    return true;
+  }
+  glm::dvec3 toLight = light.position - p;
+  double distance = glm::length(toLight);
+  if (!(distance > 0.0)) return false;
+  l = toLight / distance;
+  double window = 1.0;
+  if (std::isfinite(light.range)) {
+    double ratio = distance / light.range;
+    window = std::clamp(1.0 - ratio * ratio * ratio * ratio, 0.0, 1.0);
+    window *= window;
+  }
+  e = light.radiance / (distance * distance) * window;
+  if (light.type == scene::LightType::Spot) {
+    double s = std::clamp((glm::dot(light.direction, -l) - light.cosOuter) / std::max(1e-4, light.cosInner - light.cosOuter),
+                          0.0, 1.0);
+    e *= s * s;
+  }
+  return true;
 }
 
 glm::dvec3 shadeOpaque(const PreparedScene& prepared, const glm::dvec3& p, const glm::dvec3& shadingNormal,
@@ -485,28 +526,7 @@ glm::dvec3 shadeOpaque(const PreparedScene& prepared, const glm::dvec3& p, const
   glm::dvec3 sum(0.0);
   for (const ResolvedLight& light : prepared.lights()) {
     glm::dvec3 l, e;
-    if (light.type == scene::LightType::Directional) {
-      l = -light.direction;
-      e = light.radiance;
-    } else {
-      glm::dvec3 toLight = light.position - p;
-      double distance = glm::length(toLight);
-      if (!(distance > 0.0)) continue;  // a light on the surface has no direction
-      l = toLight / distance;
-      double window = 1.0;
-      if (std::isfinite(light.range)) {
-        double ratio = distance / light.range;
-        window = std::clamp(1.0 - ratio * ratio * ratio * ratio, 0.0, 1.0);
-        window *= window;
-      }
-      e = light.radiance / (distance * distance) * window;
-      if (light.type == scene::LightType::Spot) {
-        double s = std::clamp((glm::dot(light.direction, -l) - light.cosOuter) /
-                                  std::max(1e-4, light.cosInner - light.cosOuter),
-                              0.0, 1.0);
-        e *= s * s;
-      }
-    }
+    if (!lightAt(light, p, l, e)) continue;
     double nDotL = glm::dot(n, l);
     // Also covers l = -v, where H would be undefined (n faces v, so n.l <= 0).
     if (!(nDotL > 0.0)) continue;
@@ -517,64 +537,281 @@ glm::dvec3 shadeOpaque(const PreparedScene& prepared, const glm::dvec3& p, const
   return emissive + kAmbient * base + sum;
 }
 
-PixelResult trace(const PreparedScene& prepared, glm::dvec3 origin, glm::dvec3 d, const ReferenceSettings& settings) {
-  PixelResult result;
-  glm::dvec3 throughput(1.0);
-  double tMin = 0.0;  // primary rays: any t > 0
-  uint32_t excluded = std::numeric_limits<uint32_t>::max();
-  for (bool primary = true;; primary = false) {
-    Hit hit = prepared.intersect(origin, d, tMin, excluded);
-    if (!hit.found()) {
-      result.color = throughput * settings.background;
-      result.outcome = gpu::kOutcomeMiss;
-      return result;
-    }
-    const TriangleData& tri = prepared.triangle(hit.triangle);
-    if (primary) {
-      result.distance = hit.t;
-      result.instance = tri.item;
-      result.primitive = tri.primitive;
-    }
-    const double b1 = hit.b1, b2 = hit.b2, b0 = 1.0 - b1 - b2;
-    const glm::dvec3 p = b0 * tri.v[0] + b1 * tri.v[1] + b2 * tri.v[2];
-    const glm::dvec3& ng = tri.ng;
-    glm::dvec3 ns = unitOrZero(b0 * tri.n[0] + b1 * tri.n[1] + b2 * tri.n[2]);
-    if (ns == glm::dvec3(0.0)) ns = ng;
-    if (glm::dot(ns, ng) < 0.0) ns = -ns;
+struct PixelResult {
+  glm::dvec3 color{0.0};
+  double distance = kInfinity;
+  int32_t instance = -1, primitive = -1;
+  uint32_t interfaces = 0;
+  uint32_t outcome = gpu::kOutcomeMiss;
+  double energyError = 0.0;
+};
 
-    const ResolvedMaterial& material = prepared.material(tri.material);
-    const glm::dvec3 base = material.baseFactor * textureColor(material.base, tri, b0, b1, b2);
-    if (!material.refractive) {
-      const glm::dvec3 emissive = material.emissiveFactor * textureColor(material.emissive, tri, b0, b1, b2);
-      result.color = throughput * shadeOpaque(prepared, p, ns, d, base, emissive);
-      result.outcome = gpu::kOutcomeOpaque;
-      return result;
-    }
+// ---------------------------------------------------------------------------
+// Optics: Fresnel, media, highlights, the environment
 
-    if (result.interfaces >= settings.maxInterfaces) {
-      result.color = throughput * settings.background;  // ends as a miss
-      result.outcome = gpu::kOutcomeInterfaceLimit;
-      return result;
-    }
-    const bool entering = glm::dot(d, ng) < 0.0;
-    glm::dvec3 n = entering ? ns : -ns;
-    const double eta = entering ? 1.0 / material.ior : material.ior;
-    double c = -glm::dot(d, n);
-    if (c <= 0.0) {
-      n = entering ? ng : -ng;
-      c = -glm::dot(d, n);
-    }
-    const double k = 1.0 - eta * eta * (1.0 - c * c);
-    glm::dvec3 next = k < 0.0 ? d + 2.0 * c * n : eta * d + (eta * c - std::sqrt(k)) * n;
-    next = unitOrZero(next);
-    if (next != glm::dvec3(0.0)) d = next;
-    throughput *= base;
-    ++result.interfaces;
+/// Unpolarised dielectric reflectance for cosine c > 0 and eta = n1 / n2; 1 past the critical angle.
+double fresnelReflectance(double eta, double c) {
+  double k = 1.0 - eta * eta * (1.0 - c * c);
+  if (k < 0.0) return 1.0;
+  double ct = std::sqrt(k);
+  double rs = (eta * c - ct) / (eta * c + ct), rp = (eta * ct - c) / (eta * ct + c);
+  return 0.5 * (rs * rs + rp * rp);
+}
 
-    origin = p;
-    excluded = hit.triangle;
-    tMin = kSecondaryEpsilon * std::max(maxAbs(origin), prepared.size());
+/// The transmittance from the transmission amplitudes ts, tp (Born & Wolf),
+/// written apart from 1 - R so that R + T = 1 is a check, not an identity.
+double fresnelTransmittance(double eta, double c) {
+  double k = 1.0 - eta * eta * (1.0 - c * c);
+  if (k < 0.0) return 0.0;
+  double ct = std::sqrt(k);
+  double ts = 2.0 * eta * c / (eta * c + ct), tp = 2.0 * eta * c / (eta * ct + c);
+  return (ct / (eta * c)) * 0.5 * (ts * ts + tp * tp);
+}
+
+double channelIor(double ior, double dispersion, int channel) {
+  if (channel < 0 || channel == 1 || dispersion <= 0.0) return ior;
+  double spread = 0.025 * dispersion * (ior - 1.0);
+  return channel == 0 ? ior - spread : ior + spread;
+}
+
+/// The media a ray is inside (shared/trace.h: nested dielectrics).
+struct Media {
+  int material[gpu::kMaxMedia] = {};
+  uint32_t count = 0;
+
+  int current(const PreparedScene& prepared) const {
+    int best = -1;
+    for (uint32_t i = 0; i < count; ++i) {
+      if (best < 0 || prepared.material(material[i]).priority >= prepared.material(material[best]).priority) best = int(i);
+    }
+    return best;
   }
+  void enter(int m) {
+    if (count == gpu::kMaxMedia) {
+      for (uint32_t i = 1; i < gpu::kMaxMedia; ++i) material[i - 1] = material[i];
+      --count;
+    }
+    material[count++] = m;
+  }
+  int leave(int m) {
+    int at = -1;
+    for (uint32_t i = 0; i < count; ++i) {
+      if (material[i] == m) at = int(i);
+    }
+    if (at < 0) return -1;
+    for (uint32_t i = uint32_t(at) + 1; i < count; ++i) material[i - 1] = material[i];
+    --count;
+    return at;
+  }
+};
+
+glm::dvec3 studioGradient(const glm::dvec3& d) {
+  const glm::dvec3 ground(gpu::kStudioGround[0], gpu::kStudioGround[1], gpu::kStudioGround[2]);
+  const glm::dvec3 horizon(gpu::kStudioHorizon[0], gpu::kStudioHorizon[1], gpu::kStudioHorizon[2]);
+  const glm::dvec3 zenith(gpu::kStudioZenith[0], gpu::kStudioZenith[1], gpu::kStudioZenith[2]);
+  return d.y >= 0.0 ? glm::mix(horizon, zenith, d.y) : glm::mix(horizon, ground, std::min(1.0, -4.0 * d.y));
+}
+
+glm::dvec3 environmentColor(const scene::Optics& optics, const glm::dvec3& d) {
+  if (!optics.environment) return studioGradient(d);
+  const scene::Environment& env = *optics.environment;
+  const int64_t w = env.width, h = env.height;
+  double u = 0.5 + std::atan2(d.x, -d.z) / (2.0 * kPi), v = std::acos(std::clamp(d.y, -1.0, 1.0)) / kPi;
+  double x = u * double(w) - 0.5, y = v * double(h) - 0.5;
+  int64_t x0 = floorIndex(x), y0 = floorIndex(y);
+  double fx = x - double(x0), fy = y - double(y0);
+  auto texel = [&](int64_t tx, int64_t ty) {
+    tx = ((tx % w) + w) % w;
+    ty = std::clamp<int64_t>(ty, 0, h - 1);
+    return glm::dvec3(env.texels[size_t(ty * w + tx)]);
+  };
+  glm::dvec3 top = glm::mix(texel(x0, y0), texel(x0 + 1, y0), fx);
+  glm::dvec3 bottom = glm::mix(texel(x0, y0 + 1), texel(x0 + 1, y0 + 1), fx);
+  return glm::mix(top, bottom, fy);
+}
+
+/// Every light's GGX highlight on a boundary of normal n (the viewer's side).
+glm::dvec3 highlight(const PreparedScene& prepared, const glm::dvec3& p, const glm::dvec3& n, const glm::dvec3& d,
+                     double roughness, double eta) {
+  const glm::dvec3 v = -d;
+  const double a = std::max(roughness * roughness, double(gpu::kMinAlpha)), a2 = a * a;
+  const double nv = std::max(glm::dot(n, v), 1e-4);
+  glm::dvec3 sum(0.0);
+  for (const ResolvedLight& light : prepared.lights()) {
+    glm::dvec3 l, e;
+    if (!lightAt(light, p, l, e) || !(glm::dot(n, l) > 0.0)) continue;
+    glm::dvec3 h = glm::normalize(l + v);
+    double nh = glm::dot(n, h), vh = glm::dot(v, h);
+    if (!(nh > 0.0) || !(vh > 0.0)) continue;
+    double dd = nh * nh * (a2 - 1.0) + 1.0;
+    sum += e * (a2 / (kPi * dd * dd)) * fresnelReflectance(eta, vh) / (4.0 * nv);
+  }
+  return sum;
+}
+
+struct Tracer {
+  const PreparedScene& prepared;
+  const ReferenceSettings& settings;
+
+  double tMinFrom(const glm::dvec3& origin) const {
+    return kSecondaryEpsilon * std::max(maxAbs(origin), prepared.size());
+  }
+
+  double surfaceIor(const ResolvedMaterial& m, const TriangleData& tri, double b0, double b1, double b2, int channel) const {
+    double ior = m.baseIor;
+    if (m.ior.texture) ior = std::max(1.0, ior + m.iorOffset + m.iorScale * textureColor(m.ior, tri, b0, b1, b2, false).r);
+    return channelIor(ior, m.dispersion, channel);
+  }
+
+  double mediumIor(int material, int channel) const {
+    const ResolvedMaterial& m = prepared.material(material);
+    return channelIor(m.baseIor, m.dispersion, channel);
+  }
+
+  /// What a reflected ray from p sees: the opaque face it meets, else the environment.
+  glm::dvec3 reflected(const glm::dvec3& p, const glm::dvec3& d, uint32_t from) const {
+    Hit hit = prepared.intersect(p, d, tMinFrom(p), from);
+    if (hit.found()) {
+      const TriangleData& tri = prepared.triangle(hit.triangle);
+      const ResolvedMaterial& m = prepared.material(tri.material);
+      if (!m.refractive) {
+        const double b1 = hit.b1, b2 = hit.b2, b0 = 1.0 - b1 - b2;
+        glm::dvec3 ns = unitOrZero(b0 * tri.n[0] + b1 * tri.n[1] + b2 * tri.n[2]);
+        if (ns == glm::dvec3(0.0)) ns = tri.ng;
+        if (glm::dot(ns, tri.ng) < 0.0) ns = -ns;
+        const glm::dvec3 q = b0 * tri.v[0] + b1 * tri.v[1] + b2 * tri.v[2];
+        return shadeOpaque(prepared, q, ns, d, m.baseFactor * textureColor(m.base, tri, b0, b1, b2),
+                           m.emissiveFactor * textureColor(m.emissive, tri, b0, b1, b2));
+      }
+    }
+    return environmentColor(settings.optics, d);
+  }
+
+  /// One path for `channel` (0-2, or -1: every channel at the base IOR).
+  /// With channel -1, returns false at the first dispersive boundary: the
+  /// caller traces the pixel once per channel.
+  bool path(glm::dvec3 origin, glm::dvec3 d, int channel, PixelResult& result) const {
+    result = PixelResult{};
+    const bool fresnel = settings.optics.fresnel;
+    uint32_t reflections = fresnel ? settings.optics.reflections : 0u;
+    glm::dvec3 throughput(1.0);
+    Media media;
+    double tMin = 0.0;  // primary rays: any t > 0
+    uint32_t excluded = std::numeric_limits<uint32_t>::max();
+    for (bool primary = true;; primary = false) {
+      Hit hit = prepared.intersect(origin, d, tMin, excluded);
+      if (!hit.found()) {
+        result.color += throughput * settings.background;
+        result.outcome = gpu::kOutcomeMiss;
+        return true;
+      }
+      const int inside = media.current(prepared);
+      if (inside >= 0) {  // Beer-Lambert over the segment
+        const ResolvedMaterial& volume = prepared.material(media.material[inside]);
+        if (volume.attenuationDistance > 0.0) {
+          for (int c = 0; c < 3; ++c) throughput[c] *= std::pow(volume.attenuationColor[c], hit.t / volume.attenuationDistance);
+        }
+      }
+      const TriangleData& tri = prepared.triangle(hit.triangle);
+      if (primary) {
+        result.distance = hit.t;
+        result.instance = tri.item;
+        result.primitive = tri.primitive;
+      }
+      const double b1 = hit.b1, b2 = hit.b2, b0 = 1.0 - b1 - b2;
+      const glm::dvec3 p = b0 * tri.v[0] + b1 * tri.v[1] + b2 * tri.v[2];
+      const glm::dvec3& ng = tri.ng;
+      glm::dvec3 ns = unitOrZero(b0 * tri.n[0] + b1 * tri.n[1] + b2 * tri.n[2]);
+      if (ns == glm::dvec3(0.0)) ns = ng;
+      if (glm::dot(ns, ng) < 0.0) ns = -ns;
+
+      const ResolvedMaterial& material = prepared.material(tri.material);
+      const glm::dvec3 base = material.baseFactor * textureColor(material.base, tri, b0, b1, b2);
+      if (!material.refractive) {
+        const glm::dvec3 emissive = material.emissiveFactor * textureColor(material.emissive, tri, b0, b1, b2);
+        result.color += throughput * shadeOpaque(prepared, p, ns, d, base, emissive);
+        result.outcome = gpu::kOutcomeOpaque;
+        return true;
+      }
+      if (result.interfaces >= settings.maxInterfaces) {
+        result.color += throughput * settings.background;  // ends as a miss
+        result.outcome = gpu::kOutcomeInterfaceLimit;
+        return true;
+      }
+
+      const bool entering = glm::dot(d, ng) < 0.0;
+      bool boundary;  // a true boundary: the medium changes here
+      double n1, n2;
+      auto dispersive = [&](int other) {
+        return material.dispersion > 0.0 || (other >= 0 && prepared.material(media.material[other]).dispersion > 0.0);
+      };
+      if (entering) {
+        boundary = inside < 0 || prepared.material(media.material[inside]).priority <= material.priority;
+        if (boundary && channel < 0 && dispersive(inside)) return false;
+        n1 = inside < 0 ? 1.0 : mediumIor(media.material[inside], channel);
+        n2 = surfaceIor(material, tri, b0, b1, b2, channel);
+        media.enter(tri.material);
+      } else {
+        const int at = media.leave(tri.material);
+        boundary = at < 0 || at == inside;
+        const int outside = media.current(prepared);
+        if (boundary && channel < 0 && dispersive(outside)) return false;
+        n1 = surfaceIor(material, tri, b0, b1, b2, channel);
+        n2 = outside < 0 ? 1.0 : mediumIor(media.material[outside], channel);
+      }
+      const bool bends = boundary && result.interfaces < settings.maxBends;
+      ++result.interfaces;
+      if (bends) {
+        glm::dvec3 n = entering ? ns : -ns;
+        const double eta = n1 / n2;
+        double c = -glm::dot(d, n);
+        if (c <= 0.0) {
+          n = entering ? ng : -ng;
+          c = -glm::dot(d, n);
+        }
+        const double k = 1.0 - eta * eta * (1.0 - c * c);
+        glm::dvec3 next;
+        if (k < 0.0) {
+          next = d + 2.0 * c * n;  // total internal reflection keeps everything
+        } else {
+          const double r = fresnel ? fresnelReflectance(eta, c) : 0.0;
+          if (fresnel) {
+            result.energyError = std::max(result.energyError, std::abs(r + fresnelTransmittance(eta, c) - 1.0));
+          }
+          if (reflections > 0) {
+            --reflections;
+            if (r > 0.0) {
+              result.color += throughput * (r * reflected(p, unitOrZero(d + 2.0 * c * n), hit.triangle) +
+                                            highlight(prepared, p, n, d, material.roughness, eta));
+            }
+          }
+          next = eta * d + (eta * c - std::sqrt(k)) * n;
+          throughput *= 1.0 - r;
+        }
+        next = unitOrZero(next);
+        if (next != glm::dvec3(0.0)) d = next;
+      }
+      if (boundary) throughput *= base;
+
+      origin = p;
+      excluded = hit.triangle;
+      tMin = tMinFrom(origin);
+    }
+  }
+};
+
+PixelResult trace(const PreparedScene& prepared, const glm::dvec3& origin, const glm::dvec3& d,
+                  const ReferenceSettings& settings) {
+  const Tracer tracer{prepared, settings};
+  PixelResult result;
+  if (tracer.path(origin, d, -1, result)) return result;
+  PixelResult red, blue;
+  tracer.path(origin, d, 0, red);
+  tracer.path(origin, d, 1, result);
+  tracer.path(origin, d, 2, blue);
+  result.color = {red.color.r, result.color.g, blue.color.b};
+  result.energyError = std::max({red.energyError, result.energyError, blue.energyError});
+  return result;
 }
 
 }  // namespace
@@ -590,6 +827,7 @@ ReferenceImage renderReference(const scene::Scene& scene, const scene::Pose& pos
   image.primitive.assign(pixels, -1);
   image.interfaces.assign(pixels, 0);
   image.outcome.assign(pixels, gpu::kOutcomeMiss);
+  image.energyError.assign(pixels, 0.0);
   if (pixels == 0) return image;
   if (!settings.rays.empty() && settings.rays.size() != pixels) {
     throw std::invalid_argument("reference: " + std::to_string(settings.rays.size()) + " rays for " +
@@ -624,6 +862,7 @@ ReferenceImage renderReference(const scene::Scene& scene, const scene::Pose& pos
         image.primitive[i] = r.primitive;
         image.interfaces[i] = r.interfaces;
         image.outcome[i] = r.outcome;
+        image.energyError[i] = r.energyError;
       }
     }
   };

@@ -4,6 +4,7 @@
 #pragma once
 
 #include "scene/evaluate.h"
+#include "scene/optics.h"
 #include "scene/scene.h"
 #include "scene/view.h"
 #include "shared/trace.h"
@@ -20,9 +21,11 @@ struct ReferenceSettings {
   scene::View view;                ///< taken as given: rays come from it exactly as trace.h says
   glm::dvec3 background{0.02, 0.02, 0.025};  ///< linear RGB a miss sees
   uint32_t maxInterfaces = gpu::kDefaultMaxInterfaces;  ///< refractive faces one ray may cross
+  uint32_t maxBends = gpu::kAllBends;  ///< boundaries that bend; later ones are crossed straight
   unsigned threads = 0;  ///< 0: std::thread::hardware_concurrency()
   /// When not empty: width * height primary rays, pixel i (row-major) tracing rays[i].
   std::vector<scene::Ray> rays;
+  scene::Optics optics;  ///< Fresnel, reflections and their environment, as the GPU frame takes them
 };
 
 /// Per-pixel results, row-major, row 0 the top of the picture.
@@ -34,6 +37,9 @@ struct ReferenceImage {
   std::vector<int32_t> primitive;   ///< triangle index within that item's shape; -1 on a miss
   std::vector<uint32_t> interfaces; ///< refractive faces crossed (refraction and TIR alike)
   std::vector<uint32_t> outcome;    ///< gpu::kOutcomeMiss, kOutcomeOpaque or kOutcomeInterfaceLimit
+  /// The largest |R + T - 1| over the pixel's refracting boundaries, with T from
+  /// the Fresnel transmission amplitudes (not 1 - R): energy bookkeeping's check.
+  std::vector<double> energyError;
 
   size_t index(uint32_t x, uint32_t y) const { return size_t(y) * width + x; }
 };

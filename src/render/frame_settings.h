@@ -2,6 +2,7 @@
 // trace and the raster pass both draw from it.
 #pragma once
 
+#include "scene/optics.h"
 #include "scene/view.h"
 #include "shared/trace.h"
 
@@ -23,6 +24,8 @@ struct FrameSettings {
   /// When not empty: width * height primary rays in world space, pixel i
   /// (row-major) tracing rays[i] instead of the camera's ray through it.
   std::vector<scene::Ray> rays;
+  /// Fresnel, reflected rays, highlights and the environment they see.
+  scene::Optics optics;
 };
 
 }  // namespace snell::render

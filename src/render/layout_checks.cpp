@@ -42,7 +42,8 @@ static_assert(sizeof(BvhPush) == 16 && offsetof(BvhPush, total) == 12);
 static_assert(sizeof(GpuInstance) == 112 && offsetof(GpuInstance, worldToObject) == 48 &&
               offsetof(GpuInstance, geometry) == 96 && offsetof(GpuInstance, material) == 100);
 
-static_assert(sizeof(GpuMaterial) == 112 && offsetof(GpuMaterial, textures) == 96);
+static_assert(sizeof(GpuMaterial) == 176 && offsetof(GpuMaterial, textures) == 96 && offsetof(GpuMaterial, attenuation) == 112 &&
+              offsetof(GpuMaterial, iorTexture) == 160);
 static_assert(sizeof(GpuTexture) == 16 && offsetof(GpuTexture, flags) == 12);
 static_assert(sizeof(GpuLight) == 64 && offsetof(GpuLight, cone) == 48);
 static_assert(sizeof(TraceAov) == 32 && offsetof(TraceAov, nodeVisits) == 20);
@@ -52,6 +53,7 @@ static_assert(sizeof(TraceCompactPush) == 16 && offsetof(TraceCompactPush, pixel
 static_assert(sizeof(PresentPush) == 48 && offsetof(PresentPush, gate) == 16 && offsetof(PresentPush, flags) == 32);
 static_assert(sizeof(RasterPush) == 112 && offsetof(RasterPush, offsetStrength) == 96 && offsetof(RasterPush, flags) == 80 && offsetof(RasterPush, lightCount) == 84);
 static_assert(sizeof(TracePush) == 128 && offsetof(TracePush, eye) == 64 && offsetof(TracePush, width) == 80 &&
-              offsetof(TracePush, tilesX) == 100 && offsetof(TracePush, pixelsPerGroup) == 112);
+              offsetof(TracePush, tilesX) == 100 && offsetof(TracePush, pixelsPerGroup) == 112 &&
+              offsetof(TracePush, optics) == 120);
 
 }  // namespace snell::gpu

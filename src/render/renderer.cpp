@@ -42,7 +42,9 @@ bool sameRequest(const ViewRequest& a, const ViewRequest& b) {
          s.maxInterfaces == t.maxInterfaces && s.rays.empty() && t.rays.empty() && a.output == b.output &&
          s.maxBends == t.maxBends && a.driverTrace == b.driverTrace && a.masked == b.masked && a.aov == b.aov && r.refraction == q.refraction &&
          r.screenSpace == q.screenSpace && r.offsetStrength == q.offsetStrength && r.wireframe == q.wireframe &&
-         r.wireColor == q.wireColor && r.nearPlane == q.nearPlane && r.farPlane == q.farPlane;
+         r.wireColor == q.wireColor && r.nearPlane == q.nearPlane && r.farPlane == q.farPlane &&
+         s.optics.fresnel == t.optics.fresnel && s.optics.reflections == t.optics.reflections &&
+         s.optics.environment == t.optics.environment;
 }
 
 std::vector<glm::vec4> unpackHalves(const std::byte* data, size_t pixels) {
@@ -478,7 +480,44 @@ gpu::TracePush Renderer::tracePush(const ViewRequest& request, bool masked) cons
   push.tilesX = (settings.width + gpu::kTraceTile - 1) / gpu::kTraceTile;
   push.shiftX = float(v.shift.x);
   push.shiftY = float(v.shift.y);
+  push.optics = (settings.optics.fresnel ? gpu::kOpticsFresnel : 0u) |
+                (settings.optics.environment ? gpu::kOpticsEnvironmentMap : 0u);
+  push.reflections = settings.optics.reflections;
   return push;
+}
+
+const vk::Buffer& Renderer::environmentBuffer(const scene::Optics& optics) const {
+  if (!optics.environment) return placeholder_;
+  auto found = environments_.find(optics.environment.get());
+  if (found == environments_.end()) {
+    throw std::logic_error("renderer: an environment reached a trace before submit() uploaded it");
+  }
+  return found->second.buffer;
+}
+
+void Renderer::uploadEnvironments(const std::vector<ViewRequest>& views) {
+  for (const ViewRequest& v : views) {
+    const std::shared_ptr<const scene::Environment>& env = v.settings.optics.environment;
+    if (!env || environments_.count(env.get())) continue;
+    if (env->width == 0 || env->height == 0 || env->texels.size() != size_t(env->width) * env->height) {
+      throw std::invalid_argument("renderer: environment " + env->source + " has no texels");
+    }
+    // Header (width, height), then the texels; kept while the environment is alive.
+    std::vector<glm::vec4> data;
+    data.reserve(env->texels.size() + 1);
+    data.emplace_back(float(env->width), float(env->height), 0.0f, 0.0f);
+    for (const glm::vec3& t : env->texels) data.emplace_back(t, 0.0f);
+    VkDeviceSize bytes = data.size() * sizeof(glm::vec4);
+    if (bytes > context_.caps().maxStorageBufferRange) {
+      throw std::runtime_error(env->source + ": the environment needs " + std::to_string(bytes >> 20) +
+                               " MiB; the device binds at most " +
+                               std::to_string(context_.caps().maxStorageBufferRange >> 20) + " MiB in one buffer");
+    }
+    vk::Buffer buffer(context_, {bytes, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
+                                 vk::MemoryDomain::Device, "environment " + env->source});
+    vk::upload(context_, buffer, data.data(), bytes);
+    environments_.emplace(env.get(), Environment{env, std::move(buffer)});
+  }
 }
 
 void Renderer::recordDriverTrace(vk::Commands& commands, const ViewRequest& request, View& view, FrameStats& stats) {
@@ -495,6 +534,7 @@ void Renderer::recordDriverTrace(vk::Commands& commands, const ViewRequest& requ
                         {gpu::kTraceBindingTextures, &scene_.textures},
                         {gpu::kTraceBindingTexels, &scene_.texels},
                         {gpu::kTraceBindingLights, &lights_},
+                        {gpu::kTraceBindingEnvironment, &environmentBuffer(settings.optics)},
                         {gpu::kTraceBindingImage, nullptr, &images.trace},
                         {gpu::kTraceBindingAov, request.aov ? &images.aov : &placeholder_},
                         {gpu::kTraceBindingRays, settings.rays.empty() ? &placeholder_ : &view.rays},
@@ -550,6 +590,7 @@ void Renderer::recordTrace(vk::Commands& commands, const ViewRequest& request, V
       {gpu::kTraceBindingTextures, &scene_.textures},
       {gpu::kTraceBindingTexels, &scene_.texels},
       {gpu::kTraceBindingLights, &lights_},
+      {gpu::kTraceBindingEnvironment, &environmentBuffer(settings.optics)},
       {gpu::kTraceBindingImage, nullptr, &images.trace},
       {gpu::kTraceBindingAov, request.aov ? &images.aov : &placeholder_},
       {gpu::kTraceBindingRays, settings.rays.empty() ? &placeholder_ : &view.rays},
@@ -648,6 +689,7 @@ uint64_t Renderer::submit(const FrameRequest& request) {
       throw std::invalid_argument("renderer: ray lists have no raster image");
     }
   }
+  uploadEnvironments(request.views);
   uint64_t frame = ++submitted_;
   Slot& slot = *slots_[frame % slots_.size()];
   if (slot.pending) collect(slot);

@@ -35,6 +35,7 @@
 
 #include <deque>
 #include <functional>
+#include <map>
 #include <memory>
 #include <vector>
 
@@ -181,6 +182,8 @@ class Renderer {
   void recordView(vk::Commands& commands, Slot& slot, size_t index, const ViewRequest& request, FrameStats& stats);
   void recordTrace(vk::Commands& commands, const ViewRequest& request, View& view, bool masked, FrameStats& stats);
   gpu::TracePush tracePush(const ViewRequest& request, bool masked) const;
+  void uploadEnvironments(const std::vector<ViewRequest>& views);
+  const vk::Buffer& environmentBuffer(const scene::Optics& optics) const;
   void recordDriverTrace(vk::Commands& commands, const ViewRequest& request, View& view, FrameStats& stats);
   void collect(Slot& slot);
   bool viewNeedsTrees(const ViewRequest& request) const;
@@ -196,6 +199,13 @@ class Renderer {
   std::unique_ptr<Bvh> blas_, tlas_;
   std::unique_ptr<vk::ComputeProgram> trace_, compact_;
   vk::Buffer instances_, lights_, placeholder_, stats_;
+  /// Environments uploaded for views, by identity; each holds its own reference,
+  /// so a buffer is never freed under a frame in flight that reads it.
+  struct Environment {
+    std::shared_ptr<const scene::Environment> source;
+    vk::Buffer buffer;
+  };
+  std::map<const scene::Environment*, Environment> environments_;
   uint32_t lightCount_ = 0;
   bool refractive_ = false;
 

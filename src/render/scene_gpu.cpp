@@ -69,6 +69,14 @@ gpu::GpuMaterial packMaterial(const scene::Material& m, const scene::Scene& scen
   uvRows(m.emissiveTexture, g.emissiveUvRow0, g.emissiveUvRow1);
   g.textures = {texture(m.baseColorTexture), static_cast<uint32_t>(m.baseColorTexture.texCoord),
                 texture(m.emissiveTexture), static_cast<uint32_t>(m.emissiveTexture.texCoord)};
+  g.baseUvRow1.w = m.roughness;
+  g.emissiveUvRow0.w = m.dispersion;
+  g.emissiveUvRow1.w = static_cast<float>(m.priority);
+  g.attenuation = glm::vec4(m.attenuationColor, m.attenuates() ? m.attenuationDistance : 0.0f);
+  uvRows(m.iorTexture, g.iorUvRow0, g.iorUvRow1);
+  g.iorUvRow0.w = m.iorScale;
+  g.iorUvRow1.w = m.iorOffset;
+  g.iorTexture = {texture(m.iorTexture), static_cast<uint32_t>(m.iorTexture.texCoord), 0u, 0u};
   return g;
 }
 

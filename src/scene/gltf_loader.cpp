@@ -35,6 +35,7 @@ constexpr float kPi = 3.14159265358979f;
 const std::vector<std::string> kSupported = {
     "KHR_materials_transmission", "KHR_materials_ior",      "KHR_materials_volume", "KHR_texture_transform",
     "KHR_lights_punctual",        "EXT_mesh_gpu_instancing", "KHR_mesh_quantization",
+    "KHR_materials_dispersion",   "SNELL_materials_ior_texture", "SNELL_materials_priority",
 };
 
 // ---- textures and materials -------------------------------------------------
@@ -161,6 +162,7 @@ void loadMaterials(const Reader& r) {
     material.doubleSided = source.doubleSided;
     material.alphaMode = source.alphaMode == "MASK" ? AlphaMode::Mask : source.alphaMode == "BLEND" ? AlphaMode::Blend : AlphaMode::Opaque;
     material.alphaCutoff = static_cast<float>(source.alphaCutoff);
+    material.roughness = static_cast<float>(std::clamp(pbr.roughnessFactor, 0.0, 1.0));
 
     auto extension = [&](const char* name) -> const tinygltf::Value* {
       auto it = source.extensions.find(name);
@@ -202,12 +204,35 @@ void loadMaterials(const Reader& r) {
         }
       }
     }
+    if (const tinygltf::Value* d = extension("KHR_materials_dispersion")) {
+      double value = number(*d, "dispersion", 0.0);
+      if (!(value >= 0.0) || !std::isfinite(value)) {
+        r.fail(what + ": dispersion " + std::to_string(value) + " is invalid (KHR_materials_dispersion needs 0 or more)");
+      }
+      material.dispersion = static_cast<float>(value);
+    }
+    if (const tinygltf::Value* t = extension("SNELL_materials_ior_texture")) {
+      material.iorTexture = extensionTexture(r, *t, "iorTexture", what + " iorTexture");
+      material.iorScale = static_cast<float>(number(*t, "scale", 1.0));
+      material.iorOffset = static_cast<float>(number(*t, "offset", 0.0));
+      if (!material.iorTexture.present()) r.fail(what + ": SNELL_materials_ior_texture has no iorTexture");
+      if (!std::isfinite(material.iorScale) || !std::isfinite(material.iorOffset)) {
+        r.fail(what + ": SNELL_materials_ior_texture scale and offset must be finite");
+      }
+    }
+    if (const tinygltf::Value* p = extension("SNELL_materials_priority")) {
+      double value = number(*p, "priority", 0.0);
+      if (!(std::abs(value) <= 1e6) || value != std::floor(value)) {
+        r.fail(what + ": priority " + std::to_string(value) + " must be a whole number (SNELL_materials_priority)");
+      }
+      material.priority = static_cast<int>(value);
+    }
     r.scene.materials.push_back(material);
   }
   // A texture that could not be decoded is dropped from every material that uses it.
   for (Material& material : r.scene.materials) {
     for (TextureRef* ref : {&material.baseColorTexture, &material.emissiveTexture, &material.transmissionTexture,
-                            &material.thicknessTexture}) {
+                            &material.thicknessTexture, &material.iorTexture}) {
       if (ref->present() && r.scene.textures[size_t(ref->texture)].rgba.empty()) *ref = TextureRef{};
     }
   }

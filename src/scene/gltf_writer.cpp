@@ -166,7 +166,7 @@ void saveGlb(const Scene& scene, const std::string& path) {
     out.name = m.name;
     out.pbrMetallicRoughness.baseColorFactor = {m.baseColorFactor.r, m.baseColorFactor.g, m.baseColorFactor.b, m.baseColorFactor.a};
     out.pbrMetallicRoughness.metallicFactor = 0.0;
-    out.pbrMetallicRoughness.roughnessFactor = 0.5;
+    out.pbrMetallicRoughness.roughnessFactor = m.roughness;
     if (m.baseColorTexture.present()) {
       out.pbrMetallicRoughness.baseColorTexture.index = m.baseColorTexture.texture;
       out.pbrMetallicRoughness.baseColorTexture.texCoord = m.baseColorTexture.texCoord;
@@ -187,6 +187,23 @@ void saveGlb(const Scene& scene, const std::string& path) {
         if (std::isfinite(m.attenuationDistance)) volume["attenuationDistance"] = tinygltf::Value(double(m.attenuationDistance));
         out.extensions["KHR_materials_volume"] = tinygltf::Value(volume);
         use("KHR_materials_volume");
+      }
+      if (m.dispersion > 0.0f) {
+        out.extensions["KHR_materials_dispersion"] =
+            tinygltf::Value(tinygltf::Value::Object{{"dispersion", tinygltf::Value(double(m.dispersion))}});
+        use("KHR_materials_dispersion");
+      }
+      if (m.iorTexture.present()) {
+        out.extensions["SNELL_materials_ior_texture"] = tinygltf::Value(tinygltf::Value::Object{
+            {"iorTexture", textureInfo(m.iorTexture)},
+            {"scale", tinygltf::Value(double(m.iorScale))},
+            {"offset", tinygltf::Value(double(m.iorOffset))}});
+        use("SNELL_materials_ior_texture");
+      }
+      if (m.priority != 0) {
+        out.extensions["SNELL_materials_priority"] =
+            tinygltf::Value(tinygltf::Value::Object{{"priority", tinygltf::Value(m.priority)}});
+        use("SNELL_materials_priority");
       }
     }
     model.materials.push_back(out);

@@ -22,7 +22,9 @@ constexpr float kIrisCone = 0.0003f;      // the pupil edge stands this far in f
 constexpr float kDilation = 0.0012f;      // how far "dilate" widens the pupil
 constexpr glm::vec3 kSquash{1.08f, 1.08f, 0.75f};  // "squash": per-axis scale at weight 1
 
-enum Part { kSclera, kCorneaTip, kCorneaRest, kIris, kPupil, kPartCount };
+enum Part { kSclera, kCorneaTip, kCorneaRest, kIris, kPupil, kAqueous, kPartCount };
+constexpr float kCorneaThickness = 0.00055f;  // central corneal thickness: the aqueous starts this far in
+constexpr float kAqueousIor = 1.336f;
 enum Target { kTargetSquash, kTargetDilate };
 
 /// Adds a band of a sphere (centre (0, 0, centreZ)) between polar angles
@@ -86,15 +88,23 @@ void addIris(Shape& s, float z, uint32_t rings, uint32_t segments) {
   }
 }
 
-void addDisc(Shape& s, float radius, float z, uint32_t segments) {
+/// A disc facing +Z (or -Z, wound the other way, when `back`).
+void addDisc(Shape& s, float radius, float z, uint32_t segments, bool back = false) {
+  uint32_t base = static_cast<uint32_t>(s.positions.size());
+  glm::vec3 normal(0, 0, back ? -1.0f : 1.0f);
   s.positions.push_back({0, 0, z});
-  s.normals.push_back({0, 0, 1});
+  s.normals.push_back(normal);
+  s.texcoords0.push_back(glm::vec2(0.5f));
   for (uint32_t k = 0; k <= segments; ++k) {
     float phi = 2 * kPi * float(k) / float(segments);
     s.positions.push_back({radius * std::cos(phi), radius * std::sin(phi), z});
-    s.normals.push_back({0, 0, 1});
+    s.normals.push_back(normal);
+    s.texcoords0.push_back(glm::vec2(0.5f));
   }
-  for (uint32_t k = 0; k < segments; ++k) s.indices.insert(s.indices.end(), {0, k + 1, k + 2});
+  for (uint32_t k = 0; k < segments; ++k) {
+    if (back) s.indices.insert(s.indices.end(), {base, base + k + 2, base + k + 1});
+    else s.indices.insert(s.indices.end(), {base, base + k + 1, base + k + 2});
+  }
 }
 
 /// "squash" scales about the eye's centre; "dilate" widens the pupil and
@@ -184,8 +194,8 @@ EyeRig addEyeRig(Scene& scene, int parent, glm::vec3 offset, const std::string& 
   scene.skins.push_back(skin);
   EyeRig rig;
   rig.joint = joint;
-  const char* parts[] = {"sclera", "cornea", "iris", "pupil"};
-  for (int m = 0; m < 4; ++m) {
+  const char* parts[] = {"sclera", "cornea", "iris", "pupil", "aqueous"};
+  for (int m = 0; m < int(scene.meshes.size()); ++m) {
     int n = node(name + "_" + parts[m], -1);
     scene.nodes[size_t(n)].mesh = m;
     scene.nodes[size_t(n)].skin = static_cast<int>(scene.skins.size() - 1);
@@ -238,6 +248,7 @@ void checkEyeOptions(const EyeOptions& o) {
   range(o.corneaBulge >= 0.0005f && o.corneaBulge <= 0.005f, "--cornea-bulge must be between 0.0005 and 0.005 (metres)");
   range(o.resolution >= 8 && o.resolution <= 2048, "--resolution must be between 8 and 2048");
   range(o.crowd <= 10000, "--crowd must be at most 10000");
+  range(!o.aqueous || o.corneaBulge >= 0.0015f, "--aqueous needs a --cornea-bulge of at least 0.0015 (metres)");
 }
 
 Scene makeEye(const EyeOptions& o) {
@@ -261,6 +272,14 @@ Scene makeEye(const EyeOptions& o) {
   scene.materials[kCorneaTip].transmission = 1.0f;
   scene.materials[kCorneaTip].ior = o.ior;
   scene.materials[kCorneaTip].doubleSided = true;
+  scene.materials[kCorneaTip].roughness = 0.2f;
+  if (o.aqueous) {
+    scene.materials.push_back(plain("aqueous", {1, 1, 1}));
+    scene.materials[kAqueous].transmission = 1.0f;
+    scene.materials[kAqueous].ior = kAqueousIor;
+    scene.materials[kAqueous].roughness = 0.2f;
+    scene.materials[kAqueous].priority = 1;  // inside the cornea's medium, the aqueous wins
+  }
   scene.materials[kIris].baseColorTexture.texture = 0;
   scene.textures.push_back(irisTexture());
 
@@ -270,8 +289,15 @@ Scene makeEye(const EyeOptions& o) {
   addSphereBand(parts[kCorneaRest], shell, 0.0f, std::asin(kLimbusRadius / shell), kPi, rings, segments);
   addIris(parts[kIris], irisZ, std::max(4u, rings / 2), segments);
   addDisc(parts[kPupil], kPupilRadius, irisZ - 0.0001f, segments);
-  const char* names[] = {"sclera", "cornea_tip", "cornea_rest", "iris", "pupil"};
-  for (int p = 0; p < kPartCount; ++p) {
+  // The aqueous: a cap concentric with the cornea, kCorneaThickness inside it,
+  // closed by a disc behind the pupil (so nothing in front of the iris sees the disc).
+  const float aqueousRadius = corneaRadius - kCorneaThickness, aqueousBack = irisZ - 0.0003f;
+  const float aqueousTheta = std::acos(std::clamp((aqueousBack - corneaCentre) / aqueousRadius, -1.0f, 1.0f));
+  addSphereBand(parts[kAqueous], aqueousRadius, corneaCentre, 0.0f, aqueousTheta, std::max(4u, rings / 2), segments);
+  addDisc(parts[kAqueous], aqueousRadius * std::sin(aqueousTheta), aqueousBack, segments, true);
+  const int partCount = o.aqueous ? kPartCount : kAqueous;
+  const char* names[] = {"sclera", "cornea_tip", "cornea_rest", "iris", "pupil", "aqueous"};
+  for (int p = 0; p < partCount; ++p) {
     Shape& s = parts[size_t(p)];
     s.name = names[p];
     s.material = p;
@@ -282,8 +308,9 @@ Scene makeEye(const EyeOptions& o) {
     scene.shapes.push_back(std::move(s));
   }
   // Meshes: sclera, cornea (tip + rest: one mesh, two materials), iris, pupil.
-  const std::vector<std::vector<int>> meshShapes = {{kSclera}, {kCorneaTip, kCorneaRest}, {kIris}, {kPupil}};
-  const char* meshNames[] = {"sclera", "cornea", "iris", "pupil"};
+  std::vector<std::vector<int>> meshShapes = {{kSclera}, {kCorneaTip, kCorneaRest}, {kIris}, {kPupil}};
+  if (o.aqueous) meshShapes.push_back({kAqueous});
+  const char* meshNames[] = {"sclera", "cornea", "iris", "pupil", "aqueous"};
   for (size_t m = 0; m < meshShapes.size(); ++m) {
     Mesh mesh;
     mesh.name = meshNames[m];

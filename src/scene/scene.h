@@ -53,6 +53,7 @@ struct Material {
   bool doubleSided = false;
   AlphaMode alphaMode = AlphaMode::Opaque;
   float alphaCutoff = 0.5f;
+  float roughness = 1.0f;  ///< pbrMetallicRoughness.roughnessFactor: the width of a glass face's highlights
   // KHR_materials_transmission
   float transmission = 0.0f;
   TextureRef transmissionTexture;
@@ -63,6 +64,18 @@ struct Material {
   TextureRef thicknessTexture;
   glm::vec3 attenuationColor{1.0f};
   float attenuationDistance = std::numeric_limits<float>::infinity();
+  // KHR_materials_dispersion: 20 / Abbe number; 0: none
+  float dispersion = 0.0f;
+  // SNELL_materials_ior_texture: ior + iorOffset + iorScale * red channel (linear)
+  TextureRef iorTexture;
+  float iorScale = 1.0f, iorOffset = 0.0f;
+  // SNELL_materials_priority: which of overlapping media a ray is in (larger wins)
+  int priority = 0;
+
+  /// A volume attenuates the light crossing it (thin-walled materials do not).
+  bool attenuates() const {
+    return thickness > 0.0f && std::isfinite(attenuationDistance) && attenuationDistance > 0.0f;
+  }
 
   /// Faces with this material refract (the talk's cornea tip).
   bool refractive() const { return transmission > 0.0f; }

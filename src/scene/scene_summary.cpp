@@ -81,7 +81,23 @@ std::string describe(const Scene& scene, uint32_t width, uint32_t height) {
     if (!material.refractive()) continue;
     out << "    [" << m << "] " << (material.name.empty() ? "(unnamed)" : material.name) << ": transmission "
         << material.transmission << ", ior " << material.ior;
-    if (material.thickness > 0.0f) out << ", thickness " << material.thickness;
+    if (material.attenuates()) {
+      out << ", volume: attenuation colour " << material.attenuationColor.r << "," << material.attenuationColor.g << ","
+          << material.attenuationColor.b << " over " << material.attenuationDistance << ", thickness " << material.thickness;
+    } else if (material.thickness > 0.0f) {
+      out << ", volume (clear), thickness " << material.thickness;
+    } else {
+      out << ", thin-walled";
+    }
+    if (material.dispersion > 0.0f) {
+      out << ", dispersion " << material.dispersion << " (Abbe number " << 20.0f / material.dispersion << ")";
+    }
+    if (material.iorTexture.present()) {
+      out << ", IOR texture " << material.iorTexture.texture << " (ior + " << material.iorOffset << " + "
+          << material.iorScale << " x red)";
+    }
+    if (material.priority != 0) out << ", priority " << material.priority;
+    out << ", roughness " << material.roughness;
     out << "\n";
   }
   out << "  lights " << scene.lights.size() << (scene.lights.empty() ? " (a headlight will be used)" : "") << "\n";

@@ -2,7 +2,7 @@
 // the surface at a hit, the refraction rules of shared/trace.h and the whole
 // path of one pixel. The including shader declares the buffers of trace.h's
 // bindings (instances, positions, normals, texcoords, indices, materials,
-// textures, texels, lights, outImage, aovs, rays), the push constant `pc`, and
+// textures, texels, lights, environment, outImage, aovs, rays), the push constant `pc`, and
 // defines traceClosest() and firstTriangleOf() after this file.
 #ifndef SNELL_PATH_GLSL
 #define SNELL_PATH_GLSL
@@ -29,6 +29,7 @@ Hit traceClosest(vec3 origin, vec3 dir, uint skipInstance, uint skipPrim, float 
 uint firstTriangleOf(uint instance);
 
 #include "../../common/shading.glsl"
+#include "optics.glsl"
 
 // ------------------------------------------------------------------ shading
 
@@ -50,8 +51,11 @@ Surface surfaceAt(Hit hit) {
   vec3 n2 = vec3(normals[3u * i2], normals[3u * i2 + 1u], normals[3u * i2 + 2u]);
   vec3 ns = hit.bary.x * n0 + hit.bary.y * n1 + hit.bary.z * n2;
   vec3 ng = cross(p1 - p0, p2 - p0);
-  // Object to world; normals by the inverse transpose, i.e. worldToObject's columns.
-  mat3 toWorldNormal = transpose(mat3(inst.worldToObject[0].xyz, inst.worldToObject[1].xyz, inst.worldToObject[2].xyz));
+  // Object to world; normals by the inverse transpose.
+  // worldToObject holds the rows of W^-1, and mat3() takes columns: this is
+  // (W^-1)^T. (It was transposed once more, which is right only when W is
+  // symmetric: rotated instances got their normals turned the wrong way.)
+  mat3 toWorldNormal = mat3(inst.worldToObject[0].xyz, inst.worldToObject[1].xyz, inst.worldToObject[2].xyz);
   Surface s;
   s.position = vec3(dot(inst.objectToWorld[0], vec4(p, 1.0)), dot(inst.objectToWorld[1], vec4(p, 1.0)),
                     dot(inst.objectToWorld[2], vec4(p, 1.0)));
@@ -77,9 +81,160 @@ vec3 offsetRay(vec3 p, vec3 n) {
   return mix(pi, p + kFloatScale * n, lessThan(abs(p), vec3(kOrigin)));
 }
 
-// One pixel's ray (or its listed ray), its whole path, and what it writes.
-void tracePixel(uvec2 pixel) {
+// What one path of a pixel found.
+struct Path {
+  vec3 colour;
+  uint interfaces;
+  uint outcome;
+  float firstDistance;
+  uint firstInstance, firstPrimitive;
+};
 
+// A ray leaving the surface of `hit` at `s` along dir: its offset origin and
+// the distance within which faces are the surface it leaves.
+vec3 leave(Surface s, vec3 dir, out float tMin) {
+  vec3 origin = offsetRay(s.position, dot(dir, s.ng) > 0.0 ? s.ng : -s.ng);
+  // The offset is the hit point's error bound. A face within that distance
+  // of the new origin meets the hit point within its rounding: the surface
+  // the ray leaves, not a new one. Skipping the hit triangle alone let rays
+  // through a cube's edges enter the face across the edge a second time
+  // (bench stress: watertight cube).
+  tMin = length(origin - s.position);
+  return origin;
+}
+
+// One path from (origin, dir) for `channel` (0-2: that channel's IOR; -1: all
+// channels at the base IOR). With channel -1 it stops and returns true at the
+// first dispersive boundary: the pixel is then traced once per channel.
+// A reflected ray is traced by the next pass of the same loop, the path's
+// continuation parked meanwhile: one traversal call site, because compilers
+// that inline (lavapipe's) paid seconds of compile time for a second one.
+bool tracePath(vec3 origin, vec3 dir, int channel, out Path path) {
+  path = Path(vec3(0.0), 0u, kOutcomeMiss, -1.0, kNoHit, kNoHit);
+  bool fresnel = (pc.optics & kOpticsFresnel) != 0u;
+  uint reflections = fresnel ? pc.reflections : 0u;
+  vec3 throughput = vec3(1.0);
+  mediaCount = 0u;
+  uint skipInstance = kNoHit, skipPrim = kNoHit;
+  float tMin = 0.0;
+  bool reflecting = false;  // this pass traces a reflected ray, weighted by `reflectedWeight`
+  vec3 reflectedWeight = vec3(0.0);
+  vec3 parkedOrigin = vec3(0.0), parkedDir = vec3(0.0);
+  float parkedTMin = 0.0;
+  // maxInterfaces + 1 segments of the path at most, and its reflected rays.
+  uint passes = pc.maxInterfaces + 1u + min(reflections, pc.maxInterfaces);
+  bool segmentZero = true;
+  for (uint pass = 0u; pass < passes; ++pass) {
+    Hit hit = traceClosest(origin, dir, skipInstance, skipPrim, tMin);
+    Surface s;
+    GpuMaterial m;
+    bool opaque = false;
+    if (hit.instance != kNoHit) {
+      s = surfaceAt(hit);
+      m = materials[s.material];
+      opaque = m.emissiveFactor.w <= 0.0;
+    }
+    if (reflecting) {  // an opaque face is shaded; a miss or glass sees the environment
+      path.colour += reflectedWeight * (opaque ? phong(s.position, s.ns, s.uvs, m, dir, pc.lightCount, pc.forward.xyz)
+                                               : environmentColour(dir));
+      reflecting = false;
+      origin = parkedOrigin;
+      dir = parkedDir;
+      tMin = parkedTMin;  // the skipped face is the same: the reflection left the face the path leaves
+      continue;
+    }
+    if (hit.instance == kNoHit) {
+      path.colour += throughput * pc.background.rgb;
+      path.outcome = kOutcomeMiss;
+      return false;
+    }
+    int inside = currentMedium();
+    if (inside >= 0) {  // Beer-Lambert over the segment
+      vec4 attenuation = materials[media[inside]].attenuation;
+      if (attenuation.w > 0.0) throughput *= pow(attenuation.rgb, vec3(hit.t / attenuation.w));
+    }
+    if (segmentZero) {
+      segmentZero = false;
+      path.firstDistance = hit.t;
+      path.firstInstance = hit.instance;
+      path.firstPrimitive = hit.primitive - firstTriangleOf(hit.instance);
+    }
+    if (opaque) {
+      path.colour += throughput * phong(s.position, s.ns, s.uvs, m, dir, pc.lightCount, pc.forward.xyz);
+      path.outcome = kOutcomeOpaque;
+      return false;
+    }
+    if (path.interfaces == pc.maxInterfaces) {
+      path.colour += throughput * pc.background.rgb;
+      path.outcome = kOutcomeInterfaceLimit;
+      return false;
+    }
+    bool entering = dot(dir, s.ng) < 0.0;
+    bool boundary;  // a true boundary: the medium changes here
+    float surface = surfaceIor(m, s.uvs, channel);
+    uint other = kNoHit;  // the material of the medium on the far side; kNoHit: air
+    if (entering) {
+      if (inside >= 0) other = media[inside];
+      boundary = inside < 0 || mediumPriority(other) <= m.emissiveUvRow1.w;
+      enterMedium(s.material);
+    } else {
+      int at = leaveMedium(s.material);
+      boundary = at < 0 || at == inside;
+      int outside = currentMedium();
+      if (outside >= 0) other = media[outside];
+    }
+    float otherIor = other == kNoHit ? 1.0 : mediumIor(other, channel);
+    bool dispersive = m.emissiveUvRow0.w > 0.0 || (other != kNoHit && materials[other].emissiveUvRow0.w > 0.0);
+    if (boundary && channel < 0 && dispersive) return true;
+    float n1 = entering ? otherIor : surface, n2 = entering ? surface : otherIor;
+    // Past maxBends the ray crosses glass straight (an approximation's path, not physics).
+    bool bends = boundary && path.interfaces < pc.maxBends;
+    ++path.interfaces;
+    vec3 reflected = vec3(0.0);
+    if (bends) {
+      vec3 n = entering ? s.ns : -s.ns;
+      float eta = n1 / n2;
+      float c = -dot(dir, n);
+      if (c <= 0.0) {
+        n = entering ? s.ng : -s.ng;
+        c = -dot(dir, n);
+      }
+      float k = 1.0 - eta * eta * (1.0 - c * c);
+      if (k < 0.0) {
+        dir = normalize(dir + 2.0 * c * n);  // total internal reflection keeps everything
+      } else {
+        float r = fresnel ? fresnelReflectance(eta, c) : 0.0;
+        if (reflections > 0u) {
+          --reflections;
+          if (r > 0.0) {
+            path.colour += throughput * highlight(s.position, n, dir, m.baseUvRow1.w, eta);
+            reflectedWeight = throughput * r;
+            reflected = normalize(dir + 2.0 * c * n);
+          }
+        }
+        dir = normalize(eta * dir + (eta * c - sqrt(k)) * n);
+        throughput *= 1.0 - r;
+      }
+    }
+    if (boundary) throughput *= baseColour(m, s.uvs);
+    origin = leave(s, dir, tMin);
+    skipInstance = hit.instance;
+    skipPrim = hit.primitive;
+    if (reflected != vec3(0.0)) {  // trace the reflection next, then go on from here
+      parkedOrigin = origin;
+      parkedDir = dir;
+      parkedTMin = tMin;
+      origin = leave(s, reflected, tMin);
+      dir = reflected;
+      reflecting = true;
+    }
+  }
+  return false;
+}
+
+// One pixel's ray (or its listed ray), its path (three where it meets
+// dispersion), and what it writes.
+void tracePixel(uvec2 pixel) {
   float sx = (2.0 * (float(pixel.x) + 0.5) / float(pc.width) - 1.0) * pc.right.w + pc.shiftX;
   float sy = (1.0 - 2.0 * (float(pixel.y) + 0.5) / float(pc.height)) * pc.up.w + pc.shiftY;
   vec3 origin = pc.eye.xyz, dir;
@@ -95,68 +250,29 @@ void tracePixel(uvec2 pixel) {
   }
 
   visits = 0u;
-  vec3 throughput = vec3(1.0);
+  // One call site for the path (a compiler that inlines would copy it per
+  // call): the first pass at the base IOR, then, where it met dispersion,
+  // red, blue and green, each keeping its channel (the AOVs are green's).
+  Path path;
   vec3 colour = vec3(0.0);
-  uint interfaces = 0u;
-  uint outcome = kOutcomeMiss;
-  float firstDistance = -1.0;
-  uint firstInstance = kNoHit, firstPrimitive = kNoHit;
-  uint skipInstance = kNoHit, skipPrim = kNoHit;
-  float tMin = 0.0;
-  // Each pass of the loop is one segment; maxInterfaces + 1 segments at most.
-  for (uint segment = 0u; segment <= pc.maxInterfaces; ++segment) {
-    Hit hit = traceClosest(origin, dir, skipInstance, skipPrim, tMin);
-    if (hit.instance == kNoHit) {
-      colour = throughput * pc.background.rgb;
-      outcome = kOutcomeMiss;
-      break;
+  int channel = -1;
+  for (int pass = 0; pass < 4; ++pass) {
+    bool split = tracePath(origin, dir, channel, path);
+    if (channel < 0) {
+      colour = path.colour;
+      if (!split) break;
+      channel = 0;
+      continue;
     }
-    if (segment == 0u) {
-      firstDistance = hit.t;
-      firstInstance = hit.instance;
-      firstPrimitive = hit.primitive - firstTriangleOf(hit.instance);
-    }
-    Surface s = surfaceAt(hit);
-    GpuMaterial m = materials[s.material];
-    if (m.emissiveFactor.w <= 0.0) {
-      colour = throughput * phong(s.position, s.ns, s.uvs, m, dir, pc.lightCount, pc.forward.xyz);
-      outcome = kOutcomeOpaque;
-      break;
-    }
-    if (interfaces == pc.maxInterfaces) {
-      colour = throughput * pc.background.rgb;
-      outcome = kOutcomeInterfaceLimit;
-      break;
-    }
-    bool entering = dot(dir, s.ng) < 0.0;
-    vec3 n = entering ? s.ns : -s.ns;
-    float ior = m.baseUvRow0.w;
-    float eta = entering ? 1.0 / ior : ior;
-    float c = -dot(dir, n);
-    if (c <= 0.0) {
-      n = entering ? s.ng : -s.ng;
-      c = -dot(dir, n);
-    }
-    float k = 1.0 - eta * eta * (1.0 - c * c);
-    // Past maxBends the ray crosses glass straight (an approximation's path, not physics).
-    if (interfaces < pc.maxBends) dir = normalize(k < 0.0 ? dir + 2.0 * c * n : eta * dir + (eta * c - sqrt(k)) * n);
-    throughput *= baseColour(m, s.uvs);
-    ++interfaces;
-    origin = offsetRay(s.position, dot(dir, s.ng) > 0.0 ? s.ng : -s.ng);
-    // The offset is the hit point's error bound. A face within that distance
-    // of the new origin meets the hit point within its rounding: the surface
-    // the ray leaves, not a new one. Skipping the hit triangle alone let rays
-    // through a cube's edges enter the face across the edge a second time
-    // (bench stress: watertight cube).
-    tMin = length(origin - s.position);
-    skipInstance = hit.instance;
-    skipPrim = hit.primitive;
+    colour[channel] = path.colour[channel];
+    channel = channel == 0 ? 2 : 1;
   }
+  path.colour = colour;
 
-  imageStore(outImage, ivec2(pixel), vec4(colour, 1.0));
+  imageStore(outImage, ivec2(pixel), vec4(path.colour, 1.0));
   if ((pc.flags & kTraceFlagAov) != 0u) {
-    aovs[pixel.y * pc.width + pixel.x] =
-        TraceAov(firstDistance, firstInstance, firstPrimitive, interfaces, outcome, visits, 0u, 0u);
+    aovs[pixel.y * pc.width + pixel.x] = TraceAov(path.firstDistance, path.firstInstance, path.firstPrimitive,
+                                                  path.interfaces, path.outcome, visits, 0u, 0u);
   }
 }
 

@@ -1,0 +1,31 @@
+// How light leaves the glass, beyond the bend: Fresnel, the reflected rays
+// and the environment they see (shaders/shared/trace.h states the rules).
+// Both the GPU frame (render::FrameSettings) and the reference take one.
+#pragma once
+
+#include "shared/trace.h"
+
+#include <glm/glm.hpp>
+
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace snell::scene {
+
+/// An equirectangular environment: linear RGB, row 0 looking up (+Y), the
+/// middle column looking down -Z.
+struct Environment {
+  std::string source;  ///< the file it came from, for messages
+  uint32_t width = 0, height = 0;
+  std::vector<glm::vec3> texels;  ///< width * height
+};
+
+struct Optics {
+  bool fresnel = true;  ///< R and T at every boundary, the reflected ray and the lights' highlights
+  uint32_t reflections = gpu::kDefaultReflections;  ///< boundaries per path that send a reflected ray
+  std::shared_ptr<const Environment> environment;  ///< null: the studio gradient
+};
+
+}  // namespace snell::scene
