@@ -7,6 +7,7 @@
 #   bench/run_frame_on_device.sh tests   # the suite, validation on
 #   bench/run_frame_on_device.sh bench   # bench scale, frame and bvh
 #   bench/run_frame_on_device.sh methods # bench methods at 1920x1080, its chart
+#   bench/run_frame_on_device.sh optics  # each optics feature's cost (1920x1080) and error (320x240), stress grid's optics group
 # Results land in $OUT.
 set -uo pipefail
 for f in .gl/*.deb; do dpkg -x "$f" /; done
@@ -66,4 +67,17 @@ if [[ $step == all || $step == methods ]]; then
     done
   } 2>&1 | grep -v "CPU reference" | tee "$OUT/methods-scaling.log"
   tar -C "$json" -cf "$OUT/methods-results.tar" .
+fi
+if [[ $step == all || $step == optics ]]; then
+  s=.carry/snell
+  json=$(mktemp -d)
+  {
+    echo "== optics features, time at 1920x1080 (no reference)"
+    $s bench methods --optics --size 1920x1080 --frames 12 --no-reference --json "$json/optics-1080.json"
+    echo "== optics features, error against the reference at 320x240"
+    $s bench methods --optics --size 320x240 --frames 12 --json "$json/optics-320.json"
+    echo "== stability grid, optics group, validation on"
+    SNELL_VALIDATION=1 $s bench stress --only optics --json "$json/stress-optics.json"
+  } 2>&1 | grep -v "CPU reference" | tee "$OUT/optics.log"
+  tar -C "$json" -cf "$OUT/optics-results.tar" .
 fi

@@ -99,27 +99,6 @@ scene::Scene prismScene() {
   blue.emissiveFactor = {0.05f, 0.1f, 0.6f};
   green.emissiveFactor = {0.1f, 0.4f, 0.1f};
   s.materials = {glass, red, blue, green};
-  auto addShape = [&](std::vector<glm::vec3> p, std::vector<uint32_t> idx, int material) {
-    scene::Shape shape;
-    shape.name = "shape" + std::to_string(s.shapes.size());
-    shape.material = material;
-    shape.positions = p;
-    shape.indices = idx;
-    shape.normals.assign(p.size(), glm::vec3(0.0f));
-    for (size_t t = 0; t + 2 < idx.size(); t += 3) {  // flat shading: faces share no vertices
-      glm::vec3 n = glm::normalize(glm::cross(p[idx[t + 1]] - p[idx[t]], p[idx[t + 2]] - p[idx[t]]));
-      for (int k = 0; k < 3; ++k) shape.normals[idx[t + size_t(k)]] = n;
-    }
-    int index = int(s.shapes.size());
-    s.shapes.push_back(shape);
-    scene::Mesh mesh;
-    mesh.shapes = {index};
-    s.meshes.push_back(mesh);
-    scene::Node node;
-    node.mesh = int(s.meshes.size()) - 1;
-    s.nodes.push_back(node);
-    s.roots.push_back(int(s.nodes.size()) - 1);
-  };
   // Prism: right angle at (0,0) in xz, legs along +x and +z, extruded along y.
   std::vector<glm::vec3> corners = {{0, -1, 0}, {2, -1, 0}, {0, -1, 2}, {0, 1, 0}, {2, 1, 0}, {0, 1, 2}};
   auto quad = [&](int a, int b, int c, int d, std::vector<glm::vec3>& p, std::vector<uint32_t>& idx) {
@@ -137,11 +116,11 @@ scene::Scene prismScene() {
   uint32_t base = uint32_t(p.size());
   for (int v : {0, 1, 2, 3, 5, 4}) p.push_back(corners[size_t(v)]);
   idx.insert(idx.end(), {base, base + 1, base + 2, base + 3, base + 4, base + 5});  // caps
-  addShape(p, idx, 0);
+  addFlatShape(s, p, idx, 0);
   // Walls: red behind the camera's left (where reflected rays go), blue far behind, green floor.
-  addShape({{-6, -3, -1}, {-6, -3, 5}, {-6, 3, 5}, {-6, 3, -1}}, {0, 1, 2, 0, 2, 3}, 1);
-  addShape({{-6, -3, 8}, {6, -3, 8}, {6, 3, 8}, {-6, 3, 8}}, {0, 2, 1, 0, 3, 2}, 2);
-  addShape({{-6, -3, -8}, {6, -3, -8}, {6, -3, 8}, {-6, -3, 8}}, {0, 2, 1, 0, 3, 2}, 3);
+  addFlatShape(s, {{-6, -3, -1}, {-6, -3, 5}, {-6, 3, 5}, {-6, 3, -1}}, {0, 1, 2, 0, 2, 3}, 1);
+  addFlatShape(s, {{-6, -3, 8}, {6, -3, 8}, {6, 3, 8}, {-6, 3, 8}}, {0, 2, 1, 0, 3, 2}, 2);
+  addFlatShape(s, {{-6, -3, -8}, {6, -3, -8}, {6, -3, 8}, {-6, -3, 8}}, {0, 2, 1, 0, 3, 2}, 3);
   scene::Light light;
   light.type = scene::LightType::Directional;
   light.intensity = 2.0f;

@@ -37,6 +37,7 @@ TEST_P(StressGrid, GpuAgreesWithTheReferenceWithoutNanLeakOrSelfHit) {
   EXPECT_EQ(r.leakCount, 0u);
   EXPECT_EQ(r.selfHitCount, 0u);
   EXPECT_EQ(r.capHits, 0u);
+  EXPECT_LE(r.energyError, 1e-6) << "|R + T - 1| at a boundary, in the reference";
   EXPECT_LE(r.maxError, c.maxError) << "largest channel error, 1/255";
   EXPECT_LE(double(r.overOne), c.overOneShare * double(r.pixels)) << r.overOne << " of " << r.pixels << " pixels over 1/255";
   if (c.expectDropped >= 0) {

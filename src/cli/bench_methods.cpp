@@ -11,6 +11,7 @@
 #include "scene/gltf_loader.h"
 #include "scene/procedural_eye.h"
 #include "scene/view.h"
+#include "stress/stress.h"
 
 #include <glm/gtc/constants.hpp>
 
@@ -18,7 +19,9 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <functional>
 #include <limits>
+#include <optional>
 #include <map>
 #include <memory>
 #include <sstream>
@@ -54,6 +57,15 @@ has it (not lavapipe: reported unsupported). For it the table adds the share
 of pixels whose first hit (instance, triangle) agrees with trace's, and its
 build (first frame), update and trace times.
 
+With --optics the rows are not methods but the optics features, each drawn
+by trace on its own copy of the scene against its own reference: "plain"
+(no Fresnel: the bend only), "fresnel" (the default: Fresnel, one reflected
+ray, the lights' highlights, the studio gradient), "environment" (an HDR sky
+instead of the gradient), "reflections-4", and on every transmissive
+material "volume" (Beer-Lambert), "dispersion" (Abbe number 20: three rays
+where it applies), "ior-texture" (the scene's first texture as IOR, scale
+0.05); for the procedural eye "aqueous" (nested media), and "all" of them.
+
 options:
   --size WxH          image size (default 320x240)
   --frames N          frames of the sequence (default 24)
@@ -62,6 +74,7 @@ options:
   --offset-strength S normal-offset's displacement in image heights (0.02)
   --eye-resolution N  segments of the procedural eye (default 64)
   --crowd N           N characters' eye pairs instead of one eye
+  --optics            rows per optics feature (trace) instead of per method
   --no-reference      time only: no CPU reference, no errors (for scaling runs)
   --json FILE         write the results as JSON
   --svg FILE          write a chart of time against error (log-log, the
@@ -90,8 +103,14 @@ struct Frame {
   std::vector<bool> transmissive;  ///< the reference's first hit is a refractive face
 };
 
+// One row of the table: a method, or with --optics one optics feature drawn
+// by trace. Rows that share a scene and optics share their frames.
 struct MethodResult {
   render::MethodInfo info;
+  std::string name, summary;
+  const scene::Scene* scene = nullptr;
+  scene::Optics optics;
+  std::shared_ptr<const std::vector<Frame>> frames;
   std::string unsupported;  ///< why the method did not run here (empty: it ran)
   std::vector<double> refractionMs;
   std::map<std::string, std::vector<double>> passMs;  ///< per pass, measured frames
@@ -222,7 +241,7 @@ std::string chartSvg(const std::vector<MethodResult>& results, const std::string
   for (const MethodResult& r : results) {
     if (!r.unsupported.empty()) continue;
     double t = median(r.refractionMs), e = r.glass.rmse();
-    std::string label = r.info.name;
+    std::string label = r.name;
     if (t <= 0) label += " (no work)";
     if (e <= 0) label += " (exact)";
     double lx = px(t) + 8, ly = py(e) - 6;
@@ -234,12 +253,109 @@ std::string chartSvg(const std::vector<MethodResult>& results, const std::string
     }
     placed.emplace_back(lx, ly);
     svg << "<circle cx=\"" << px(t) << "\" cy=\"" << py(e) << "\" r=\"5\" fill=\"#2468a8\"><title>"
-        << xmlEscape(r.info.summary) << "</title></circle><text x=\"" << lx << "\" y=\"" << ly << "\">"
+        << xmlEscape(r.summary) << "</title></circle><text x=\"" << lx << "\" y=\"" << ly << "\">"
         << xmlEscape(label) << "</text>\n";
   }
   svg << "<text x=\"" << width - right + 10 << "\" y=\"" << top + 10
       << "\" fill=\"#c33\">- - Pareto front</text>\n</svg>\n";
   return svg.str();
+}
+
+// ------------------------------------------------------------------ sequence
+
+struct SequenceSettings {
+  uint32_t width, height, frames, maxInterfaces;
+  float offsetStrength;
+  bool reference;
+  std::string images;  ///< where the last frame's reference goes as PNG (empty: nowhere)
+};
+
+// The animated sequence of one scene, with the reference image of each frame
+// under `optics` (unless the run has no reference).
+std::shared_ptr<const std::vector<Frame>> makeFrames(const scene::Scene& scene, const scene::Optics& optics,
+                                                     const SequenceSettings& s, const std::string& imageName,
+                                                     std::chrono::steady_clock::time_point began) {
+  double duration = scene::animationDuration(scene);
+  scene::Pose first = scene::evaluate(scene, 0.0);
+  scene::View start = scene::resolveView(scene, first, scene::ViewRequest{});
+  auto frames = std::make_shared<std::vector<Frame>>(s.frames);
+  for (uint32_t f = 0; f < s.frames; ++f) {
+    Frame& frame = (*frames)[f];
+    double along = s.frames > 1 ? double(f) / double(s.frames - 1) : 0.0;
+    frame.time = duration * along;
+    frame.pose = scene::evaluate(scene, frame.time);
+    frame.view = orbitView(scene, frame.pose, start, glm::radians(80.0) * along);
+    // Fitted once here, so the timed loop does no work per triangle on the host.
+    glm::dvec3 lo, hi;
+    scene::sceneBounds(scene, frame.pose, lo, hi);
+    frame.raster.offsetStrength = s.offsetStrength;
+    render::fitDepthRange(frame.view, lo, hi, frame.raster);
+    if (!s.reference) continue;
+    ref::ReferenceSettings settings;
+    settings.width = s.width;
+    settings.height = s.height;
+    settings.view = frame.view;
+    settings.maxInterfaces = s.maxInterfaces;
+    settings.optics = optics;
+    ref::ReferenceImage reference = ref::renderReference(scene, frame.pose, settings);
+    LinearImage linear{s.width, s.height, {}};
+    frame.transmissive.resize(reference.color.size());
+    for (size_t i = 0; i < reference.color.size(); ++i) {
+      linear.rgba.emplace_back(glm::vec3(reference.color[i]), 1.0f);
+      int item = reference.instance[i];
+      if (item < 0) continue;
+      int shape = frame.pose.items[size_t(item)].shape;
+      int material = scene.shapes[size_t(shape)].material;
+      frame.transmissive[i] = material >= 0 && scene.materials[size_t(material)].refractive();
+    }
+    frame.reference = toSrgb8(linear);
+    if (!s.images.empty() && f + 1 == s.frames) writeImage(s.images + "/" + imageName + ".png", linear);
+    double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - began).count();
+    std::fprintf(stderr, "\rCPU reference (%s): frame %u/%u, %.1f s   ", imageName.c_str(), f + 1, s.frames, seconds);
+  }
+  return frames;
+}
+
+// ------------------------------------------------------------------ optics rows
+
+struct OpticsVariant {
+  std::string name, summary;
+  scene::Scene scene;
+  scene::Optics optics;
+};
+
+std::vector<OpticsVariant> opticsVariants(const scene::Scene& scene, const std::optional<scene::EyeOptions>& eye) {
+  scene::Optics plain, fresnel, environment, reflections;
+  plain.fresnel = false;
+  environment.environment = std::make_shared<scene::Environment>(scene::proceduralSky());
+  reflections.reflections = 4;
+  using stress::withGlass;
+  auto volume = [](scene::Material& m) { stress::addVolume(m, 0.004f); };  // 4 mm: the eye's scale
+  auto iorTexture = [&](scene::Material& m) {
+    if (!scene.textures.empty()) stress::addIorTexture(m, 0);
+  };
+  std::vector<OpticsVariant> rows = {
+      {"plain", "no Fresnel: the bend only", scene, plain},
+      {"fresnel", "Fresnel, one reflected ray, highlights, studio gradient (the default)", scene, fresnel},
+      {"environment", "the reflected ray sees a 1024x512 HDR sky with a sun", scene, environment},
+      {"reflections-4", "four boundaries per path send a reflected ray", scene, reflections},
+      {"volume", "Beer-Lambert inside every transmissive material", withGlass(scene, volume), fresnel},
+      {"dispersion", "Abbe number 20 on every transmissive material: three rays there", withGlass(scene, stress::addDispersion),
+       fresnel},
+  };
+  if (!scene.textures.empty()) {
+    rows.push_back({"ior-texture", "IOR + 0.05 x the scene's first texture", withGlass(scene, iorTexture), fresnel});
+  }
+  scene::Scene all = withGlass(scene, [&](scene::Material& m) { volume(m), stress::addDispersion(m), iorTexture(m); });
+  if (eye) {
+    scene::EyeOptions nested = *eye;
+    nested.aqueous = true;
+    rows.push_back({"aqueous", "the aqueous humour nested in the cornea (priorities)", scene::makeEye(nested), fresnel});
+    all = withGlass(scene::makeEye(nested), [&](scene::Material& m) { volume(m), stress::addDispersion(m), iorTexture(m); });
+  }
+  rows.push_back({"all", "every feature above at once", std::move(all), environment});
+  rows.back().optics.reflections = 4;
+  return rows;
 }
 
 }  // namespace
@@ -249,7 +365,7 @@ int runBenchMethods(const Args& args) {
   float offsetStrength = render::RasterOptions{}.offsetStrength;
   std::string file, json, svg, images;
   scene::EyeOptions eye;
-  bool reference = true;
+  bool reference = true, optics = false;
   std::vector<render::MethodInfo> chosen = render::methods();
   for (size_t i = 0; i < args.size(); ++i) {
     const std::string& a = args[i];
@@ -261,8 +377,9 @@ int runBenchMethods(const Args& args) {
       file = a;
       continue;
     }
-    if (a == "--no-reference") {
-      reference = false;
+    if (a == "--no-reference" || a == "--optics") {
+      reference = reference && a != "--no-reference";
+      optics = optics || a == "--optics";
       continue;
     }
     if (i + 1 >= args.size()) throw UsageError{"bench methods: " + a + " needs a value (or is unknown)"};
@@ -320,69 +437,55 @@ int runBenchMethods(const Args& args) {
   std::printf("device: %s\nscene: %s, %ux%u, %u frames\n", context->facts().name.c_str(), label.c_str(), width, height,
               frameCount);
 
-  // The sequence and its reference images, once for every method.
-  double duration = scene::animationDuration(scene);
-  scene::Pose first = scene::evaluate(scene, 0.0);
-  scene::View start = scene::resolveView(scene, first, scene::ViewRequest{});
-  std::vector<Frame> frames(frameCount);
-  auto began = std::chrono::steady_clock::now();
-  for (uint32_t f = 0; f < frameCount; ++f) {
-    Frame& frame = frames[f];
-    double along = frameCount > 1 ? double(f) / double(frameCount - 1) : 0.0;
-    frame.time = duration * along;
-    frame.pose = scene::evaluate(scene, frame.time);
-    frame.view = orbitView(scene, frame.pose, start, glm::radians(80.0) * along);
-    // Fitted once here, so the timed loop does no work per triangle on the host.
-    glm::dvec3 lo, hi;
-    scene::sceneBounds(scene, frame.pose, lo, hi);
-    frame.raster.offsetStrength = offsetStrength;
-    render::fitDepthRange(frame.view, lo, hi, frame.raster);
-    if (!reference) continue;
-    ref::ReferenceSettings settings;
-    settings.width = width;
-    settings.height = height;
-    settings.view = frame.view;
-    settings.maxInterfaces = maxInterfaces;
-    ref::ReferenceImage reference = ref::renderReference(scene, frame.pose, settings);
-    LinearImage linear{width, height, {}};
-    frame.transmissive.resize(reference.color.size());
-    for (size_t i = 0; i < reference.color.size(); ++i) {
-      linear.rgba.emplace_back(glm::vec3(reference.color[i]), 1.0f);
-      int item = reference.instance[i];
-      if (item < 0) continue;
-      int shape = frame.pose.items[size_t(item)].shape;
-      int material = scene.shapes[size_t(shape)].material;
-      frame.transmissive[i] = material >= 0 && scene.materials[size_t(material)].refractive();
-    }
-    frame.reference = toSrgb8(linear);
-    if (!images.empty() && f + 1 == frameCount) writeImage(images + "/reference.png", linear);
-    double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - began).count();
-    std::fprintf(stderr, "\rCPU reference: frame %u/%u, %.1f s", f + 1, frameCount, seconds);
+  // The rows: every chosen method on the scene as it is, or (--optics) trace
+  // on each optics variant. Frames and references are made once per variant.
+  std::vector<OpticsVariant> variants;
+  if (optics) {
+    variants = opticsVariants(scene, file.empty() ? std::optional<scene::EyeOptions>(eye) : std::nullopt);
+    auto trace = std::find_if(render::methods().begin(), render::methods().end(),
+                              [](const render::MethodInfo& m) { return m.method == render::Method::Trace; });
+    chosen.assign(variants.size(), *trace);
   }
-  std::fputc('\n', stderr);
-
-  // One renderer per method, all alive at once, so the timing can take the
-  // methods in turn on every frame: whatever the GPU's clocks do, they do it
-  // to every method alike, and the ratios stand.
   std::vector<MethodResult> results(chosen.size());
-  std::vector<std::unique_ptr<render::Renderer>> renderers(chosen.size());
+  SequenceSettings sequence{width, height, frameCount, maxInterfaces, offsetStrength, reference, images};
+  auto began = std::chrono::steady_clock::now();
   for (size_t m = 0; m < chosen.size(); ++m) {
-    results[m].info = chosen[m];
-    if (render::needsDriverRayTracing(chosen[m].method) && !context->caps().driverRayTracing) {
+    MethodResult& r = results[m];
+    r.info = chosen[m];
+    r.name = optics ? variants[m].name : chosen[m].name;
+    r.summary = optics ? variants[m].summary : chosen[m].summary;
+    r.scene = optics ? &variants[m].scene : &scene;
+    r.optics = optics ? variants[m].optics : scene::Optics{};
+    if (m == 0 || optics) {
+      r.frames = makeFrames(*r.scene, r.optics, sequence, optics ? "reference-" + r.name : "reference", began);
+    } else {
+      r.frames = results[0].frames;
+    }
+  }
+  if (reference) std::fputc('\n', stderr);
+
+  // One renderer per row, all alive at once, so the timing can take the rows
+  // in turn on every frame: whatever the GPU's clocks do, they do it to every
+  // row alike, and the ratios stand.
+  std::vector<std::unique_ptr<render::Renderer>> renderers(results.size());
+  for (size_t m = 0; m < results.size(); ++m) {
+    if (render::needsDriverRayTracing(results[m].info.method) && !context->caps().driverRayTracing) {
       results[m].unsupported = "this device offers no ray tracing pipelines (VK_KHR_ray_tracing_pipeline)";
-      std::printf("%s: unsupported: %s\n", chosen[m].name, results[m].unsupported.c_str());
+      std::printf("%s: unsupported: %s\n", results[m].name.c_str(), results[m].unsupported.c_str());
       continue;
     }
-    renderers[m] = std::make_unique<render::Renderer>(*context, scene, first);
+    renderers[m] = std::make_unique<render::Renderer>(*context, *results[m].scene, results[m].frames->at(0).pose);
   }
   auto hitsOf = [](render::Method method) {
     return method == render::Method::Trace || method == render::Method::DriverRt;
   };
-  auto request = [&](render::Method method, const Frame& frame, bool readback) {
+  auto request = [&](const MethodResult& row, uint32_t f, bool readback) {
+    const Frame& frame = row.frames->at(f);
     render::FrameSettings settings{width, height, frame.view, glm::vec3(0.02f, 0.02f, 0.025f), maxInterfaces};
-    render::ViewRequest view = render::methodView(method, settings, frame.raster);
+    settings.optics = row.optics;
+    render::ViewRequest view = render::methodView(row.info.method, settings, frame.raster);
     view.readback = readback;
-    view.aov = readback && hitsOf(method);
+    view.aov = readback && hitsOf(row.info.method);
     render::FrameRequest r;
     r.pose = &frame.pose;
     r.views.push_back(view);
@@ -399,21 +502,21 @@ int runBenchMethods(const Args& args) {
     result.refractionMs.push_back(ms);
   };
   // The first frame builds the trees and the pipelines: reported, not timed.
-  for (size_t m = 0; m < chosen.size(); ++m) {
+  for (size_t m = 0; m < results.size(); ++m) {
     if (!renderers[m]) continue;
-    for (const vk::PassTime& p : renderers[m]->wait(renderers[m]->submit(request(chosen[m].method, frames[0], false))).passes) {
+    for (const vk::PassTime& p : renderers[m]->wait(renderers[m]->submit(request(results[m], 0, false))).passes) {
       results[m].firstFrameMs[p.name] += p.milliseconds;
     }
   }
   // Timing: one round to warm up, then kTimingRounds measured, each frame
-  // drawn by every method in turn, two frames in flight per renderer and
+  // drawn by every row in turn, two frames in flight per renderer and
   // nothing read back, as a viewer runs.
-  std::vector<uint64_t> previous(chosen.size(), 0);
+  std::vector<uint64_t> previous(results.size(), 0);
   for (uint32_t round = 0; round <= kTimingRounds; ++round) {
     for (uint32_t f = 0; f < frameCount; ++f) {
-      for (size_t m = 0; m < chosen.size(); ++m) {
+      for (size_t m = 0; m < results.size(); ++m) {
         if (!renderers[m]) continue;
-        uint64_t id = renderers[m]->submit(request(chosen[m].method, frames[f], false));
+        uint64_t id = renderers[m]->submit(request(results[m], f, false));
         if (previous[m]) {
           const render::FrameResult& out = renderers[m]->wait(previous[m]);
           if (round > 0) timed(results[m], out);
@@ -422,29 +525,29 @@ int runBenchMethods(const Args& args) {
       }
     }
   }
-  for (size_t m = 0; m < chosen.size(); ++m) {
+  for (size_t m = 0; m < results.size(); ++m) {
     if (renderers[m]) timed(results[m], renderers[m]->wait(previous[m]));
   }
-  // Errors: every frame once more, read back, all methods on one frame before
+  // Errors: every frame once more, read back, all rows on one frame before
   // the next, so only that frame's first hits are kept for the comparison.
   for (uint32_t f = 0; f < frameCount; ++f) {
-    const Frame& frame = frames[f];
     std::vector<std::pair<uint32_t, uint32_t>> traceHits, driverHits;
     MethodResult* driver = nullptr;
-    for (size_t m = 0; m < chosen.size(); ++m) {
+    for (size_t m = 0; m < results.size(); ++m) {
       if (!renderers[m]) continue;
       MethodResult& result = results[m];
-      render::Method method = chosen[m].method;
-      const render::FrameResult& out = renderers[m]->wait(renderers[m]->submit(request(method, frame, true)));
+      const Frame& frame = result.frames->at(f);
+      render::Method method = result.info.method;
+      const render::FrameResult& out = renderers[m]->wait(renderers[m]->submit(request(result, f, true)));
       const render::ViewPixels& pixels = out.views.at(0);
-      if (hitsOf(method)) {
+      if (hitsOf(method) && !optics) {
         std::vector<std::pair<uint32_t, uint32_t>>& hits = method == render::Method::Trace ? traceHits : driverHits;
         for (const gpu::TraceAov& a : pixels.aov) hits.emplace_back(a.instance, a.primitive);
         if (method == render::Method::DriverRt) driver = &result;
       }
       LinearImage image{width, height, render::drawsComposite(method) ? pixels.composite : pixels.trace};
       if (reference) accumulate(toSrgb8(image), frame, result.glass, result.image, result.worstFrameWithin1);
-      if (!images.empty() && f + 1 == frameCount) writeImage(images + "/" + result.info.name + ".png", image);
+      if (!images.empty() && f + 1 == frameCount) writeImage(images + "/" + result.name + ".png", image);
       if (f + 1 == frameCount) result.memoryBytes = renderers[m]->memoryBytes();
     }
     if (driver && traceHits.size() == driverHits.size()) {
@@ -457,10 +560,10 @@ int runBenchMethods(const Args& args) {
               ">1/255", ">8/255", "max", "image RMSE", ">1/255", ">8/255", "worst frame", "GPU MiB");
   for (const MethodResult& r : results) {
     if (!r.unsupported.empty()) {
-      std::printf("%-14s unsupported here\n", r.info.name);
+      std::printf("%-14s unsupported here\n", r.name.c_str());
       continue;
     }
-    std::printf("%-14s %10.4f %10.5f %8.3f%% %8.3f%% %5d %10.5f %8.3f%% %8.3f%% %11.3f%% %10.2f\n", r.info.name,
+    std::printf("%-14s %10.4f %10.5f %8.3f%% %8.3f%% %5d %10.5f %8.3f%% %8.3f%% %11.3f%% %10.2f\n", r.name.c_str(),
                 median(r.refractionMs), r.glass.rmse(), 100 * r.glass.share(r.glass.over1),
                 100 * r.glass.share(r.glass.over8), r.glass.maximum, r.image.rmse(), 100 * r.image.share(r.image.over1),
                 100 * r.image.share(r.image.over8), 100 * r.worstFrameWithin1, double(r.memoryBytes) / 1048576.0);
@@ -472,7 +575,7 @@ int runBenchMethods(const Args& args) {
   for (const MethodResult& r : results) {
     bool peer = r.info.method == render::Method::Trace || r.info.method == render::Method::DriverRt;
     if (!peer || !r.unsupported.empty()) continue;
-    std::printf("\n%s passes, ms (first frame / median of the others):", r.info.name);
+    std::printf("\n%s passes, ms (first frame / median of the others):", r.name.c_str());
     std::map<std::string, int> names;  // every pass of any frame
     for (const auto& entry : r.firstFrameMs) names[entry.first] = 1;
     for (const auto& entry : r.passMs) names[entry.first] = 1;
@@ -488,6 +591,19 @@ int runBenchMethods(const Args& args) {
     }
   }
   std::printf("\n");
+  if (optics) {
+    // Each feature's price: the trace pass against the plain bend's, same frames, same run.
+    auto traceMs = [](const MethodResult& r) {
+      auto it = r.passMs.find("trace");
+      return it == r.passMs.end() ? 0.0 : median(it->second);
+    };
+    double plain = traceMs(results.at(0));
+    std::printf("\n%-14s %10s %10s   %s\n", "optics", "trace ms", "x plain", "what the row adds");
+    for (const MethodResult& r : results) {
+      std::printf("%-14s %10.4f %10.2f   %s\n", r.name.c_str(), traceMs(r), plain > 0 ? traceMs(r) / plain : 0.0,
+                  r.summary.c_str());
+    }
+  }
   const MethodResult *traced = nullptr, *driver = nullptr;
   for (const MethodResult& r : results) {
     if (r.info.method == render::Method::Trace) traced = &r;
@@ -515,15 +631,15 @@ int runBenchMethods(const Args& args) {
     };
     out << "{\n  \"device\": \"" << jsonEscape(context->facts().name) << "\",\n  \"scene\": \"" << jsonEscape(label)
         << "\",\n  \"width\": " << width << ",\n  \"height\": " << height << ",\n  \"frames\": " << frameCount
-        << ",\n  \"methods\": [\n";
+        << ",\n  \"rows\": \"" << (optics ? "optics features, drawn by trace" : "methods") << "\",\n  \"methods\": [\n";
     for (size_t i = 0; i < results.size(); ++i) {
       const MethodResult& r = results[i];
       if (!r.unsupported.empty()) {
-        out << "    {\"method\": \"" << r.info.name << "\", \"unsupported\": \"" << jsonEscape(r.unsupported) << "\"}"
+        out << "    {\"method\": \"" << r.name << "\", \"unsupported\": \"" << jsonEscape(r.unsupported) << "\"}"
             << (i + 1 < results.size() ? "," : "") << "\n";
         continue;
       }
-      out << "    {\"method\": \"" << r.info.name << "\", \"passes_median_ms\": {";
+      out << "    {\"method\": \"" << r.name << "\", \"passes_median_ms\": {";
       bool comma = false;
       for (const auto& [name, v] : r.passMs) out << (comma ? ", " : "") << "\"" << name << "\": " << median(v), comma = true;
       out << "}, \"first_frame_ms\": {";
@@ -531,7 +647,7 @@ int runBenchMethods(const Args& args) {
       for (const auto& [name, v] : r.firstFrameMs) out << (comma ? ", " : "") << "\"" << name << "\": " << v, comma = true;
       out << "}, \"first_hits_agreeing_with_trace\": "
           << (r.hitsCompared ? double(r.hitsAgreeing) / double(r.hitsCompared) : -1.0);
-      out << ", \"summary\": \"" << jsonEscape(r.info.summary)
+      out << ", \"summary\": \"" << jsonEscape(r.summary)
           << "\", \"refraction_median_ms\": " << median(r.refractionMs) << ", \"glass\": " << errorJson(r.glass)
           << ", \"image\": " << errorJson(r.image) << ", \"worst_frame_within_1\": " << r.worstFrameWithin1
           << ", \"memory_bytes\": " << r.memoryBytes << "}" << (i + 1 < results.size() ? "," : "") << "\n";

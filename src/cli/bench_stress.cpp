@@ -17,7 +17,9 @@ double-precision reference and compares them: the eye far from the origin
 and at extreme scales, grazing views, cornea IORs from 0.75 to 4, total
 internal reflection, rays aimed exactly at shared edges and vertices of
 closed meshes, thin slabs down to 1e-5, degenerate and non-finite triangles,
-a deformation squashed to 1% and turned inside out, and odd image sizes.
+a deformation squashed to 1% and turned inside out, odd image sizes, and
+every optics feature (Fresnel, sky, volume, dispersion, IOR texture, nested
+media) alone and together.
 
   --size WxH   image cases' size (default 96x72)
   --rays N     aimed-ray cases trace N x N rays (default 1024: about 10^6)
@@ -30,7 +32,9 @@ Columns: max and mean channel error against the reference (sRGB, 1/255),
 pixels more than 1/255 off, NaN pixels, leaks (aimed rays that slipped
 between triangles or never left a closed mesh), self-hits (more crossings
 than the reference), rays that hit the traversal's step cap, triangles the
-GPU dropped as non-finite. Exits 1 when any case leaks, self-hits or NaNs.
+GPU dropped as non-finite, and |R+T-1|: the reference's largest energy
+error at any boundary (T from the Fresnel amplitudes, not 1 - R). Exits 1
+when any case leaks, self-hits or NaNs, or an energy error passes 1e-6.
 )";
 
 std::string jsonString(const std::string& s) {
@@ -70,8 +74,8 @@ int runBenchStress(const Args& args) {
   }
   auto context = vk::Context::create(contextDescFromEnvironment());
   std::printf("device: %s\n", context->facts().name.c_str());
-  std::printf("%-58s %8s %6s %7s %7s %5s %6s %6s %6s %7s %7s\n", "case", "pixels", "max", "mean", ">1/255", "NaN",
-              "leaks", "self", "caps", "dropped", "seconds");
+  std::printf("%-58s %8s %6s %7s %7s %5s %6s %6s %6s %7s %7s %8s\n", "case", "pixels", "max", "mean", ">1/255", "NaN",
+              "leaks", "self", "caps", "dropped", "seconds", "|R+T-1|");
   std::vector<stress::Result> results;
   bool bad = false;
   for (const stress::Case& c : stress::grid(options)) {
@@ -80,14 +84,14 @@ int runBenchStress(const Args& args) {
     if (!r.error.empty()) {
       std::printf("%-58.58s error: %s\n", r.name.c_str(), r.error.c_str());
     } else {
-      std::printf("%-58.58s %8llu %6d %7.3f %7llu %5llu %6llu %6llu %6llu %7llu %7.1f\n", r.name.c_str(),
+      std::printf("%-58.58s %8llu %6d %7.3f %7llu %5llu %6llu %6llu %6llu %7llu %7.1f %8.1e\n", r.name.c_str(),
                   (unsigned long long)r.pixels, r.maxError, r.meanError, (unsigned long long)r.overOne,
                   (unsigned long long)r.nanCount, (unsigned long long)r.leakCount, (unsigned long long)r.selfHitCount,
-                  (unsigned long long)r.capHits, (unsigned long long)r.dropped, r.seconds);
+                  (unsigned long long)r.capHits, (unsigned long long)r.dropped, r.seconds, r.energyError);
     }
     if (verbose && !r.firstProblems.empty()) std::fputs(r.firstProblems.c_str(), stdout);
     std::fflush(stdout);
-    bad = bad || r.nanCount || r.leakCount || r.selfHitCount;
+    bad = bad || r.nanCount || r.leakCount || r.selfHitCount || r.energyError > 1e-6;
     results.push_back(r);
   }
   if (!json.empty()) {
@@ -102,7 +106,7 @@ int runBenchStress(const Args& args) {
             << ", \"max_error\": " << r.maxError << ", \"mean_error\": " << r.meanError
             << ", \"over_one\": " << r.overOne << ", \"nan_count\": " << r.nanCount
             << ", \"leak_count\": " << r.leakCount << ", \"self_hit_count\": " << r.selfHitCount
-            << ", \"cap_hits\": " << r.capHits << ", \"dropped_triangles\": " << r.dropped
+            << ", \"cap_hits\": " << r.capHits << ", \"energy_error\": " << r.energyError << ", \"dropped_triangles\": " << r.dropped
             << ", \"error\": " << jsonString(r.error) << ", \"seconds\": " << r.seconds << "}"
             << (i + 1 < results.size() ? "," : "") << "\n";
       }

@@ -668,6 +668,15 @@ struct Tracer {
     return channelIor(m.baseIor, m.dispersion, channel);
   }
 
+  /// The point a hit lands on and its shading normal, turned to the
+  /// geometric normal's side (the geometric normal where the shading one is 0).
+  static void surfaceAt(const TriangleData& tri, double b0, double b1, double b2, glm::dvec3& p, glm::dvec3& ns) {
+    p = b0 * tri.v[0] + b1 * tri.v[1] + b2 * tri.v[2];
+    ns = unitOrZero(b0 * tri.n[0] + b1 * tri.n[1] + b2 * tri.n[2]);
+    if (ns == glm::dvec3(0.0)) ns = tri.ng;
+    if (glm::dot(ns, tri.ng) < 0.0) ns = -ns;
+  }
+
   /// What a reflected ray from p sees: the opaque face it meets, else the environment.
   glm::dvec3 reflected(const glm::dvec3& p, const glm::dvec3& d, uint32_t from) const {
     Hit hit = prepared.intersect(p, d, tMinFrom(p), from);
@@ -676,10 +685,8 @@ struct Tracer {
       const ResolvedMaterial& m = prepared.material(tri.material);
       if (!m.refractive) {
         const double b1 = hit.b1, b2 = hit.b2, b0 = 1.0 - b1 - b2;
-        glm::dvec3 ns = unitOrZero(b0 * tri.n[0] + b1 * tri.n[1] + b2 * tri.n[2]);
-        if (ns == glm::dvec3(0.0)) ns = tri.ng;
-        if (glm::dot(ns, tri.ng) < 0.0) ns = -ns;
-        const glm::dvec3 q = b0 * tri.v[0] + b1 * tri.v[1] + b2 * tri.v[2];
+        glm::dvec3 q, ns;
+        surfaceAt(tri, b0, b1, b2, q, ns);
         return shadeOpaque(prepared, q, ns, d, m.baseFactor * textureColor(m.base, tri, b0, b1, b2),
                            m.emissiveFactor * textureColor(m.emissive, tri, b0, b1, b2));
       }
@@ -719,11 +726,9 @@ struct Tracer {
         result.primitive = tri.primitive;
       }
       const double b1 = hit.b1, b2 = hit.b2, b0 = 1.0 - b1 - b2;
-      const glm::dvec3 p = b0 * tri.v[0] + b1 * tri.v[1] + b2 * tri.v[2];
       const glm::dvec3& ng = tri.ng;
-      glm::dvec3 ns = unitOrZero(b0 * tri.n[0] + b1 * tri.n[1] + b2 * tri.n[2]);
-      if (ns == glm::dvec3(0.0)) ns = ng;
-      if (glm::dot(ns, ng) < 0.0) ns = -ns;
+      glm::dvec3 p, ns;
+      surfaceAt(tri, b0, b1, b2, p, ns);
 
       const ResolvedMaterial& material = prepared.material(tri.material);
       const glm::dvec3 base = material.baseFactor * textureColor(material.base, tri, b0, b1, b2);

@@ -22,6 +22,11 @@ struct Environment {
   std::vector<glm::vec3> texels;  ///< width * height
 };
 
+/// A small HDR sky for tests and benchmarks: blue above, grey ground below,
+/// and a sun 40 times brighter than the sky, low in front (+Z, up, right), so
+/// the reflected rays carry a catch light of their own. `width` x width/2 texels.
+Environment proceduralSky(uint32_t width = 1024);
+
 struct Optics {
   bool fresnel = true;  ///< R and T at every boundary, the reflected ray and the lights' highlights
   uint32_t reflections = gpu::kDefaultReflections;  ///< boundaries per path that send a reflected ray

@@ -5,6 +5,7 @@
 #pragma once
 
 #include "scene/evaluate.h"
+#include "scene/optics.h"
 #include "scene/scene.h"
 #include "scene/view.h"
 #include "vk/context.h"
@@ -21,6 +22,19 @@ namespace snell::stress {
 scene::Scene placed(scene::Scene s, const glm::vec3& offset, float scale);
 /// The procedural eye with its cornea's IOR, in front of a coloured backdrop.
 scene::Scene eyeScene(float ior);
+/// The eye of eyeScene(1.376) with the aqueous humour nested in the cornea.
+scene::Scene aqueousEyeScene();
+
+/// `s` with `change` applied to every transmissive material: the optics
+/// features below, for the grid's optics group and `bench methods --optics`.
+scene::Scene withGlass(scene::Scene s, const std::function<void(scene::Material&)>& change);
+/// KHR_materials_volume: a blue-green tint, light falling to 75% red over `distance`.
+void addVolume(scene::Material& m, float distance);
+/// KHR_materials_dispersion with Abbe number 20 (dense flint): three rays where it applies.
+void addDispersion(scene::Material& m);
+/// SNELL_materials_ior_texture: IOR + 0.05 x texture `texture`'s red channel.
+void addIorTexture(scene::Material& m, int texture);
+
 /// A closed UV sphere (shared vertices, outward winding) of radius 1 at the origin.
 scene::Scene sphereScene(uint32_t segments, float ior);
 /// A closed cube [-1, 1]^3, each face split into n x n quads sharing their vertices.
@@ -70,6 +84,7 @@ struct Case {
   std::function<void(scene::Pose&, uint32_t frame)> morph;
   double time = 0.0;
   uint32_t maxInterfaces = 8;
+  scene::Optics optics;  ///< Fresnel, reflections, environment: the same for GPU and reference
   /// Bounds the test asserts, stated per case: the largest channel error in
   /// 1/255 anywhere, and the share of pixels that may differ by more than 1/255.
   int maxError = 255;
@@ -89,6 +104,7 @@ struct Result {
   uint64_t selfHitCount = 0; ///< aimed rays that crossed more faces than the reference (hit their own surface)
   uint64_t capHits = 0;      ///< rays that ran into the traversal's step cap
   uint64_t dropped = 0;      ///< triangles the GPU dropped as non-finite
+  double energyError = 0.0;  ///< the reference's largest |R + T - 1| at any boundary (T from amplitudes)
   std::string error;         ///< set when the case could not run (a clear error instead of a picture)
   std::string firstProblems; ///< the first few pixels or rays that leaked, self-hit or differ, GPU against reference
   double seconds = 0.0;      ///< wall time, GPU and reference together

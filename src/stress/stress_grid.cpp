@@ -289,6 +289,48 @@ std::vector<Case> grid(const GridOptions& o) {
     cases.push_back(c);
   }
 
+  // Optics: every feature of shaders/shared/trace.h on the eye, alone and all
+  // together far from the origin; aimed rays through nested and dispersive
+  // glass, where the reference also checks R + T = 1 at every boundary.
+  {
+    auto eye = [] { return eyeScene(1.376f); };
+    auto volume = [](scene::Material& m) { addVolume(m, 0.004f); };  // 4 mm: the eye's scale
+    auto iorTexture = [](scene::Material& m) { addIorTexture(m, 0); };  // the iris texture
+    auto all = [=](scene::Material& m) { volume(m), addDispersion(m), iorTexture(m); };
+    scene::Optics noFresnel, sky;
+    noFresnel.fresnel = false;
+    sky.environment = std::make_shared<scene::Environment>(scene::proceduralSky(256));
+    sky.reflections = 4;
+    auto opticsCase = [&](std::string name, std::function<scene::Scene()> make, ViewFn view, scene::Optics optics) {
+      cases.push_back(image("optics: " + name, "optics", std::move(make), std::move(view), o, 8));
+      cases.back().optics = std::move(optics);
+    };
+    opticsCase("Fresnel off", eye, eyeView(20.0), noFresnel);
+    opticsCase("HDR sky, 4 reflections, 60 degrees", eye, eyeView(60.0), sky);
+    opticsCase("volume", [=] { return withGlass(eyeScene(1.376f), volume); }, eyeView(20.0), {});
+    opticsCase("dispersion", [=] { return withGlass(eyeScene(1.376f), addDispersion); }, eyeView(20.0), {});
+    opticsCase("IOR texture", [=] { return withGlass(eyeScene(1.376f), iorTexture); }, eyeView(20.0), {});
+    opticsCase("aqueous nested in the cornea", aqueousEyeScene, eyeView(20.0), {});
+    glm::vec3 far(1e4f);
+    opticsCase("all, moved by 10000", [=] { return placed(withGlass(aqueousEyeScene(), all), far, 1.0f); },
+               eyeView(45.0, glm::dvec3(far)), sky);
+    auto throughEdges = [](ViewFn view) {
+      return [=](const scene::Scene& s, const scene::Pose& pose, std::vector<scene::Ray>& rays, std::vector<double>& d) {
+        scene::View v = view(s, pose);
+        auto tris = worldTriangles(s, pose, [](const std::string& n) { return n.rfind("backdrop", 0) != 0; });
+        aimAtEdges(tris, rays.size(), [&](const glm::dvec3&, const glm::dvec3&, size_t) { return v.eye; }, rays, d);
+      };
+    };
+    cases.push_back(aimed("optics: aimed rays through the aqueous eye, all features", "optics",
+                          [=] { return withGlass(aqueousEyeScene(), all); }, eyeView(20.0), o,
+                          throughEdges(eyeView(20.0)), false));
+    cases.back().optics = sky;
+    cases.push_back(aimed("optics: aimed rays into a dispersive, absorbing sphere", "optics",
+                          [] { return withGlass(sphereScene(48, 1.5f), [](scene::Material& m) { addVolume(m, 1.0f), addDispersion(m); }); },
+                          sphereView, o, aimAt(3.0), false));
+    cases.back().optics = sky;
+  }
+
   // Bounds of the image.
   for (auto [w, h] : {std::pair<uint32_t, uint32_t>{1, 1}, {7, 13}, {1, 37}, {33, 1}}) {
     Case c = image("size: " + std::to_string(w) + "x" + std::to_string(h), "size", [] { return eyeScene(1.376f); },
@@ -319,6 +361,7 @@ Result run(vk::Context& context, const Case& c) {
       settings.height = c.height;
       settings.view = c.view(s, pose);
       settings.maxInterfaces = c.maxInterfaces;
+      settings.optics = c.optics;
       std::vector<double> aimedDistance;
       if (c.kind == Kind::AimedRays) {
         settings.rays.resize(size_t(c.width) * c.height);
@@ -332,7 +375,9 @@ Result run(vk::Context& context, const Case& c) {
       rs.background = glm::dvec3(settings.background);
       rs.maxInterfaces = c.maxInterfaces;
       rs.rays = settings.rays;
+      rs.optics = c.optics;
       ref::ReferenceImage cpu = ref::renderReference(s, pose, rs);
+      for (double e : cpu.energyError) r.energyError = std::max(r.energyError, e);
 
       r.dropped += gpu.droppedTriangles;
       double sum = 0.0;

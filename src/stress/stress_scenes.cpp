@@ -148,6 +148,34 @@ scene::Scene eyeScene(float ior) {
   return s;
 }
 
+scene::Scene aqueousEyeScene() {
+  scene::EyeOptions options;
+  options.aqueous = true;
+  scene::Scene s = scene::makeEye(options);
+  addBackdrop(s, 0.03f, -0.02f);
+  return s;
+}
+
+scene::Scene withGlass(scene::Scene s, const std::function<void(scene::Material&)>& change) {
+  for (scene::Material& m : s.materials) {
+    if (m.refractive()) change(m);
+  }
+  return s;
+}
+
+void addVolume(scene::Material& m, float distance) {
+  m.thickness = std::max(m.thickness, 1e-3f * distance);
+  m.attenuationColor = {0.75f, 0.88f, 1.0f};
+  m.attenuationDistance = distance;
+}
+
+void addDispersion(scene::Material& m) { m.dispersion = 1.0f; }  // 20 / Abbe number
+
+void addIorTexture(scene::Material& m, int texture) {
+  m.iorTexture.texture = texture;
+  m.iorScale = 0.05f;
+}
+
 scene::Scene sphereScene(uint32_t segments, float ior) {
   scene::Scene s;
   s.source = "stress sphere";
