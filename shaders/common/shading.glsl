@@ -1,17 +1,37 @@
 // Texture sampling and Phong shading as shaders/shared/trace.h states them,
 // shared by the trace pass (where a ray lands) and the raster pass (opaque
 // fragments), so both draw an opaque face the same way. The including shader
-// declares the readonly buffers `textures` (GpuTexture[]), `texels` (uint[])
-// and `lights` (GpuLight[]).
+// declares the readonly buffer `lights` (GpuLight[]) and defines the binding
+// slots of the texture table, the sRGB decode table and the first texel page
+// (SNELL_BINDING_TEXTURES, SNELL_BINDING_SRGB_DECODE, SNELL_BINDING_TEXEL_PAGES).
 
 #ifndef SNELL_SHADING_GLSL
 #define SNELL_SHADING_GLSL
 
+layout(std430, binding = SNELL_BINDING_TEXTURES) readonly buffer Textures { GpuTexture textures[]; };
+layout(std430, binding = SNELL_BINDING_SRGB_DECODE) readonly buffer SrgbDecode { float srgbDecode[]; };
+// Pages are separate bindings, chosen by a switch rather than an array index:
+// indexing an array of buffers per ray needs descriptor indexing, which
+// Debian 12's lavapipe does not offer. Texels are filtered here, in float, as
+// trace.h states, so the GPU stays within rounding of the reference.
+layout(std430, binding = SNELL_BINDING_TEXEL_PAGES) readonly buffer TexelPage0 { uint texelPage0[]; };
+layout(std430, binding = SNELL_BINDING_TEXEL_PAGES + 1) readonly buffer TexelPage1 { uint texelPage1[]; };
+layout(std430, binding = SNELL_BINDING_TEXEL_PAGES + 2) readonly buffer TexelPage2 { uint texelPage2[]; };
+layout(std430, binding = SNELL_BINDING_TEXEL_PAGES + 3) readonly buffer TexelPage3 { uint texelPage3[]; };
+
+uint texelWord(uint page, uint i) {
+  switch (page) {
+    case 0u: return texelPage0[i];
+    case 1u: return texelPage1[i];
+    case 2u: return texelPage2[i];
+    default: return texelPage3[i];
+  }
+}
+
 const float kPi = 3.14159265358979;
 
 vec3 srgbToLinear(uint rgba) {
-  return vec3(uintBitsToFloat(texels[rgba & 0xffu]), uintBitsToFloat(texels[(rgba >> 8) & 0xffu]),
-              uintBitsToFloat(texels[(rgba >> 16) & 0xffu]));
+  return vec3(srgbDecode[rgba & 0xffu], srgbDecode[(rgba >> 8) & 0xffu], srgbDecode[(rgba >> 16) & 0xffu]);
 }
 
 int wrapIndex(int i, int size, uint mode) {
@@ -28,13 +48,13 @@ int wrapIndex(int i, int size, uint mode) {
 vec3 texel(GpuTexture tex, int x, int y, bool srgb) {
   x = wrapIndex(x, int(tex.width), tex.flags & 3u);
   y = wrapIndex(y, int(tex.height), (tex.flags >> 2) & 3u);
-  uint rgba = texels[tex.firstTexel + uint(y) * tex.width + uint(x)];
+  uint rgba = texelWord(tex.flags >> kTexturePageShift, tex.firstTexel + uint(y) * tex.width + uint(x));
   return srgb ? srgbToLinear(rgba) : vec3(rgba & 0xffu, (rgba >> 8) & 0xffu, (rgba >> 16) & 0xffu) / 255.0;
 }
 
 vec3 sampleTexture(uint index, vec2 uv, bool srgb) {
   GpuTexture tex = textures[index];
-  if ((tex.flags & 16u) != 0u) {
+  if ((tex.flags & kTextureFlagNearest) != 0u) {
     return texel(tex, int(floor(uv.x * float(tex.width))), int(floor(uv.y * float(tex.height))), srgb);
   }
   vec2 p = uv * vec2(tex.width, tex.height) - 0.5;

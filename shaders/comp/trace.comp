@@ -23,8 +23,9 @@ layout(std430, binding = kTraceBindingNormals) readonly buffer Normals { float n
 layout(std430, binding = kTraceBindingTexcoords) readonly buffer Texcoords { vec4 texcoords[]; };
 layout(std430, binding = kTraceBindingIndices) readonly buffer Indices { uint indices[]; };
 layout(std430, binding = kTraceBindingMaterials) readonly buffer Materials { GpuMaterial materials[]; };
-layout(std430, binding = kTraceBindingTextures) readonly buffer Textures { GpuTexture textures[]; };
-layout(std430, binding = kTraceBindingTexels) readonly buffer Texels { uint texels[]; };
+#define SNELL_BINDING_TEXTURES kTraceBindingTextures
+#define SNELL_BINDING_SRGB_DECODE kTraceBindingSrgbDecode
+#define SNELL_BINDING_TEXEL_PAGES kTraceBindingTexelPages
 layout(std430, binding = kTraceBindingLights) readonly buffer Lights { GpuLight lights[]; };
 layout(std430, binding = kTraceBindingEnvironment) readonly buffer Environment { vec4 environment[]; };
 layout(binding = kTraceBindingImage, rgba16f) uniform writeonly image2D outImage;

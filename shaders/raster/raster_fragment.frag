@@ -10,8 +10,9 @@
 
 layout(push_constant) uniform Push { RasterPush pc; };
 layout(std430, binding = kRasterBindingMaterials) readonly buffer Materials { GpuMaterial materials[]; };
-layout(std430, binding = kRasterBindingTextures) readonly buffer Textures { GpuTexture textures[]; };
-layout(std430, binding = kRasterBindingTexels) readonly buffer Texels { uint texels[]; };
+#define SNELL_BINDING_TEXTURES kRasterBindingTextures
+#define SNELL_BINDING_SRGB_DECODE kRasterBindingSrgbDecode
+#define SNELL_BINDING_TEXEL_PAGES kRasterBindingTexelPages
 layout(std430, binding = kRasterBindingLights) readonly buffer Lights { GpuLight lights[]; };
 layout(binding = kRasterBindingTraceImage, rgba16f) uniform readonly image2D traceImage;
 layout(binding = kRasterBindingBehindDepth, r32ui) uniform readonly uimage2D behindDepth;

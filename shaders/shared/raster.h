@@ -29,9 +29,10 @@ SNELL_CONST kRasterBindingTexcoords = 3;  // vec4[vertexCount]
 SNELL_CONST kRasterBindingIndices = 4;    // uint[3 * triangleCount], absolute
 SNELL_CONST kRasterBindingMaterials = 5;  // GpuMaterial[]
 SNELL_CONST kRasterBindingTextures = 6;   // GpuTexture[]
-SNELL_CONST kRasterBindingTexels = 7;     // uint[]: RGBA8
+SNELL_CONST kRasterBindingSrgbDecode = 7;  // float[kSrgbDecodeWords]
 SNELL_CONST kRasterBindingLights = 8;     // GpuLight[]
 SNELL_CONST kRasterBindingTraceImage = 9; // rgba16f storage image, read at the fragment's pixel (or displaced)
+SNELL_CONST kRasterBindingTexelPages = 11;  // 11 to 11 + kTexelPages - 1: uint[] texel pages
 SNELL_CONST kRasterBindingBehindDepth = 10;  // r32ui storage image: view depth bits behind the glass (kRasterFlagIrisPlane)
 
 // One draw per draw item: gl_InstanceIndex is the item, gl_VertexIndex / 3

@@ -166,17 +166,40 @@ struct GpuMaterial {
   uvec4 iorTexture;      // 16: IOR texture (kNoTexture: none), its texCoord, unused, unused
 };
 
-// The texel buffer starts with this many words: the linear value of each sRGB
-// byte as float bits (the reference's double, rounded once), so a texel decodes
-// by lookup, as the CPU reference does, rather than by a float pow.
+// The sRGB decode table (kTraceBindingSrgbDecode): the linear value of each
+// sRGB byte (the reference's double, rounded once), so a texel decodes by
+// lookup, as the CPU reference does, rather than by a float pow.
 SNELL_CONST kSrgbDecodeWords = 256;
+
+// Texels live in up to kTexelPages storage buffers (pages), each within the
+// device's largest storage buffer, so a scene's textures together may exceed
+// it. A texture's whole mip chain lies in one page: level 0 (RGBA8, as the
+// file stores it, one uint per texel) from firstTexel, each next level (half
+// the size, rounded down, at least 1) right after the one before, down to 1x1.
+SNELL_CONST kTexelPages = 4;
+SNELL_CONST kTextureFlagNearest = 16u;
+SNELL_CONST kTextureLevelsShift = 8;   // flags bits 8-12: mip levels
+SNELL_CONST kTexturePageShift = 13;    // flags bits 13-15: the page
 
 // 16 bytes, total: 16 bytes
 struct GpuTexture {
-  uint firstTexel;  // 4: into the texel buffer, RGBA8 sRGB (after the decode table)
-  uint width;       // 4
+  uint firstTexel;  // 4: level 0's first texel in its page
+  uint width;       // 4: of level 0
   uint height;      // 4
-  uint flags;       // 4: bits 0-1 wrap S, 2-3 wrap T, 4 nearest
+  uint flags;       // 4: bits 0-1 wrap S, 2-3 wrap T, 4 nearest, 8-12 levels, 13-15 page
+};
+
+// shaders/comp/texture_mips.comp: one level from the level above, in one page.
+// 32 bytes, total: 32 bytes
+struct TextureMipPush {
+  uint sourceFirst;   // 4: the level above's first texel
+  uint sourceWidth;   // 4
+  uint sourceHeight;  // 4
+  uint targetFirst;   // 4
+  uint targetWidth;   // 4
+  uint targetHeight;  // 4
+  uint srgb;          // 4: 1: averaged in linear light (colour), 0: as bytes (data)
+  uint pad;           // 4
 };
 
 // 64 bytes, total: 64 bytes
@@ -222,7 +245,7 @@ SNELL_CONST kTraceBindingTexcoords = 7;   // vec4[vertexCount]: uv0, uv1
 SNELL_CONST kTraceBindingIndices = 8;     // uint[3 * triangleCount], absolute
 SNELL_CONST kTraceBindingMaterials = 9;   // GpuMaterial[]
 SNELL_CONST kTraceBindingTextures = 10;   // GpuTexture[]
-SNELL_CONST kTraceBindingTexels = 11;     // uint[]: the sRGB decode table, then RGBA8 texels
+SNELL_CONST kTraceBindingSrgbDecode = 11;  // float[kSrgbDecodeWords]
 SNELL_CONST kTraceBindingLights = 12;     // GpuLight[]
 SNELL_CONST kTraceBindingImage = 13;      // rgba16f storage image
 SNELL_CONST kTraceBindingAov = 14;        // TraceAov[width * height]
@@ -231,6 +254,7 @@ SNELL_CONST kTraceBindingPixels = 16;     // TracePixelList, with kTraceFlagPixe
 SNELL_CONST kTraceBindingMask = 17;       // r32ui image: non-zero where a transmissive face is visible (compaction)
 SNELL_CONST kTraceBindingGeometryFirst = 18;  // uint[geometryCount]: first triangle (driver-rt pipeline only)
 SNELL_CONST kTraceBindingEnvironment = 19;    // vec4[]: (width, height, 0, 0), then width * height linear RGB texels, row 0 at +Y
+SNELL_CONST kTraceBindingTexelPages = 20;     // 20 to 20 + kTexelPages - 1: uint[] texel pages
 
 // A primary ray from a list, relative to the frame origin like everything the trace sees.
 // 32 bytes, total: 32 bytes

@@ -45,6 +45,7 @@ static_assert(sizeof(GpuInstance) == 112 && offsetof(GpuInstance, worldToObject)
 static_assert(sizeof(GpuMaterial) == 176 && offsetof(GpuMaterial, textures) == 96 && offsetof(GpuMaterial, attenuation) == 112 &&
               offsetof(GpuMaterial, iorTexture) == 160);
 static_assert(sizeof(GpuTexture) == 16 && offsetof(GpuTexture, flags) == 12);
+static_assert(sizeof(TextureMipPush) == 32 && offsetof(TextureMipPush, srgb) == 24);
 static_assert(sizeof(GpuLight) == 64 && offsetof(GpuLight, cone) == 48);
 static_assert(sizeof(TraceAov) == 32 && offsetof(TraceAov, nodeVisits) == 20);
 static_assert(sizeof(GpuRay) == 32 && offsetof(GpuRay, direction) == 16);

@@ -172,7 +172,11 @@ void RasterPass::recordShadingPass(vk::Commands& commands, const RasterScene& sc
                                            {gpu::kRasterBindingIndices, &s.indices},
                                            {gpu::kRasterBindingMaterials, &s.materials},
                                            {gpu::kRasterBindingTextures, &s.textures},
-                                           {gpu::kRasterBindingTexels, &s.texels},
+                                           {gpu::kRasterBindingSrgbDecode, &s.srgbDecode},
+                                           {gpu::kRasterBindingTexelPages, &s.texelPages[0]},
+                                           {gpu::kRasterBindingTexelPages + 1, &s.texelPages[1]},
+                                           {gpu::kRasterBindingTexelPages + 2, &s.texelPages[2]},
+                                           {gpu::kRasterBindingTexelPages + 3, &s.texelPages[3]},
                                            {gpu::kRasterBindingLights, scene.lights},
                                            {gpu::kRasterBindingTraceImage, nullptr, &traceImage},
                                            {gpu::kRasterBindingBehindDepth, nullptr, &behindDepth}};

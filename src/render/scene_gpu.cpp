@@ -3,6 +3,8 @@
 
 #include "shared/trace.h"
 #include "vk/commands.h"
+#include "vk/compute_program.h"
+#include "texture_mips.spv.h"
 
 #include <cstring>
 #include <stdexcept>
@@ -35,14 +37,111 @@ vk::Buffer uploaded(vk::Context& context, const std::vector<T>& data, const std:
   return buffer;
 }
 
-// The head of the texel buffer (kSrgbDecodeWords): float bits of each sRGB byte's linear value.
-std::vector<uint32_t> srgbDecodeTable() {
-  std::vector<uint32_t> table(gpu::kSrgbDecodeWords);
-  for (uint32_t v = 0; v < gpu::kSrgbDecodeWords; ++v) {
-    float linear = static_cast<float>(scene::srgbToLinear(static_cast<uint8_t>(v)));
-    std::memcpy(&table[v], &linear, sizeof linear);
-  }
+// kTraceBindingSrgbDecode: each sRGB byte's linear value.
+std::vector<float> srgbDecodeTable() {
+  std::vector<float> table(gpu::kSrgbDecodeWords);
+  for (uint32_t v = 0; v < gpu::kSrgbDecodeWords; ++v) table[v] = float(scene::srgbToLinear(static_cast<uint8_t>(v)));
   return table;
+}
+
+// Textures only an IOR texture reads hold data, not colour: their mips average bytes.
+std::vector<bool> colourTextures(const scene::Scene& scene) {
+  std::vector<bool> data(scene.textures.size(), false), colour(scene.textures.size(), false);
+  auto mark = [&](const scene::TextureRef& ref, std::vector<bool>& as) {
+    if (ref.present() && size_t(ref.texture) < scene.textures.size()) as[size_t(ref.texture)] = true;
+  };
+  for (const scene::Material& m : scene.materials) {
+    mark(m.baseColorTexture, colour);
+    mark(m.emissiveTexture, colour);
+    mark(m.iorTexture, data);
+  }
+  for (size_t t = 0; t < colour.size(); ++t) colour[t] = colour[t] || !data[t];
+  return colour;
+}
+
+// Which page each texture's chain goes to, and where: first fit over the
+// pages, each at most the device's largest storage buffer. Throws naming the
+// numbers when the textures do not fit.
+struct TexturePlacement {
+  std::vector<uint32_t> page, first;
+  std::array<uint64_t, gpu::kTexelPages> pageTexels{};
+};
+
+// Pages are read back by tests and tools (transfer source) as well as written.
+constexpr VkBufferUsageFlags kTexelPageUsage =
+    VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT;
+
+TexturePlacement placeTextures(const vk::Context& context, const scene::Scene& scene) {
+  const uint64_t capacity = context.caps().maxStorageBufferRange / 4;
+  TexturePlacement place;
+  uint64_t total = 0;
+  for (const scene::Texture& t : scene.textures) {
+    uint64_t texels = mipChainTexels(std::max(t.width, 1u), std::max(t.height, 1u));
+    total += texels;
+    uint32_t p = 0;
+    while (p < gpu::kTexelPages && place.pageTexels[p] + texels > capacity) ++p;
+    if (p == gpu::kTexelPages) {
+      throw std::runtime_error(scene.source + ": textures need at least " + std::to_string((total * 4) >> 20) +
+                               " MiB with their mips; this device holds " + std::to_string(gpu::kTexelPages) +
+                               " texel pages of " + std::to_string((capacity * 4) >> 20) + " MiB (texture '" + t.name +
+                               "' of " + std::to_string(t.width) + "x" + std::to_string(t.height) + " did not fit)");
+    }
+    place.page.push_back(p);
+    place.first.push_back(static_cast<uint32_t>(place.pageTexels[p]));
+    place.pageTexels[p] += texels;
+  }
+  return place;
+}
+
+// Level 0 of every texture copied to its page, then the other levels made on
+// the GPU (texture_mips.comp), level by level, every texture at once.
+void uploadTextures(vk::Context& context, const scene::Scene& scene, const TexturePlacement& place, SceneGpu& gpu) {
+  const std::string& name = scene.source.empty() ? std::string("scene") : scene.source;
+  for (uint32_t p = 0; p < gpu::kTexelPages; ++p) {
+    VkDeviceSize bytes = std::max<VkDeviceSize>(place.pageTexels[p] * 4, 16);
+    gpu.texelPages[p] = vk::Buffer(context, {bytes, kTexelPageUsage,
+                                             vk::MemoryDomain::Device, name + " texel page " + std::to_string(p)});
+    gpu.textureBytes += place.pageTexels[p] * 4;
+    gpu.bytes += bytes;
+  }
+  if (scene.textures.empty()) return;
+  VkDeviceSize stagingBytes = 0;
+  for (const scene::Texture& t : scene.textures) stagingBytes += VkDeviceSize(t.rgba.size());
+  vk::Buffer staging(context, {std::max<VkDeviceSize>(stagingBytes, 4), VK_BUFFER_USAGE_TRANSFER_SRC_BIT,
+                               vk::MemoryDomain::Upload, name + " texture staging"});
+  vk::ComputeProgram mips(context, vk::ComputeProgramDesc{"texture mips", kSpvTextureMips, {}, false});
+  std::vector<bool> colour = colourTextures(scene);
+  vk::Commands commands(context, "upload " + name + " textures");
+  commands.begin();
+  VkDeviceSize offset = 0;
+  for (size_t i = 0; i < scene.textures.size(); ++i) {
+    const scene::Texture& t = scene.textures[i];
+    if (t.rgba.empty()) continue;
+    std::memcpy(staging.mapped().data() + offset, t.rgba.data(), t.rgba.size());
+    commands.copyBuffer(staging, gpu.texelPages[place.page[i]], t.rgba.size(), offset, VkDeviceSize(place.first[i]) * 4);
+    offset += t.rgba.size();
+  }
+  commands.transferToCompute();
+  uint32_t most = 1;
+  for (const scene::Texture& t : scene.textures) most = std::max(most, mipLevels(t.width, t.height));
+  for (uint32_t level = 1; level < most; ++level) {
+    for (size_t i = 0; i < scene.textures.size(); ++i) {
+      const scene::Texture& t = scene.textures[i];
+      if (t.rgba.empty() || level >= mipLevels(t.width, t.height)) continue;
+      uint32_t first = place.first[i];
+      uint32_t w = t.width, h = t.height;
+      for (uint32_t l = 1; l < level; ++l) {
+        first += w * h;
+        w = std::max(w / 2, 1u), h = std::max(h / 2, 1u);
+      }
+      gpu::TextureMipPush push{first, w, h, first + w * h, std::max(w / 2, 1u), std::max(h / 2, 1u),
+                               colour[i] ? 1u : 0u, 0u};
+      mips.dispatchThreads(commands, {{0, &gpu.srgbDecode}, {1, &gpu.texelPages[place.page[i]]}}, push,
+                           uint64_t(push.targetWidth) * push.targetHeight);
+    }
+    commands.computeToCompute();
+  }
+  commands.submitAndWait();
 }
 
 uint32_t wrapMode(bool repeat, bool mirror) {
@@ -141,16 +240,15 @@ SceneGpu uploadScene(vk::Context& context, const scene::Scene& scene, const scen
   for (const scene::Material& m : scene.materials) materials.push_back(packMaterial(m, scene));
   materials.push_back(packMaterial(scene::Material{}, scene));  // for shapes without one
 
+  TexturePlacement place = placeTextures(context, scene);
   std::vector<gpu::GpuTexture> textures;
-  std::vector<uint32_t> texels = srgbDecodeTable();
-  for (const scene::Texture& t : scene.textures) {
-    gpu::GpuTexture g{static_cast<uint32_t>(texels.size()), t.width, t.height,
-                      wrapMode(t.repeatS, t.mirrorS) | (wrapMode(t.repeatT, t.mirrorT) << 2) | (t.linearFilter ? 0u : 16u)};
-    size_t count = size_t(t.width) * t.height;
-    size_t at = texels.size();
-    texels.resize(at + count);
-    if (count) std::memcpy(&texels[at], t.rgba.data(), count * 4);
-    textures.push_back(g);
+  for (size_t i = 0; i < scene.textures.size(); ++i) {
+    const scene::Texture& t = scene.textures[i];
+    uint32_t flags = wrapMode(t.repeatS, t.mirrorS) | (wrapMode(t.repeatT, t.mirrorT) << 2) |
+                     (t.linearFilter ? 0u : gpu::kTextureFlagNearest) |
+                     (mipLevels(std::max(t.width, 1u), std::max(t.height, 1u)) << gpu::kTextureLevelsShift) |
+                     (place.page[i] << gpu::kTexturePageShift);
+    textures.push_back({place.first[i], t.width, t.height, flags});
   }
 
   const std::string& name = scene.source.empty() ? std::string("scene") : scene.source;
@@ -160,8 +258,23 @@ SceneGpu uploadScene(vk::Context& context, const scene::Scene& scene, const scen
   gpu.indices = uploaded(context, indices, name + " indices", gpu.bytes, true);
   gpu.materials = uploaded(context, materials, name + " materials", gpu.bytes);
   gpu.textures = uploaded(context, textures, name + " texture table", gpu.bytes);
-  gpu.texels = uploaded(context, texels, name + " texels", gpu.bytes);
+  gpu.srgbDecode = uploaded(context, srgbDecodeTable(), name + " sRGB decode", gpu.bytes);
+  uploadTextures(context, scene, place, gpu);
   return gpu;
+}
+
+uint64_t mipChainTexels(uint32_t width, uint32_t height) {
+  uint64_t texels = 0;
+  for (uint32_t level = 0; level < mipLevels(width, height); ++level) {
+    texels += uint64_t(std::max(width >> level, 1u)) * std::max(height >> level, 1u);
+  }
+  return texels;
+}
+
+uint32_t mipLevels(uint32_t width, uint32_t height) {
+  uint32_t levels = 1;
+  for (uint32_t size = std::max(width, height); size > 1; size >>= 1) ++levels;
+  return levels;
 }
 
 }  // namespace snell::render

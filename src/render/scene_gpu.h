@@ -1,14 +1,16 @@
 // The scene's static data on the GPU, laid out for the BVH, trace and raster
 // passes: every vertex of every geometry in one set of buffers (deforming
 // items write their slice each frame), triangles with absolute vertex
-// indices, materials, textures as one texel buffer.
+// indices, materials, and texel pages holding every texture's mip chain.
 #pragma once
 
 #include "scene/evaluate.h"
 #include "scene/scene.h"
+#include "shared/trace.h"
 #include "vk/buffer.h"
 #include "vk/context.h"
 
+#include <array>
 #include <cstdint>
 #include <vector>
 
@@ -34,7 +36,9 @@ struct SceneGpu {
   vk::Buffer indices;             ///< uint[3 * triangleCount], absolute
   vk::Buffer materials;           ///< gpu::GpuMaterial[], the scene's then a default one
   vk::Buffer textures;            ///< gpu::GpuTexture[]
-  vk::Buffer texels;              ///< RGBA8 texels of every texture
+  vk::Buffer srgbDecode;          ///< float[kSrgbDecodeWords]: each sRGB byte's linear value
+  std::array<vk::Buffer, gpu::kTexelPages> texelPages;  ///< RGBA8 mip chains (unused pages: 16 bytes)
+  uint64_t textureBytes = 0;      ///< GPU memory the texel pages take, mips included
   uint64_t bytes = 0;             ///< GPU memory the buffers above take
 };
 
@@ -42,5 +46,11 @@ struct SceneGpu {
 /// change with time). Throws std::runtime_error naming the scene when it is
 /// larger than the device's buffers can hold.
 SceneGpu uploadScene(vk::Context& context, const scene::Scene& scene, const scene::Pose& layout);
+
+/// Mip levels of a width x height texture: down to 1x1, each level half the
+/// one above (rounded down, at least 1).
+uint32_t mipLevels(uint32_t width, uint32_t height);
+/// Texels of a width x height texture's whole mip chain.
+uint64_t mipChainTexels(uint32_t width, uint32_t height);
 
 }  // namespace snell::render

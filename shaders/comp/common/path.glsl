@@ -2,7 +2,8 @@
 // the surface at a hit, the refraction rules of shared/trace.h and the whole
 // path of one pixel. The including shader declares the buffers of trace.h's
 // bindings (instances, positions, normals, texcoords, indices, materials,
-// textures, texels, lights, environment, outImage, aovs, rays), the push constant `pc`, and
+// lights, environment, outImage, aovs, rays) and the texture binding macros
+// of common/shading.glsl, the push constant `pc`, and
 // defines traceClosest() and firstTriangleOf() after this file.
 #ifndef SNELL_PATH_GLSL
 #define SNELL_PATH_GLSL
