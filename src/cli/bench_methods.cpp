@@ -346,14 +346,15 @@ std::vector<OpticsVariant> opticsVariants(const scene::Scene& scene, const std::
   if (!scene.textures.empty()) {
     rows.push_back({"ior-texture", "IOR + 0.05 x the scene's first texture", withGlass(scene, iorTexture), fresnel});
   }
-  scene::Scene all = withGlass(scene, [&](scene::Material& m) { volume(m), stress::addDispersion(m), iorTexture(m); });
+  auto everything = [&](scene::Material& m) { volume(m), stress::addDispersion(m), iorTexture(m); };
+  scene::Scene all = scene;
   if (eye) {
     scene::EyeOptions nested = *eye;
     nested.aqueous = true;
     rows.push_back({"aqueous", "the aqueous humour nested in the cornea (priorities)", scene::makeEye(nested), fresnel});
-    all = withGlass(scene::makeEye(nested), [&](scene::Material& m) { volume(m), stress::addDispersion(m), iorTexture(m); });
+    all = rows.back().scene;
   }
-  rows.push_back({"all", "every feature above at once", std::move(all), environment});
+  rows.push_back({"all", "every feature above at once", withGlass(std::move(all), everything), environment});
   rows.back().optics.reflections = 4;
   return rows;
 }

@@ -90,7 +90,7 @@ void DriverTracer::recordUpdate(vk::Commands& commands, vk::UploadArena& arena,
   commands.endPass();
 }
 
-void DriverTracer::recordTrace(vk::Commands& commands, std::initializer_list<vk::BufferBinding> buffers,
+void DriverTracer::recordTrace(vk::Commands& commands, std::span<const vk::BufferBinding> buffers,
                                const gpu::TracePush& push) {
   DriverTracePush p{push, tlas_->address(), 0};
   commands.beginPass("driver trace");

@@ -39,7 +39,7 @@ class DriverTracer {
   void recordUpdate(vk::Commands& commands, vk::UploadArena& arena, const std::vector<gpu::GpuInstance>& instances,
                     bool instancesChanged, const std::vector<uint32_t>& moved);
   /// Traces width x height pixels with `push` (pass: driver trace).
-  void recordTrace(vk::Commands& commands, std::initializer_list<vk::BufferBinding> buffers, const gpu::TracePush& push);
+  void recordTrace(vk::Commands& commands, std::span<const vk::BufferBinding> buffers, const gpu::TracePush& push);
   const vk::Buffer& geometryFirst() const { return geometryFirst_; }
   uint64_t bytes() const;
 

@@ -165,21 +165,17 @@ void RasterPass::recordShadingPass(vk::Commands& commands, const RasterScene& sc
   {
     vk::RenderingScope scope(commands, target, &depth, area, clear, false);
     const SceneGpu& s = *scene.scene;
-    const vk::BufferBinding resources[] = {{gpu::kRasterBindingInstances, scene.instances},
-                                           {gpu::kRasterBindingPositions, &s.positions},
-                                           {gpu::kRasterBindingNormals, &s.normals},
-                                           {gpu::kRasterBindingTexcoords, &s.texcoords},
-                                           {gpu::kRasterBindingIndices, &s.indices},
-                                           {gpu::kRasterBindingMaterials, &s.materials},
-                                           {gpu::kRasterBindingTextures, &s.textures},
-                                           {gpu::kRasterBindingSrgbDecode, &s.srgbDecode},
-                                           {gpu::kRasterBindingTexelPages, &s.texelPages[0]},
-                                           {gpu::kRasterBindingTexelPages + 1, &s.texelPages[1]},
-                                           {gpu::kRasterBindingTexelPages + 2, &s.texelPages[2]},
-                                           {gpu::kRasterBindingTexelPages + 3, &s.texelPages[3]},
-                                           {gpu::kRasterBindingLights, scene.lights},
-                                           {gpu::kRasterBindingTraceImage, nullptr, &traceImage},
-                                           {gpu::kRasterBindingBehindDepth, nullptr, &behindDepth}};
+    std::vector<vk::BufferBinding> resources = {{gpu::kRasterBindingInstances, scene.instances},
+                                                {gpu::kRasterBindingPositions, &s.positions},
+                                                {gpu::kRasterBindingNormals, &s.normals},
+                                                {gpu::kRasterBindingTexcoords, &s.texcoords},
+                                                {gpu::kRasterBindingIndices, &s.indices},
+                                                {gpu::kRasterBindingMaterials, &s.materials},
+                                                {gpu::kRasterBindingLights, scene.lights},
+                                                {gpu::kRasterBindingTraceImage, nullptr, &traceImage},
+                                                {gpu::kRasterBindingBehindDepth, nullptr, &behindDepth}};
+    s.appendTextureBindings(resources, gpu::kRasterBindingTextures, gpu::kRasterBindingSrgbDecode,
+                            gpu::kRasterBindingTexelPages);
     gpu::RasterPush p = push(scene, settings, options);
     drawItems(commands, *fill_, scene, options, p, resources, area);
     if (options.wireframe) {

@@ -520,30 +520,31 @@ void Renderer::uploadEnvironments(const std::vector<ViewRequest>& views) {
   }
 }
 
+std::vector<vk::BufferBinding> Renderer::pathBindings(const ViewRequest& request, View& view) const {
+  const FrameSettings& settings = request.settings;
+  std::vector<vk::BufferBinding> bindings = {
+      {gpu::kTraceBindingInstances, &instances_},
+      {gpu::kTraceBindingPositions, &scene_.positions},
+      {gpu::kTraceBindingNormals, &scene_.normals},
+      {gpu::kTraceBindingTexcoords, &scene_.texcoords},
+      {gpu::kTraceBindingIndices, &scene_.indices},
+      {gpu::kTraceBindingMaterials, &scene_.materials},
+      {gpu::kTraceBindingLights, &lights_},
+      {gpu::kTraceBindingEnvironment, &environmentBuffer(settings.optics)},
+      {gpu::kTraceBindingImage, nullptr, &view.images.trace},
+      {gpu::kTraceBindingAov, request.aov ? &view.images.aov : &placeholder_},
+      {gpu::kTraceBindingRays, settings.rays.empty() ? &placeholder_ : &view.rays}};
+  scene_.appendTextureBindings(bindings, gpu::kTraceBindingTextures, gpu::kTraceBindingSrgbDecode,
+                               gpu::kTraceBindingTexelPages);
+  return bindings;
+}
+
 void Renderer::recordDriverTrace(vk::Commands& commands, const ViewRequest& request, View& view, FrameStats& stats) {
   const FrameSettings& settings = request.settings;
-  ViewImages& images = view.images;
   commands.computeToCompute();
-  driver_->recordTrace(commands,
-                       {{gpu::kTraceBindingInstances, &instances_},
-                        {gpu::kTraceBindingPositions, &scene_.positions},
-                        {gpu::kTraceBindingNormals, &scene_.normals},
-                        {gpu::kTraceBindingTexcoords, &scene_.texcoords},
-                        {gpu::kTraceBindingIndices, &scene_.indices},
-                        {gpu::kTraceBindingMaterials, &scene_.materials},
-                        {gpu::kTraceBindingTextures, &scene_.textures},
-                        {gpu::kTraceBindingSrgbDecode, &scene_.srgbDecode},
-                        {gpu::kTraceBindingTexelPages, &scene_.texelPages[0]},
-                        {gpu::kTraceBindingTexelPages + 1, &scene_.texelPages[1]},
-                        {gpu::kTraceBindingTexelPages + 2, &scene_.texelPages[2]},
-                        {gpu::kTraceBindingTexelPages + 3, &scene_.texelPages[3]},
-                        {gpu::kTraceBindingLights, &lights_},
-                        {gpu::kTraceBindingEnvironment, &environmentBuffer(settings.optics)},
-                        {gpu::kTraceBindingImage, nullptr, &images.trace},
-                        {gpu::kTraceBindingAov, request.aov ? &images.aov : &placeholder_},
-                        {gpu::kTraceBindingRays, settings.rays.empty() ? &placeholder_ : &view.rays},
-                        {gpu::kTraceBindingGeometryFirst, &driver_->geometryFirst()}},
-                       tracePush(request, false));
+  std::vector<vk::BufferBinding> bindings = pathBindings(request, view);
+  bindings.push_back({gpu::kTraceBindingGeometryFirst, &driver_->geometryFirst()});
+  driver_->recordTrace(commands, bindings, tracePush(request, false));
   stats.pixelsTraced += uint64_t(settings.width) * settings.height;
   ++stats.traceDispatches;
 }
@@ -580,29 +581,12 @@ void Renderer::recordTrace(vk::Commands& commands, const ViewRequest& request, V
     commands.beginPass("trace");
     stats.pixelsTraced += uint64_t(settings.width) * settings.height;
   }
-  std::initializer_list<vk::BufferBinding> bindings = {
-      {gpu::kTraceBindingTlasNodes, &tlas_->nodes},
-      {gpu::kTraceBindingTlasGroups, &tlas_->groups},
-      {gpu::kTraceBindingInstances, &instances_},
-      {gpu::kTraceBindingBlasNodes, &blas_->nodes},
-      {gpu::kTraceBindingBlasGroups, &blas_->groups},
-      {gpu::kTraceBindingPositions, &scene_.positions},
-      {gpu::kTraceBindingNormals, &scene_.normals},
-      {gpu::kTraceBindingTexcoords, &scene_.texcoords},
-      {gpu::kTraceBindingIndices, &scene_.indices},
-      {gpu::kTraceBindingMaterials, &scene_.materials},
-      {gpu::kTraceBindingTextures, &scene_.textures},
-      {gpu::kTraceBindingSrgbDecode, &scene_.srgbDecode},
-      {gpu::kTraceBindingTexelPages, &scene_.texelPages[0]},
-      {gpu::kTraceBindingTexelPages + 1, &scene_.texelPages[1]},
-      {gpu::kTraceBindingTexelPages + 2, &scene_.texelPages[2]},
-      {gpu::kTraceBindingTexelPages + 3, &scene_.texelPages[3]},
-      {gpu::kTraceBindingLights, &lights_},
-      {gpu::kTraceBindingEnvironment, &environmentBuffer(settings.optics)},
-      {gpu::kTraceBindingImage, nullptr, &images.trace},
-      {gpu::kTraceBindingAov, request.aov ? &images.aov : &placeholder_},
-      {gpu::kTraceBindingRays, settings.rays.empty() ? &placeholder_ : &view.rays},
-      {gpu::kTraceBindingPixels, masked ? &images.pixels : &placeholder_}};
+  std::vector<vk::BufferBinding> bindings = pathBindings(request, view);
+  bindings.insert(bindings.end(), {{gpu::kTraceBindingTlasNodes, &tlas_->nodes},
+                                   {gpu::kTraceBindingTlasGroups, &tlas_->groups},
+                                   {gpu::kTraceBindingBlasNodes, &blas_->nodes},
+                                   {gpu::kTraceBindingBlasGroups, &blas_->groups},
+                                   {gpu::kTraceBindingPixels, masked ? &images.pixels : &placeholder_}});
   if (masked) {
     trace_->dispatchIndirect(commands, bindings, push, images.pixels, gpu::kTracePixelListDispatchOffset);
   } else {

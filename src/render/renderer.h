@@ -185,6 +185,8 @@ class Renderer {
   void uploadEnvironments(const std::vector<ViewRequest>& views);
   const vk::Buffer& environmentBuffer(const scene::Optics& optics) const;
   void recordDriverTrace(vk::Commands& commands, const ViewRequest& request, View& view, FrameStats& stats);
+  /// What trace.comp and the driver's ray generation shader both bind (path.glsl's buffers).
+  std::vector<vk::BufferBinding> pathBindings(const ViewRequest& request, View& view) const;
   void collect(Slot& slot);
   bool viewNeedsTrees(const ViewRequest& request) const;
   bool transmissiveInView(const FrameSettings& settings) const;

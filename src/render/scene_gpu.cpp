@@ -263,6 +263,13 @@ SceneGpu uploadScene(vk::Context& context, const scene::Scene& scene, const scen
   return gpu;
 }
 
+void SceneGpu::appendTextureBindings(std::vector<vk::BufferBinding>& out, uint32_t tableSlot, uint32_t decodeSlot,
+                                     uint32_t firstPageSlot) const {
+  out.push_back({tableSlot, &textures});
+  out.push_back({decodeSlot, &srgbDecode});
+  for (uint32_t p = 0; p < gpu::kTexelPages; ++p) out.push_back({firstPageSlot + p, &texelPages[p]});
+}
+
 uint64_t mipChainTexels(uint32_t width, uint32_t height) {
   uint64_t texels = 0;
   for (uint32_t level = 0; level < mipLevels(width, height); ++level) {

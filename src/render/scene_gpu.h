@@ -9,6 +9,7 @@
 #include "shared/trace.h"
 #include "vk/buffer.h"
 #include "vk/context.h"
+#include "vk/descriptors.h"
 
 #include <array>
 #include <cstdint>
@@ -39,6 +40,11 @@ struct SceneGpu {
   vk::Buffer srgbDecode;          ///< float[kSrgbDecodeWords]: each sRGB byte's linear value
   std::array<vk::Buffer, gpu::kTexelPages> texelPages;  ///< RGBA8 mip chains (unused pages: 16 bytes)
   uint64_t textureBytes = 0;      ///< GPU memory the texel pages take, mips included
+
+  /// Appends the bindings of the scene's textures as trace.h numbers them for
+  /// a pass: the texture table, the sRGB decode table, then the pages from `firstPageSlot`.
+  void appendTextureBindings(std::vector<vk::BufferBinding>& out, uint32_t tableSlot, uint32_t decodeSlot,
+                             uint32_t firstPageSlot) const;
   uint64_t bytes = 0;             ///< GPU memory the buffers above take
 };
 

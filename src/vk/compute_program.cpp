@@ -119,7 +119,7 @@ std::vector<std::string> ComputeProgram::statistics() const {
   return lines;
 }
 
-void ComputeProgram::record(Commands& commands, std::initializer_list<BufferBinding> buffers, const void* push,
+void ComputeProgram::record(Commands& commands, std::span<const BufferBinding> buffers, const void* push,
                             size_t pushBytes, uint64_t groups, const Buffer* indirect,
                             VkDeviceSize indirectOffset) const {
   if (pushBytes != reflection_.pushConstantBytes && !(reflection_.pushConstantBytes == 0 && push == nullptr)) {
@@ -132,7 +132,7 @@ void ComputeProgram::record(Commands& commands, std::initializer_list<BufferBind
   }
   if (groups == 0 && !indirect) return;
   VkDescriptorSet set =
-      writeSet(commands, setLayout_, reflection_.bindings, std::span(buffers.begin(), buffers.size()), name_);
+      writeSet(commands, setLayout_, reflection_.bindings, buffers, name_);
 
   VkCommandBuffer cmd = commands.handle();
   vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline_);

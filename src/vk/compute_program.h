@@ -47,6 +47,11 @@ class ComputeProgram {
   template <typename Push>
   void dispatchThreads(Commands& commands, std::initializer_list<BufferBinding> buffers, const Push& push,
                        uint64_t threads) const {
+    dispatchThreads(commands, std::span(buffers.begin(), buffers.size()), push, threads);
+  }
+  template <typename Push>
+  void dispatchThreads(Commands& commands, std::span<const BufferBinding> buffers, const Push& push,
+                       uint64_t threads) const {
     uint64_t groups = (threads + reflection_.localSize[0] - 1) / reflection_.localSize[0];
     record(commands, buffers, &push, sizeof(Push), groups);
   }
@@ -55,18 +60,23 @@ class ComputeProgram {
   template <typename Push>
   void dispatchGroups(Commands& commands, std::initializer_list<BufferBinding> buffers, const Push& push,
                       uint64_t groups) const {
+    record(commands, std::span(buffers.begin(), buffers.size()), &push, sizeof(Push), groups);
+  }
+  template <typename Push>
+  void dispatchGroups(Commands& commands, std::span<const BufferBinding> buffers, const Push& push,
+                      uint64_t groups) const {
     record(commands, buffers, &push, sizeof(Push), groups);
   }
   /// Dispatches the workgroup counts (x, y, z) the GPU wrote at `offset` of
   /// `arguments` (VkDispatchIndirectCommand), made visible to the indirect stage before.
   template <typename Push>
-  void dispatchIndirect(Commands& commands, std::initializer_list<BufferBinding> buffers, const Push& push,
+  void dispatchIndirect(Commands& commands, std::span<const BufferBinding> buffers, const Push& push,
                         const Buffer& arguments, VkDeviceSize offset = 0) const {
     record(commands, buffers, &push, sizeof(Push), 0, &arguments, offset);
   }
 
  private:
-  void record(Commands& commands, std::initializer_list<BufferBinding> buffers, const void* push, size_t pushBytes,
+  void record(Commands& commands, std::span<const BufferBinding> buffers, const void* push, size_t pushBytes,
               uint64_t groups, const Buffer* indirect = nullptr, VkDeviceSize indirectOffset = 0) const;
 
   Context* context_;

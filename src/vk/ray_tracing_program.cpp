@@ -117,14 +117,14 @@ RayTracingProgram::~RayTracingProgram() {
   });
 }
 
-void RayTracingProgram::record(Commands& commands, std::initializer_list<BufferBinding> buffers, const void* push,
+void RayTracingProgram::record(Commands& commands, std::span<const BufferBinding> buffers, const void* push,
                                size_t pushBytes, uint32_t width, uint32_t height) const {
   if (pushBytes != reflection_.pushConstantBytes) {
     throw VulkanError("program '" + name_ + "' takes " + std::to_string(reflection_.pushConstantBytes) +
                       " bytes of push constants; the call gave " + std::to_string(pushBytes));
   }
   VkDescriptorSet set =
-      writeSet(commands, setLayout_, reflection_.bindings, std::span(buffers.begin(), buffers.size()), name_);
+      writeSet(commands, setLayout_, reflection_.bindings, buffers, name_);
   VkCommandBuffer cmd = commands.handle();
   vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_RAY_TRACING_KHR, pipeline_);
   vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_RAY_TRACING_KHR, pipelineLayout_, 0, 1, &set, 0, nullptr);

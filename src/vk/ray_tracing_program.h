@@ -32,13 +32,13 @@ class RayTracingProgram {
 
   /// Launches width x height ray generation invocations.
   template <typename Push>
-  void trace(Commands& commands, std::initializer_list<BufferBinding> buffers, const Push& push, uint32_t width,
+  void trace(Commands& commands, std::span<const BufferBinding> buffers, const Push& push, uint32_t width,
              uint32_t height) const {
     record(commands, buffers, &push, sizeof(Push), width, height);
   }
 
  private:
-  void record(Commands& commands, std::initializer_list<BufferBinding> buffers, const void* push, size_t pushBytes,
+  void record(Commands& commands, std::span<const BufferBinding> buffers, const void* push, size_t pushBytes,
               uint32_t width, uint32_t height) const;
 
   Context* context_;
