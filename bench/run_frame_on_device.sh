@@ -8,6 +8,7 @@
 #   bench/run_frame_on_device.sh bench   # bench scale, frame and bvh
 #   bench/run_frame_on_device.sh methods # bench methods at 1920x1080, its chart
 #   bench/run_frame_on_device.sh optics  # each optics feature's cost (1920x1080) and error (320x240), stress grid's optics group
+#   bench/run_frame_on_device.sh textures # load times of the textured sample models (three runs each)
 # Results land in $OUT.
 set -uo pipefail
 for f in .gl/*.deb; do dpkg -x "$f" /; done
@@ -80,4 +81,9 @@ if [[ $step == all || $step == optics ]]; then
     SNELL_VALIDATION=1 $s bench stress --only optics --json "$json/stress-optics.json"
   } 2>&1 | grep -v "CPU reference" | tee "$OUT/optics.log"
   tar -C "$json" -cf "$OUT/optics-results.tar" .
+fi
+if [[ $step == all || $step == textures ]]; then
+  for m in .assets/gltf/LightsPunctualLamp/glTF/LightsPunctualLamp.gltf .assets/gltf/GlassVaseFlowers/glTF-Binary/*.glb; do
+    for run in 1 2 3; do .carry/snell info "$m" --timings | grep -E "texture memory|load times"; done
+  done 2>&1 | tee "$OUT/textures.log"
 fi

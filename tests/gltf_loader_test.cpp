@@ -5,6 +5,7 @@
 
 #include "scene/gltf_loader.h"
 #include "scene/scene_summary.h"
+#include "scene/texture_mips.h"
 
 #include <gtest/gtest.h>
 
@@ -14,6 +15,7 @@
 #include <fstream>
 #include <random>
 #include <set>
+#include <thread>
 
 namespace snell::test {
 namespace {
@@ -145,6 +147,50 @@ TEST(GltfLoader, DecodesTexturesBehindUrisWithSpaces) {
   for (const scene::Texture& t : scene.textures) {
     EXPECT_GT(t.width, 0u);
     EXPECT_EQ(t.rgba.size(), size_t(t.width) * t.height * 4);
+  }
+}
+
+TEST(GltfLoader, DecodesImagesOnEveryCoreAndSaysHowLongItTook) {
+  Scene scene = loadGltf(model("LightsPunctualLamp/glTF/LightsPunctualLamp.gltf"));
+  ASSERT_FALSE(scene.textures.empty());
+  for (const scene::Texture& t : scene.textures) EXPECT_EQ(t.rgba.size(), size_t(t.width) * t.height * 4) << t.name;
+  unsigned cores = std::max(1u, std::thread::hardware_concurrency());
+  EXPECT_EQ(scene.loadTimes.decodeThreads, std::min<unsigned>(cores, unsigned(scene.textures.size())));
+  EXPECT_GT(scene.loadTimes.decodeSeconds, 0.0);
+  EXPECT_GT(scene.loadTimes.parseSeconds, 0.0);
+}
+
+TEST(GltfLoader, ATextureBudgetLoadsTheLargestTexturesAtALowerMipWithANote) {
+  const std::string lamp = model("LightsPunctualLamp/glTF/LightsPunctualLamp.gltf");
+  scene::LoadOptions options;
+  options.textureBudget = 16ull << 20;
+  Scene full = loadGltf(lamp), fitted = loadGltf(lamp, options);
+  ASSERT_GT(scene::textureChainBytes(full), options.textureBudget) << "the model no longer tests the budget";
+  EXPECT_LE(scene::textureChainBytes(fitted), options.textureBudget);
+  size_t smaller = 0;
+  for (size_t i = 0; i < full.textures.size(); ++i) {
+    const scene::Texture &a = full.textures[i], &b = fitted.textures[i];
+    if (a.width == b.width && a.height == b.height) continue;
+    ++smaller;
+    int level = std::countr_zero(a.width / b.width);
+    EXPECT_EQ(b.width, std::max(a.width >> level, 1u)) << a.name;  // a mip level of the original
+    EXPECT_EQ(b.height, std::max(a.height >> level, 1u)) << a.name;
+  }
+  size_t notes = std::count_if(fitted.warnings.begin(), fitted.warnings.end(),
+                               [](const std::string& w) { return w.find("texture budget of 16.0 MiB") != std::string::npos; });
+  EXPECT_GT(smaller, 0u);
+  EXPECT_EQ(notes, smaller);
+}
+
+TEST(GltfLoader, ATextureBudgetNoMipLevelMeetsIsAClearError) {
+  scene::LoadOptions options;
+  options.textureBudget = 1;
+  try {
+    loadGltf(model("LightsPunctualLamp/glTF/LightsPunctualLamp.gltf"), options);
+    FAIL() << "a 1-byte texture budget was met";
+  } catch (const SceneError& e) {
+    EXPECT_NE(std::string(e.what()).find("LightsPunctualLamp.gltf"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("even at 1x1; the texture budget is 0.0 MiB"), std::string::npos) << e.what();
   }
 }
 

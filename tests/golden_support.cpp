@@ -225,6 +225,27 @@ scene::Scene iorStepScene() {
   return s;
 }
 
+render::CompositeFrame compositeOf(vk::Context& context, render::Renderer& renderer, const scene::Scene& s,
+                                   const scene::Pose& pose, const scene::View& view, uint32_t width, uint32_t height) {
+  render::RasterOptions options;
+  glm::dvec3 lo, hi;
+  scene::sceneBounds(s, pose, lo, hi);
+  render::fitDepthRange(view, lo, hi, options);
+  return render::renderComposite(context, renderer, pose, {width, height, view, {0.02f, 0.02f, 0.025f}, 8}, options);
+}
+
+void addGlassBox(scene::Scene& s, glm::vec3 lo, glm::vec3 hi, float ior) {
+  scene::Material glass;
+  glass.name = "glass box";
+  glass.transmission = 1.0f;
+  glass.ior = ior;
+  s.materials.push_back(glass);
+  std::vector<glm::vec3> positions;
+  std::vector<uint32_t> indices;
+  boxTriangles(lo, hi, positions, indices);
+  addFlatShape(s, positions, indices, int(s.materials.size()) - 1, glm::mat4(1.0f));
+}
+
 scene::Scene loadModel(const std::string& relative) {
   scene::LoadOptions load;
   load.ignoredExtensions = {"KHR_materials_iridescence"};  // Suzanne's film; her glass is what counts here

@@ -3,6 +3,7 @@
 #pragma once
 
 #include "cli/image_file.h"
+#include "render/renderer.h"
 #include "scene/evaluate.h"
 #include "scene/scene.h"
 #include "scene/view.h"
@@ -36,6 +37,11 @@ struct Comparison {
 
 Comparison compare(const cli::Rgb8Image& got, const cli::Rgb8Image& want);
 
+/// The viewport composite (and its whole trace) of `renderer`'s scene `s` at
+/// `pose` from `view`, the raster depth range fitted to the scene's bounds.
+render::CompositeFrame compositeOf(vk::Context& context, render::Renderer& renderer, const scene::Scene& s,
+                                   const scene::Pose& pose, const scene::View& view, uint32_t width, uint32_t height);
+
 /// The procedural eye with the cornea's index of refraction set.
 scene::Scene eyeWith(float ior);
 /// The eye with every transmissive face taken out: what IOR 1 must look like.
@@ -52,6 +58,8 @@ scene::Scene iorStepScene();
 int addFlatShape(scene::Scene& s, const std::vector<glm::vec3>& positions, const std::vector<uint32_t>& indices,
                  int material, const glm::mat4& world = glm::mat4(1.0f));
 /// An axis-aligned box's 12 triangles, wound to face out.
+/// A closed box of glass (transmission 1, `ior`) from `lo` to `hi`, flat faces.
+void addGlassBox(scene::Scene& s, glm::vec3 lo, glm::vec3 hi, float ior);
 void boxTriangles(glm::vec3 lo, glm::vec3 hi, std::vector<glm::vec3>& positions, std::vector<uint32_t>& indices);
 /// A model of ../shared/assets, its iridescence ignored.
 scene::Scene loadModel(const std::string& relative);

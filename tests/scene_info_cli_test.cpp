@@ -40,6 +40,23 @@ TEST(SceneInfoCommand, RequiredExtensionCanBeIgnoredOnRequest) {
   EXPECT_EQ(run.exitCode, 0) << run.output;
 }
 
+TEST(SceneInfoCommand, ReportsTextureMemoryWithMipsAndLoadTimes) {
+  CommandRun run = snell("info " + shellQuoted(model("LightsPunctualLamp/glTF/LightsPunctualLamp.gltf")) + " --timings");
+  EXPECT_EQ(run.exitCode, 0) << run.output;
+  EXPECT_NE(run.output.find("on the GPU with mips; largest"), std::string::npos) << run.output;
+  EXPECT_NE(run.output.find("load times: parse"), std::string::npos) << run.output;
+  EXPECT_NE(run.output.find("image decode"), std::string::npos) << run.output;
+}
+
+TEST(SceneInfoCommand, ATextureBudgetLoadsLowerMipsAndSaysSo) {
+  CommandRun run = snell("info " + shellQuoted(model("LightsPunctualLamp/glTF/LightsPunctualLamp.gltf")) +
+                         " --texture-budget 16");
+  EXPECT_EQ(run.exitCode, 0) << run.output;
+  EXPECT_NE(run.output.find("over the texture budget of 16.0 MiB"), std::string::npos) << run.output;
+  EXPECT_EQ(snell("info " + shellQuoted(model("LightsPunctualLamp/glTF/LightsPunctualLamp.gltf")) +
+                  " --texture-budget 0").exitCode, 2);
+}
+
 TEST(SceneInfoCommand, BadArgumentsExitTwoWithUsageHint) {
   CommandRun run = snell("info --frobnicate");
   EXPECT_EQ(run.exitCode, 2) << run.output;

@@ -197,12 +197,7 @@ TEST_F(GpuTest, FilmBackPanAndZoomMoveTraceAndRasterTogether) {
   view.halfHeight /= 1.6;
   const uint32_t w = 192, h = 144;
   render::Renderer renderer(context(), s, pose);
-  render::RasterOptions options;
-  glm::dvec3 lo, hi;
-  scene::sceneBounds(s, pose, lo, hi);
-  render::fitDepthRange(view, lo, hi, options);
-  render::CompositeFrame frame = render::renderComposite(context(), renderer, pose,
-                                                         {w, h, view, {0.02f, 0.02f, 0.025f}, 8}, options);
+  render::CompositeFrame frame = compositeOf(context(), renderer, s, pose, view, w, h);
   cli::Rgb8Image reference = referenceImage(s, pose, view, w, h);
   Comparison composite = compare(cli::toSrgb8({w, h, frame.rgba}), reference);
   Comparison trace = compare(cli::toSrgb8({w, h, frame.trace.rgba}), reference);

@@ -41,6 +41,7 @@ options:
   --json FILE         with --frames: write median frame and pass times
   --scene NAME|INDEX  which glTF scene of the file
   --ignore-extension E  load a file that requires extension E anyway
+  --texture-budget MIB  textures (with mips) beyond MIB MiB load at a lower mip level
 
 mouse (Maya):  Alt+left tumble, Alt+middle track, Alt+right dolly
 trackpad:      left drag tumble, Shift+left track, Ctrl+left or wheel dolly
@@ -95,6 +96,8 @@ snell::viewer::ViewerOptions parse(const std::vector<std::string>& args) {
       o.load.scene = v;
     } else if (a == "--ignore-extension") {
       o.load.ignoredExtensions.push_back(v);
+    } else if (a == "--texture-budget") {
+      o.load.textureBudget = snell::cli::parseTextureBudget(a, v);
     } else {
       throw UsageError{"unknown option " + a};
     }

@@ -1,32 +1,13 @@
 // Texture sampling and Phong shading as shaders/shared/trace.h states them,
 // shared by the trace pass (where a ray lands) and the raster pass (opaque
-// fragments), so both draw an opaque face the same way. The including shader
-// declares the readonly buffer `lights` (GpuLight[]) and defines the binding
-// slots of the texture table, the sRGB decode table and the first texel page
-// (SNELL_BINDING_TEXTURES, SNELL_BINDING_SRGB_DECODE, SNELL_BINDING_TEXEL_PAGES).
+// fragments), so both draw an opaque face the same way. Textures are
+// filtered here, in float, as trace.h states, so the GPU stays within
+// rounding of the reference. Include after common/scene.glsl.
 
 #ifndef SNELL_SHADING_GLSL
 #define SNELL_SHADING_GLSL
 
-layout(std430, binding = SNELL_BINDING_TEXTURES) readonly buffer Textures { GpuTexture textures[]; };
-layout(std430, binding = SNELL_BINDING_SRGB_DECODE) readonly buffer SrgbDecode { float srgbDecode[]; };
-// Pages are separate bindings, chosen by a switch rather than an array index:
-// indexing an array of buffers per ray needs descriptor indexing, which
-// Debian 12's lavapipe does not offer. Texels are filtered here, in float, as
-// trace.h states, so the GPU stays within rounding of the reference.
-layout(std430, binding = SNELL_BINDING_TEXEL_PAGES) readonly buffer TexelPage0 { uint texelPage0[]; };
-layout(std430, binding = SNELL_BINDING_TEXEL_PAGES + 1) readonly buffer TexelPage1 { uint texelPage1[]; };
-layout(std430, binding = SNELL_BINDING_TEXEL_PAGES + 2) readonly buffer TexelPage2 { uint texelPage2[]; };
-layout(std430, binding = SNELL_BINDING_TEXEL_PAGES + 3) readonly buffer TexelPage3 { uint texelPage3[]; };
-
-uint texelWord(uint page, uint i) {
-  switch (page) {
-    case 0u: return texelPage0[i];
-    case 1u: return texelPage1[i];
-    case 2u: return texelPage2[i];
-    default: return texelPage3[i];
-  }
-}
+#include "../shared/trace.h"
 
 const float kPi = 3.14159265358979;
 
@@ -44,40 +25,85 @@ int wrapIndex(int i, int size, uint mode) {
   return ((i % size) + size) % size;
 }
 
+// One mip level of a texture: where it starts in its page and its size.
+struct MipLevel {
+  uint first;
+  int width, height;
+};
+
+MipLevel mipLevel(GpuTexture tex, uint level) {
+  MipLevel m = MipLevel(tex.firstTexel, int(tex.width), int(tex.height));
+  for (uint l = 0u; l < level; ++l) {
+    m.first += uint(m.width * m.height);
+    m.width = max(m.width / 2, 1);
+    m.height = max(m.height / 2, 1);
+  }
+  return m;
+}
+
 // Colour textures are sRGB; data textures (the IOR's) are read as bytes / 255.
-vec3 texel(GpuTexture tex, int x, int y, bool srgb) {
-  x = wrapIndex(x, int(tex.width), tex.flags & 3u);
-  y = wrapIndex(y, int(tex.height), (tex.flags >> 2) & 3u);
-  uint rgba = texelWord(tex.flags >> kTexturePageShift, tex.firstTexel + uint(y) * tex.width + uint(x));
+vec3 texel(GpuTexture tex, MipLevel m, int x, int y, bool srgb) {
+  x = wrapIndex(x, m.width, tex.flags & 3u);
+  y = wrapIndex(y, m.height, (tex.flags >> 2) & 3u);
+  uint rgba = texelWord(tex.flags >> kTexturePageShift, m.first + uint(y * m.width + x));
   return srgb ? srgbToLinear(rgba) : vec3(rgba & 0xffu, (rgba >> 8) & 0xffu, (rgba >> 16) & 0xffu) / 255.0;
 }
 
-vec3 sampleTexture(uint index, vec2 uv, bool srgb) {
-  GpuTexture tex = textures[index];
-  if ((tex.flags & kTextureFlagNearest) != 0u) {
-    return texel(tex, int(floor(uv.x * float(tex.width))), int(floor(uv.y * float(tex.height))), srgb);
-  }
-  vec2 p = uv * vec2(tex.width, tex.height) - 0.5;
+vec3 bilinear(GpuTexture tex, uint level, vec2 uv, bool srgb) {
+  MipLevel m = mipLevel(tex, level);
+  vec2 p = uv * vec2(m.width, m.height) - 0.5;
   vec2 base = floor(p);
   vec2 f = p - base;
   int x = int(base.x), y = int(base.y);
-  vec3 top = mix(texel(tex, x, y, srgb), texel(tex, x + 1, y, srgb), f.x);
-  vec3 bottom = mix(texel(tex, x, y + 1, srgb), texel(tex, x + 1, y + 1, srgb), f.x);
+  vec3 top = mix(texel(tex, m, x, y, srgb), texel(tex, m, x + 1, y, srgb), f.x);
+  vec3 bottom = mix(texel(tex, m, x, y + 1, srgb), texel(tex, m, x + 1, y + 1, srgb), f.x);
   return mix(top, bottom, f.y);
 }
 
-vec3 textured(uint texture, vec4 uvs, uint texCoord, vec4 row0, vec4 row1, bool srgb) {
-  if (texture == kNoTexture) return vec3(1.0);
-  vec3 uv = vec3(texCoord == 1u ? uvs.zw : uvs.xy, 1.0);
-  return sampleTexture(texture, vec2(dot(row0.xyz, uv), dot(row1.xyz, uv)), srgb);
+// The texture at uv and level of detail `lod` (trace.h: Textures): trilinear
+// between the two levels around it, or the nearest texel of level 0.
+vec3 sampleTexture(uint index, vec2 uv, bool srgb, float lod) {
+  GpuTexture tex = textures[index];
+  if ((tex.flags & kTextureFlagNearest) != 0u) {
+    MipLevel m = mipLevel(tex, 0u);
+    return texel(tex, m, int(floor(uv.x * float(m.width))), int(floor(uv.y * float(m.height))), srgb);
+  }
+  uint levels = (tex.flags >> kTextureLevelsShift) & 31u;
+  if (!(lod > 0.0)) lod = 0.0;  // magnified, no footprint, or not finite: level 0
+  lod = min(lod, float(levels - 1u));
+  uint level = uint(lod);
+  float f = lod - float(level);
+  vec3 c = bilinear(tex, level, uv, srgb);
+  if (f > 0.0) c = mix(c, bilinear(tex, level + 1u, uv, srgb), f);
+  return c;
 }
 
-vec3 textured(uint texture, vec4 uvs, uint texCoord, vec4 row0, vec4 row1) {
-  return textured(texture, uvs, texCoord, row0, row1, true);
+// A lookup's level of detail comes in two parts: per UV set, what a texture
+// of lodOffset 0 is read at on this face (below), plus the slot's lodOffset.
+// 0.5 log2(UV area / world area) of a triangle, per UV set, from its world
+// edges e1 = p1 - p0, e2 = p2 - p0 and its corners' UVs.
+vec2 uvDensity(vec3 e1, vec3 e2, vec4 uv0, vec4 uv1, vec4 uv2) {
+  float world = length(cross(e1, e2));
+  vec4 d1 = uv1 - uv0, d2 = uv2 - uv0;
+  vec2 uvArea = abs(vec2(d1.x * d2.y - d1.y * d2.x, d1.z * d2.w - d1.w * d2.z));
+  return 0.5 * log2(uvArea / world);
 }
 
-vec3 baseColour(GpuMaterial m, vec4 uvs) {
-  return m.baseColorFactor.rgb * textured(m.textures.x, uvs, m.textures.y, m.baseUvRow0, m.baseUvRow1);
+// The level of detail a cone of `width` meeting the face at cosine `cosine`
+// (with its geometric normal) reads a texture of lodOffset 0 at.
+vec2 coneLod(vec2 density, float width, float cosine) {
+  return density + vec2(log2(width) - log2(abs(cosine)));
+}
+
+vec3 textured(GpuTextureSlot slot, vec4 uvs, vec2 lods, bool srgb) {
+  if (slot.texture == kNoTexture) return vec3(1.0);
+  vec3 uv = vec3(slot.texCoord == 1u ? uvs.zw : uvs.xy, 1.0);
+  float lod = (slot.texCoord == 1u ? lods.y : lods.x) + slot.lodOffset;
+  return sampleTexture(slot.texture, vec2(dot(slot.uvRow0.xyz, uv), dot(slot.uvRow1.xyz, uv)), srgb, lod);
+}
+
+vec3 baseColour(GpuMaterial m, vec4 uvs, vec2 lods) {
+  return m.baseColorFactor.rgb * textured(m.base, uvs, lods, true);
 }
 
 // Light i as seen from `position` (camera-relative): the unit direction
@@ -117,13 +143,13 @@ bool lightAt(uint i, uint lightCount, vec3 headlight, vec3 position, out vec3 l,
 }
 
 // Lit colour of a surface point seen along `dir`: `position` camera-relative,
-// `ns` the shading normal, `lightCount` lights (0: the headlight shining along
-// `headlight`).
-vec3 phong(vec3 position, vec3 ns, vec4 uvs, GpuMaterial m, vec3 dir, uint lightCount, vec3 headlight) {
-  vec3 base = baseColour(m, uvs);
+// `ns` the shading normal, `lods` its textures' level of detail, `lightCount`
+// lights (0: the headlight shining along `headlight`).
+vec3 phong(vec3 position, vec3 ns, vec4 uvs, vec2 lods, GpuMaterial m, vec3 dir, uint lightCount, vec3 headlight) {
+  vec3 base = baseColour(m, uvs, lods);
   vec3 n = dot(ns, dir) > 0.0 ? -ns : ns;  // towards the viewer
   vec3 v = -dir;
-  vec3 colour = m.emissiveFactor.rgb * textured(m.textures.z, uvs, m.textures.w, m.emissiveUvRow0, m.emissiveUvRow1) +
+  vec3 colour = m.emissiveFactor.rgb * textured(m.emissive, uvs, lods, true) +
                 kAmbient * base;
   uint count = max(lightCount, 1u);
   for (uint i = 0u; i < count; ++i) {

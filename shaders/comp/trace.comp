@@ -15,18 +15,8 @@ layout(push_constant) uniform Push { TracePush pc; };
 // Nodes are 40 bytes: read as five 8-byte words rather than ten 4-byte ones.
 layout(std430, binding = kTraceBindingTlasNodes) readonly buffer TlasNodes { uvec2 tlasWords[]; };
 layout(std430, binding = kTraceBindingTlasGroups) readonly buffer TlasGroups { BvhGroup tlasGroups[]; };
-layout(std430, binding = kTraceBindingInstances) readonly buffer Instances { GpuInstance instances[]; };
 layout(std430, binding = kTraceBindingBlasNodes) readonly buffer BlasNodes { uvec2 blasWords[]; };
 layout(std430, binding = kTraceBindingBlasGroups) readonly buffer BlasGroups { BvhGroup blasGroups[]; };
-layout(std430, binding = kTraceBindingPositions) readonly buffer Positions { float positions[]; };
-layout(std430, binding = kTraceBindingNormals) readonly buffer Normals { float normals[]; };
-layout(std430, binding = kTraceBindingTexcoords) readonly buffer Texcoords { vec4 texcoords[]; };
-layout(std430, binding = kTraceBindingIndices) readonly buffer Indices { uint indices[]; };
-layout(std430, binding = kTraceBindingMaterials) readonly buffer Materials { GpuMaterial materials[]; };
-#define SNELL_BINDING_TEXTURES kTraceBindingTextures
-#define SNELL_BINDING_SRGB_DECODE kTraceBindingSrgbDecode
-#define SNELL_BINDING_TEXEL_PAGES kTraceBindingTexelPages
-layout(std430, binding = kTraceBindingLights) readonly buffer Lights { GpuLight lights[]; };
 layout(std430, binding = kTraceBindingEnvironment) readonly buffer Environment { vec4 environment[]; };
 layout(binding = kTraceBindingImage, rgba16f) uniform writeonly image2D outImage;
 layout(std430, binding = kTraceBindingAov) writeonly buffer Aovs { TraceAov aovs[]; };

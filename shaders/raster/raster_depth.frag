@@ -9,5 +9,6 @@ layout(location = 1) in vec3 inNormal;
 layout(location = 2) in vec4 inUvs;
 layout(location = 3) flat in vec3 inGeometricNormal;
 layout(location = 4) flat in uint inMaterial;
+layout(location = 5) flat in vec2 inDensity;
 
 void main() {}

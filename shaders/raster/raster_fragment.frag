@@ -6,18 +6,12 @@
 #version 460
 #extension GL_GOOGLE_include_directive : require
 #include "../shared/raster.h"
-#include "../shared/trace.h"
+#include "../common/scene.glsl"
+#include "../common/shading.glsl"
 
 layout(push_constant) uniform Push { RasterPush pc; };
-layout(std430, binding = kRasterBindingMaterials) readonly buffer Materials { GpuMaterial materials[]; };
-#define SNELL_BINDING_TEXTURES kRasterBindingTextures
-#define SNELL_BINDING_SRGB_DECODE kRasterBindingSrgbDecode
-#define SNELL_BINDING_TEXEL_PAGES kRasterBindingTexelPages
-layout(std430, binding = kRasterBindingLights) readonly buffer Lights { GpuLight lights[]; };
 layout(binding = kRasterBindingTraceImage, rgba16f) uniform readonly image2D traceImage;
 layout(binding = kRasterBindingBehindDepth, r32ui) uniform readonly uimage2D behindDepth;
-
-#include "../common/shading.glsl"
 
 // The depth pre-pass has settled visibility: each pixel is shaded once.
 layout(early_fragment_tests) in;
@@ -27,6 +21,7 @@ layout(location = 1) in vec3 inNormal;
 layout(location = 2) in vec4 inUvs;
 layout(location = 3) flat in vec3 inGeometricNormal;
 layout(location = 4) flat in uint inMaterial;
+layout(location = 5) flat in vec2 inDensity;
 
 layout(location = 0) out vec4 outColour;
 
@@ -65,8 +60,13 @@ void main() {
   vec3 ng = normalize(inGeometricNormal);
   vec3 ns = dot(inNormal, inNormal) > 0.0 ? normalize(inNormal) : ng;
   if (dot(ns, ng) < 0.0) ns = -ns;
-  vec3 dir = (pc.flags & kRasterFlagOrthographic) != 0u ? pc.forward.xyz : normalize(inPosition - pc.eye.xyz);
-  if (m.emissiveFactor.w > 0.0) {
+  bool ortho = (pc.flags & kRasterFlagOrthographic) != 0u;
+  vec3 dir = ortho ? pc.forward.xyz : normalize(inPosition - pc.eye.xyz);
+  // The primary ray's cone, as the trace starts it (trace.h: Textures).
+  float height = float(imageSize(traceImage).y);
+  float width = ortho ? 2.0 / (pc.up.w * height) : atan(2.0 / (pc.up.w * height)) * length(inPosition - pc.eye.xyz);
+  vec2 lods = coneLod(inDensity, width, dot(dir, ng));
+  if (refractive(m)) {
     if ((pc.flags & (kRasterFlagNormalOffset | kRasterFlagIrisPlane)) == 0u) {
       outColour = vec4(imageLoad(traceImage, ivec2(gl_FragCoord.xy)).rgb, 1.0);
       return;
@@ -77,11 +77,11 @@ void main() {
       // Refraction bends the view towards the inward normal: look up against the normal's screen direction.
       at -= pc.offsetStrength * size.y * vec2(dot(ns, pc.right.xyz), -dot(ns, pc.up.xyz));
     } else {
-      at = irisPlaneLookup(dir, ns, m.baseUvRow0.w, size);
+      at = irisPlaneLookup(dir, ns, m.ior, size);
     }
     ivec2 texel = clamp(ivec2(floor(at)), ivec2(0), ivec2(size) - 1);
-    outColour = vec4(imageLoad(traceImage, texel).rgb * baseColour(m, inUvs), 1.0);
+    outColour = vec4(imageLoad(traceImage, texel).rgb * baseColour(m, inUvs, lods), 1.0);
     return;
   }
-  outColour = vec4(phong(inPosition, ns, inUvs, m, dir, pc.lightCount, pc.forward.xyz), 1.0);
+  outColour = vec4(phong(inPosition, ns, inUvs, lods, m, dir, pc.lightCount, pc.forward.xyz), 1.0);
 }

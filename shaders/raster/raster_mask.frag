@@ -6,18 +6,18 @@
 #version 460
 #extension GL_GOOGLE_include_directive : require
 #include "../shared/raster.h"
-#include "../shared/trace.h"
+#include "../common/scene.glsl"
 
 layout(early_fragment_tests) in;
 
 layout(push_constant) uniform Push { RasterPush pc; };
-layout(std430, binding = kRasterBindingMaterials) readonly buffer Materials { GpuMaterial materials[]; };
 
 layout(location = 0) in vec3 inPosition;
 layout(location = 1) in vec3 inNormal;
 layout(location = 2) in vec4 inUvs;
 layout(location = 3) flat in vec3 inGeometricNormal;
 layout(location = 4) flat in uint inMaterial;
+layout(location = 5) flat in vec2 inDensity;
 
 layout(location = 0) out uint outMask;
 
@@ -30,5 +30,5 @@ void main() {
     outMask = floatBitsToUint(max(ortho ? z - pc.forward.w + 1.0 : z, 1e-30));
     return;
   }
-  outMask = materials[inMaterial].emissiveFactor.w > 0.0 ? 1u : 0u;
+  outMask = refractive(materials[inMaterial]) ? 1u : 0u;
 }

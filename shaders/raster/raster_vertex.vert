@@ -2,41 +2,35 @@
 // (no vertex buffer, no second copy), placed by its instance's transform.
 #version 460
 #extension GL_GOOGLE_include_directive : require
-#include "../shared/bvh.h"
 #include "../shared/raster.h"
+#include "../common/scene.glsl"
+#include "../common/shading.glsl"
 
 layout(push_constant) uniform Push { RasterPush pc; };
-layout(std430, binding = kRasterBindingInstances) readonly buffer Instances { GpuInstance instances[]; };
-layout(std430, binding = kRasterBindingPositions) readonly buffer Positions { float positions[]; };
-layout(std430, binding = kRasterBindingNormals) readonly buffer Normals { float normals[]; };
-layout(std430, binding = kRasterBindingTexcoords) readonly buffer Texcoords { vec4 texcoords[]; };
-layout(std430, binding = kRasterBindingIndices) readonly buffer Indices { uint indices[]; };
 
 layout(location = 0) out vec3 outPosition;  // relative to the frame's origin
 layout(location = 1) out vec3 outNormal;    // world space, not normalised
 layout(location = 2) out vec4 outUvs;
 layout(location = 3) flat out vec3 outGeometricNormal;
 layout(location = 4) flat out uint outMaterial;
-
-vec3 vertexAt(uint v) { return vec3(positions[3u * v], positions[3u * v + 1u], positions[3u * v + 2u]); }
+layout(location = 5) flat out vec2 outDensity;  // uvDensity() of the triangle, per UV set
 
 void main() {
   uint triangle = uint(gl_VertexIndex) / 3u;
   uint corner = uint(gl_VertexIndex) % 3u;
   GpuInstance inst = instances[gl_InstanceIndex];
-  uint i0 = indices[3u * triangle], i1 = indices[3u * triangle + 1u], i2 = indices[3u * triangle + 2u];
-  uint v = corner == 0u ? i0 : (corner == 1u ? i1 : i2);
+  uvec3 i = triangleAt(triangle);
+  uint v = i[corner];
   vec4 p = vec4(vertexAt(v), 1.0);
   precise vec3 world = vec3(dot(inst.objectToWorld[0], p), dot(inst.objectToWorld[1], p), dot(inst.objectToWorld[2], p));
   // Normals by the inverse transpose, as the trace does.
-  // worldToObject holds the rows of W^-1, and mat3() takes columns: this is
-  // (W^-1)^T. (It was transposed once more, which is right only when W is
-  // symmetric: rotated instances got their normals turned the wrong way.)
-  mat3 toWorldNormal = mat3(inst.worldToObject[0].xyz, inst.worldToObject[1].xyz, inst.worldToObject[2].xyz);
-  vec3 p0 = vertexAt(i0), p1 = vertexAt(i1), p2 = vertexAt(i2);
+  mat3 toWorldNormal = normalToWorld(inst);
+  vec3 p0 = vertexAt(i.x), p1 = vertexAt(i.y), p2 = vertexAt(i.z);
   outGeometricNormal = toWorldNormal * cross(p1 - p0, p2 - p0);
-  outNormal = toWorldNormal * vec3(normals[3u * v], normals[3u * v + 1u], normals[3u * v + 2u]);
+  outNormal = toWorldNormal * normalAt(v);
   outUvs = texcoords[v];
+  outDensity = uvDensity(vectorToWorld(inst, p1 - p0), vectorToWorld(inst, p2 - p0), texcoords[i.x], texcoords[i.y],
+                         texcoords[i.z]);
   outMaterial = inst.material;
   outPosition = world;
 

@@ -7,7 +7,7 @@
 // away from silhouettes. Depth is reverse Z (near is 1, infinity is 0).
 #ifndef SNELL_RASTER_H
 #define SNELL_RASTER_H
-#include "shared_types.h"
+#include "scene.h"
 
 SNELL_GPU_BEGIN
 
@@ -21,19 +21,9 @@ SNELL_CONST kRasterFlagIrisPlane = 16u;    // where the refracted ray meets the 
 // nearest face (0: nothing), for kRasterFlagIrisPlane, instead of the transmissive mask.
 SNELL_CONST kRasterFlagBehindDepth = 32u;
 
-// Binding slots of set 0 (the same buffers the trace binds).
-SNELL_CONST kRasterBindingInstances = 0;  // GpuInstance[]
-SNELL_CONST kRasterBindingPositions = 1;  // float[3 * vertexCount]
-SNELL_CONST kRasterBindingNormals = 2;    // float[3 * vertexCount]
-SNELL_CONST kRasterBindingTexcoords = 3;  // vec4[vertexCount]
-SNELL_CONST kRasterBindingIndices = 4;    // uint[3 * triangleCount], absolute
-SNELL_CONST kRasterBindingMaterials = 5;  // GpuMaterial[]
-SNELL_CONST kRasterBindingTextures = 6;   // GpuTexture[]
-SNELL_CONST kRasterBindingSrgbDecode = 7;  // float[kSrgbDecodeWords]
-SNELL_CONST kRasterBindingLights = 8;     // GpuLight[]
-SNELL_CONST kRasterBindingTraceImage = 9; // rgba16f storage image, read at the fragment's pixel (or displaced)
-SNELL_CONST kRasterBindingTexelPages = 11;  // 11 to 11 + kTexelPages - 1: uint[] texel pages
-SNELL_CONST kRasterBindingBehindDepth = 10;  // r32ui storage image: view depth bits behind the glass (kRasterFlagIrisPlane)
+// The raster pass's own binding slots, after the scene binding set (shared/scene.h).
+SNELL_CONST kRasterBindingTraceImage = kSceneBindingCount + 0;   // rgba16f storage image, read at the fragment's pixel (or displaced)
+SNELL_CONST kRasterBindingBehindDepth = kSceneBindingCount + 1;  // r32ui storage image: view depth bits behind the glass (kRasterFlagIrisPlane)
 
 // One draw per draw item: gl_InstanceIndex is the item, gl_VertexIndex / 3
 // the absolute triangle. Vectors are relative to the frame's origin.

@@ -94,13 +94,36 @@
 // reflected rays see the environment). Alpha is 1 everywhere.
 //
 // Textures. uv' = (T * vec3(uv, 1)).xy with T the KHR_texture_transform matrix;
-// x = u' W - 0.5, y = v' H - 0.5 (row 0 is the image's first row); texels are
-// decoded from sRGB to linear, then filtered bilinearly (or the nearest texel,
-// floor(u' W), when the sampler says nearest). Wrap per axis: repeat, mirrored
-// repeat or clamp to edge, applied to the integer texel index.
+// at mip level l (W_l = max(1, W >> l), H_l likewise; shared/scene.h lays the
+// levels out, each the 2x2 mean of the one above in linear light),
+// x = u' W_l - 0.5, y = v' H_l - 0.5 (row 0 is the image's first row); texels
+// are decoded from sRGB to linear, then filtered bilinearly within a level and
+// linearly between the two levels around the level of detail (trilinear).
+// A sampler that says nearest reads the nearest texel of level 0, floor(u' W).
+// Wrap per axis: repeat, mirrored repeat or clamp to edge, applied to the
+// integer texel index.
+// Level of detail: ray cones (Akenine-Möller et al., Ray Tracing Gems, ch. 20).
+//   Each ray carries a cone, width w at its origin and spread angle a:
+//   perspective primary rays w = 0, a = atan(2 tanHalfFovY / H); orthographic
+//   w = 2 halfHeight / H, a = 0; listed rays w = 0, a = 0 (level 0). At a hit
+//   at distance t the cone is w' = w + a t wide, and a texture is read at
+//     lod = 0.5 log2(W H |det T2|) + 0.5 log2(A_uv / A_world) + log2(w') - log2|dot(d, Ng)|,
+//   T2 the transform's 2x2 part, A_uv = |cross2(uv1 - uv0, uv2 - uv0)| of the
+//   texture's UV set and A_world = |cross(v1 - v0, v2 - v0)| (world space);
+//   clamped to [0, levels - 1], and 0 where it is not a number.
+//   The cone goes on from the hit w' wide. At a boundary that bends, with
+//   k = the triangle's curvature, the largest |n_i - n_j| / |v_i - v_j| over
+//   its edges (unit world vertex normals; 0 without normals or on a
+//   degenerate edge): a refracted ray's a' = eta a + |1 - eta| k w'; a
+//   reflected ray and total internal reflection a' = a + 2 k w'. A straight
+//   crossing keeps a. (|1 - eta| widens where a converging lens would narrow:
+//   it errs on the side of blur, never of aliasing.) The raster pass reads
+//   opaque fragments with the primary ray's cone, so it and the trace agree.
+//   The environment map has no mips: reflected rays read it at full size.
+//   With kOpticsTextureLod off, traced rays read every texture at level 0.
 #ifndef SNELL_TRACE_H
 #define SNELL_TRACE_H
-#include "shared_types.h"
+#include "scene.h"
 
 SNELL_GPU_BEGIN
 
@@ -135,80 +158,13 @@ SNELL_CONST kDefaultReflections = 1;  // true boundaries per path that send a re
 // TracePush::optics bits.
 SNELL_CONST kOpticsFresnel = 1u;         // R and T at every boundary, reflections, highlights
 SNELL_CONST kOpticsEnvironmentMap = 2u;  // reflected rays read kTraceBindingEnvironment, not the studio gradient
-
-SNELL_CONST kLightDirectional = 0;
-SNELL_CONST kLightPoint = 1;
-SNELL_CONST kLightSpot = 2;
-
-SNELL_CONST kWrapRepeat = 0;
-SNELL_CONST kWrapMirror = 1;
-SNELL_CONST kWrapClamp = 2;
-
-SNELL_CONST kNoTexture = 0xffffffffu;
+SNELL_CONST kOpticsTextureLod = 4u;      // textures at the ray cone's level of detail (off: level 0)
 
 // What a traced pixel ended on (TraceAov::outcome).
 SNELL_CONST kOutcomeMiss = 0;
 SNELL_CONST kOutcomeOpaque = 1;
 SNELL_CONST kOutcomeInterfaceLimit = 2;  // more refractive faces than maxInterfaces
 
-// 176 bytes, total: 176 bytes
-struct GpuMaterial {
-  vec4 baseColorFactor;  // 16
-  vec4 emissiveFactor;   // 16: rgb, w: transmission factor (> 0: the face refracts)
-  vec4 baseUvRow0;       // 16: KHR_texture_transform, first row (xyz); w: index of refraction
-  vec4 baseUvRow1;       // 16: second row (xyz); w: roughness (the highlight's width)
-  vec4 emissiveUvRow0;   // 16: xyz; w: dispersion (20 / Abbe number; 0: none)
-  vec4 emissiveUvRow1;   // 16: xyz; w: priority among overlapping media (larger wins)
-  uvec4 textures;        // 16: base texture, its texCoord, emissive texture, its texCoord
-  vec4 attenuation;      // 16: rgb attenuation colour; w: attenuation distance (0: no volume)
-  vec4 iorUvRow0;        // 16: the IOR texture's transform, first row; w: its scale
-  vec4 iorUvRow1;        // 16: second row; w: its offset
-  uvec4 iorTexture;      // 16: IOR texture (kNoTexture: none), its texCoord, unused, unused
-};
-
-// The sRGB decode table (kTraceBindingSrgbDecode): the linear value of each
-// sRGB byte (the reference's double, rounded once), so a texel decodes by
-// lookup, as the CPU reference does, rather than by a float pow.
-SNELL_CONST kSrgbDecodeWords = 256;
-
-// Texels live in up to kTexelPages storage buffers (pages), each within the
-// device's largest storage buffer, so a scene's textures together may exceed
-// it. A texture's whole mip chain lies in one page: level 0 (RGBA8, as the
-// file stores it, one uint per texel) from firstTexel, each next level (half
-// the size, rounded down, at least 1) right after the one before, down to 1x1.
-SNELL_CONST kTexelPages = 4;
-SNELL_CONST kTextureFlagNearest = 16u;
-SNELL_CONST kTextureLevelsShift = 8;   // flags bits 8-12: mip levels
-SNELL_CONST kTexturePageShift = 13;    // flags bits 13-15: the page
-
-// 16 bytes, total: 16 bytes
-struct GpuTexture {
-  uint firstTexel;  // 4: level 0's first texel in its page
-  uint width;       // 4: of level 0
-  uint height;      // 4
-  uint flags;       // 4: bits 0-1 wrap S, 2-3 wrap T, 4 nearest, 8-12 levels, 13-15 page
-};
-
-// shaders/comp/texture_mips.comp: one level from the level above, in one page.
-// 32 bytes, total: 32 bytes
-struct TextureMipPush {
-  uint sourceFirst;   // 4: the level above's first texel
-  uint sourceWidth;   // 4
-  uint sourceHeight;  // 4
-  uint targetFirst;   // 4
-  uint targetWidth;   // 4
-  uint targetHeight;  // 4
-  uint srgb;          // 4: 1: averaged in linear light (colour), 0: as bytes (data)
-  uint pad;           // 4
-};
-
-// 64 bytes, total: 64 bytes
-struct GpuLight {
-  vec4 positionType;  // 16: camera-relative position, w: kLight* as float
-  vec4 direction;     // 16: the way the light shines (unit), w: range (0: infinite)
-  vec4 radiance;      // 16: colour * intensity, w unused
-  vec4 cone;          // 16: cos inner, cos outer, unused, unused
-};
 
 // Per-pixel outputs for tests and tools, written when TracePush::flags has kTraceFlagAov.
 // 32 bytes, total: 32 bytes
@@ -233,28 +189,18 @@ SNELL_CONST kTraceTile = 8;  // pixels per side of one workgroup's tile
 // Nodes one ray segment may visit before it gives up: a corrupted tree ends here.
 SNELL_CONST kTraceMaxVisits = 1u << 20;
 
-// Binding slots of set 0.
-SNELL_CONST kTraceBindingTlasNodes = 0;
-SNELL_CONST kTraceBindingTlasGroups = 1;
-SNELL_CONST kTraceBindingInstances = 2;
-SNELL_CONST kTraceBindingBlasNodes = 3;
-SNELL_CONST kTraceBindingBlasGroups = 4;
-SNELL_CONST kTraceBindingPositions = 5;   // float[3 * vertexCount]
-SNELL_CONST kTraceBindingNormals = 6;     // float[3 * vertexCount]
-SNELL_CONST kTraceBindingTexcoords = 7;   // vec4[vertexCount]: uv0, uv1
-SNELL_CONST kTraceBindingIndices = 8;     // uint[3 * triangleCount], absolute
-SNELL_CONST kTraceBindingMaterials = 9;   // GpuMaterial[]
-SNELL_CONST kTraceBindingTextures = 10;   // GpuTexture[]
-SNELL_CONST kTraceBindingSrgbDecode = 11;  // float[kSrgbDecodeWords]
-SNELL_CONST kTraceBindingLights = 12;     // GpuLight[]
-SNELL_CONST kTraceBindingImage = 13;      // rgba16f storage image
-SNELL_CONST kTraceBindingAov = 14;        // TraceAov[width * height]
-SNELL_CONST kTraceBindingRays = 15;       // GpuRay[width * height], with kTraceFlagRayList
-SNELL_CONST kTraceBindingPixels = 16;     // TracePixelList, with kTraceFlagPixelList
-SNELL_CONST kTraceBindingMask = 17;       // r32ui image: non-zero where a transmissive face is visible (compaction)
-SNELL_CONST kTraceBindingGeometryFirst = 18;  // uint[geometryCount]: first triangle (driver-rt pipeline only)
-SNELL_CONST kTraceBindingEnvironment = 19;    // vec4[]: (width, height, 0, 0), then width * height linear RGB texels, row 0 at +Y
-SNELL_CONST kTraceBindingTexelPages = 20;     // 20 to 20 + kTexelPages - 1: uint[] texel pages
+// The trace's own binding slots, after the scene binding set (shared/scene.h).
+SNELL_CONST kTraceBindingTlasNodes = kSceneBindingCount + 0;
+SNELL_CONST kTraceBindingTlasGroups = kSceneBindingCount + 1;
+SNELL_CONST kTraceBindingBlasNodes = kSceneBindingCount + 2;
+SNELL_CONST kTraceBindingBlasGroups = kSceneBindingCount + 3;
+SNELL_CONST kTraceBindingImage = kSceneBindingCount + 4;          // rgba16f storage image
+SNELL_CONST kTraceBindingAov = kSceneBindingCount + 5;            // TraceAov[width * height]
+SNELL_CONST kTraceBindingRays = kSceneBindingCount + 6;           // GpuRay[width * height], with kTraceFlagRayList
+SNELL_CONST kTraceBindingPixels = kSceneBindingCount + 7;         // TracePixelList, with kTraceFlagPixelList
+SNELL_CONST kTraceBindingMask = kSceneBindingCount + 8;           // r32ui image: non-zero where a transmissive face is visible (compaction)
+SNELL_CONST kTraceBindingGeometryFirst = kSceneBindingCount + 9;  // uint[geometryCount]: first triangle (driver-rt pipeline only)
+SNELL_CONST kTraceBindingEnvironment = kSceneBindingCount + 10;   // vec4[]: (width, height, 0, 0), then width * height linear RGB texels, row 0 at +Y
 
 // A primary ray from a list, relative to the frame origin like everything the trace sees.
 // 32 bytes, total: 32 bytes

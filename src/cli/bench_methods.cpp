@@ -325,8 +325,9 @@ struct OpticsVariant {
 };
 
 std::vector<OpticsVariant> opticsVariants(const scene::Scene& scene, const std::optional<scene::EyeOptions>& eye) {
-  scene::Optics plain, fresnel, environment, reflections;
+  scene::Optics plain, fresnel, environment, reflections, levelZero;
   plain.fresnel = false;
+  levelZero.textureLod = false;
   environment.environment = std::make_shared<scene::Environment>(scene::proceduralSky());
   reflections.reflections = 4;
   using stress::withGlass;
@@ -337,6 +338,7 @@ std::vector<OpticsVariant> opticsVariants(const scene::Scene& scene, const std::
   std::vector<OpticsVariant> rows = {
       {"plain", "no Fresnel: the bend only", scene, plain},
       {"fresnel", "Fresnel, one reflected ray, highlights, studio gradient (the default)", scene, fresnel},
+      {"texture-level-0", "the default without ray cones: every texture read at level 0", scene, levelZero},
       {"environment", "the reflected ray sees a 1024x512 HDR sky with a sun", scene, environment},
       {"reflections-4", "four boundaries per path send a reflected ray", scene, reflections},
       {"volume", "Beer-Lambert inside every transmissive material", withGlass(scene, volume), fresnel},

@@ -37,6 +37,9 @@ void parseSize(const std::string& option, const std::string& value, uint32_t& wi
 /// Parses an unsigned integer option value or throws UsageError naming the option.
 unsigned long long parseCount(const std::string& option, const std::string& value);
 
+/// Parses a texture budget in MiB (1..2^20) into bytes, or throws UsageError naming the option.
+uint64_t parseTextureBudget(const std::string& option, const std::string& value);
+
 /// The median of `values` (0 when empty), for benchmark tables.
 double median(std::vector<double> values);
 

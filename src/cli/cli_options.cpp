@@ -35,6 +35,12 @@ void parseSize(const std::string& option, const std::string& value, uint32_t& wi
   height = uint32_t(h);
 }
 
+uint64_t parseTextureBudget(const std::string& option, const std::string& value) {
+  unsigned long long mib = parseCount(option, value);
+  if (mib == 0 || mib > (1ull << 20)) throw UsageError{option + " " + value + " is out of range (1 to 1048576 MiB)"};
+  return uint64_t(mib) << 20;
+}
+
 double median(std::vector<double> values) {
   if (values.empty()) return 0;
   std::sort(values.begin(), values.end());

@@ -1,11 +1,15 @@
 // `snell info`: the device table (--devices), or what a scene file holds.
 #include "cli/cli.h"
 
+#include "render/scene_gpu.h"
+#include "scene/evaluate.h"
 #include "scene/gltf_loader.h"
 #include "scene/scene_summary.h"
 #include "vk/context.h"
 
+#include <chrono>
 #include <cstdio>
+#include <memory>
 
 namespace snell::cli {
 
@@ -13,12 +17,17 @@ namespace {
 
 constexpr const char* kHelp = R"(usage: snell info --devices
        snell info SCENE.gltf|SCENE.glb [--scene NAME|INDEX] [--ignore-extension EXT]...
+                  [--texture-budget MIB] [--timings]
 
   --devices             list Vulkan devices, the one snell picks, and why
   SCENE                 shapes, triangles, refractive materials with their IOR,
-                        lights, cameras, animations, and the GPU memory a frame needs
+                        textures and their memory with mips, lights, cameras,
+                        animations, and the GPU memory a frame needs
   --scene S             use this glTF scene instead of the file's default
   --ignore-extension E  load a file that requires extension E anyway, without it
+  --texture-budget MIB  textures (with mips) beyond MIB MiB load at a lower mip level
+  --timings             also upload the scene to the GPU and print where loading
+                        spent its time: parse, image decode (all cores), upload
 )";
 
 int devices() {
@@ -48,12 +57,16 @@ int runInfo(const Args& args) {
   }
   std::string path;
   scene::LoadOptions options;
+  bool timings = false;
   for (size_t i = 0; i < args.size(); ++i) {
     const std::string& a = args[i];
-    if (a == "--scene" || a == "--ignore-extension") {
+    if (a == "--scene" || a == "--ignore-extension" || a == "--texture-budget") {
       if (i + 1 >= args.size()) throw UsageError{"info: " + a + " needs a value"};
       if (a == "--scene") options.scene = args[++i];
-      else options.ignoredExtensions.push_back(args[++i]);
+      else if (a == "--ignore-extension") options.ignoredExtensions.push_back(args[++i]);
+      else options.textureBudget = parseTextureBudget(a, args[++i]);
+    } else if (a == "--timings") {
+      timings = true;
     } else if (!a.empty() && a[0] == '-') {
       throw UsageError{"info: unknown option " + a};
     } else if (path.empty()) {
@@ -65,6 +78,18 @@ int runInfo(const Args& args) {
   if (path.empty()) throw UsageError{"info: no scene file given"};
   scene::Scene scene = scene::loadGltf(path, options);
   std::fputs(scene::describe(scene).c_str(), stdout);
+  if (timings) {
+    const scene::Scene::LoadTimes& t = scene.loadTimes;
+    std::unique_ptr<vk::Context> context = vk::Context::create(contextDescFromEnvironment());
+    scene::Pose pose = scene::evaluate(scene, 0.0);
+    auto start = std::chrono::steady_clock::now();
+    render::SceneGpu gpu = render::uploadScene(*context, scene, pose);
+    double upload = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    std::printf("  load times: parse %.1f ms, image decode %.1f ms (%u threads), upload %.1f ms "
+                "(textures %.1f ms: %s with mips through a 32 MiB staging ring) on %s\n",
+                t.parseSeconds * 1e3, t.decodeSeconds * 1e3, t.decodeThreads, upload * 1e3,
+                gpu.textureUploadSeconds * 1e3, scene::mebibytes(gpu.textureBytes).c_str(), context->facts().name.c_str());
+  }
   return 0;
 }
 

@@ -56,6 +56,7 @@ options:
   --no-fresnel           glass transmits everything and reflects nothing
   --scene NAME|INDEX     which glTF scene of the file
   --ignore-extension E   load a file that requires extension E anyway
+  --texture-budget MIB   textures (with mips) beyond MIB MiB load at a lower mip level
   --reference            render with the CPU double-precision reference instead
                          of the GPU (slow; golden images are made this way)
   --method M             how refraction is drawn (default trace): trace,
@@ -182,6 +183,8 @@ Options parse(const Args& args) {
       o.load.scene = v;
     } else if (a == "--ignore-extension") {
       o.load.ignoredExtensions.push_back(v);
+    } else if (a == "--texture-budget") {
+      o.load.textureBudget = parseTextureBudget(a, v);
     } else {
       throw UsageError{"render: unknown option " + a};
     }

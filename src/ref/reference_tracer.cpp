@@ -4,6 +4,7 @@
 #include "ref/reference_tracer.h"
 
 #include "ref/sah_bvh.h"
+#include "scene/texture_mips.h"
 
 #include <algorithm>
 #include <atomic>
@@ -43,11 +44,16 @@ glm::dvec3 unitOrZero(const glm::dvec3& v) {
 // ---------------------------------------------------------------------------
 // Textures
 
-/// A texture decoded once to linear RGB (sRGB decode per texel, before filtering).
-struct LinearTexture {
-  uint32_t width = 0, height = 0;
-  std::vector<glm::dvec3> texels;  // row 0 is the image's first row
+/// One mip level decoded once (sRGB decode per texel, before filtering).
+struct LinearLevel {
+  int64_t width = 0, height = 0;
+  std::vector<glm::dvec3> texels;  // linear RGB; row 0 is the image's first row
   std::vector<glm::dvec3> data;    // the same texels as bytes / 255 (data textures: the IOR's)
+};
+
+/// A texture's mip chain (scene::mipChain, the GPU's rule) decoded.
+struct LinearTexture {
+  std::vector<LinearLevel> levels;  // empty: unusable, sampled as white
   uint32_t wrapS = gpu::kWrapRepeat, wrapT = gpu::kWrapRepeat;
   bool nearest = false;
 };
@@ -57,21 +63,23 @@ uint32_t wrapMode(bool repeat, bool mirror) {
   return repeat ? gpu::kWrapRepeat : gpu::kWrapClamp;
 }
 
-LinearTexture decode(const scene::Texture& t) {
+LinearTexture decode(const scene::Texture& t, bool colour) {
   LinearTexture out;
-  const size_t count = size_t(t.width) * t.height;
-  if (count == 0 || t.rgba.size() < count * 4) return out;  // unusable: sampled as white
   double table[256];
   for (int v = 0; v < 256; ++v) table[v] = scene::srgbToLinear(uint8_t(v));
-  out.width = t.width;
-  out.height = t.height;
-  out.texels.resize(count);
-  for (size_t i = 0; i < count; ++i) {
-    out.texels[i] = {table[t.rgba[i * 4 + 0]], table[t.rgba[i * 4 + 1]], table[t.rgba[i * 4 + 2]]};
-  }
-  out.data.resize(count);
-  for (size_t i = 0; i < count; ++i) {
-    out.data[i] = glm::dvec3(t.rgba[i * 4 + 0], t.rgba[i * 4 + 1], t.rgba[i * 4 + 2]) / 255.0;
+  for (const scene::MipLevel& level : scene::mipChain(t, colour)) {
+    LinearLevel l;
+    l.width = level.width;
+    l.height = level.height;
+    const size_t count = size_t(level.width) * level.height;
+    l.texels.resize(count);
+    l.data.resize(count);
+    for (size_t i = 0; i < count; ++i) {
+      const uint8_t* rgba = &level.rgba[i * 4];
+      l.texels[i] = {table[rgba[0]], table[rgba[1]], table[rgba[2]]};
+      l.data[i] = glm::dvec3(rgba[0], rgba[1], rgba[2]) / 255.0;
+    }
+    out.levels.push_back(std::move(l));
   }
   out.wrapS = wrapMode(t.repeatS, t.mirrorS);
   out.wrapT = wrapMode(t.repeatT, t.mirrorT);
@@ -95,19 +103,36 @@ int64_t floorIndex(double x) {
   return int64_t(std::floor(std::clamp(x, -1e15, 1e15)));
 }
 
-glm::dvec3 sample(const LinearTexture& t, const glm::dvec2& uv, bool srgb = true) {
-  const int64_t w = t.width, h = t.height;
-  const std::vector<glm::dvec3>& texels = srgb ? t.texels : t.data;
+glm::dvec3 bilinear(const LinearTexture& t, size_t level, const glm::dvec2& uv, bool srgb) {
+  const LinearLevel& l = t.levels[level];
+  const std::vector<glm::dvec3>& texels = srgb ? l.texels : l.data;
   auto texel = [&](int64_t x, int64_t y) {
-    return texels[size_t(wrapIndex(y, h, t.wrapT) * w + wrapIndex(x, w, t.wrapS))];
+    return texels[size_t(wrapIndex(y, l.height, t.wrapT) * l.width + wrapIndex(x, l.width, t.wrapS))];
   };
-  if (t.nearest) return texel(floorIndex(uv.x * double(w)), floorIndex(uv.y * double(h)));
-  double x = uv.x * double(w) - 0.5, y = uv.y * double(h) - 0.5;
+  double x = uv.x * double(l.width) - 0.5, y = uv.y * double(l.height) - 0.5;
   int64_t x0 = floorIndex(x), y0 = floorIndex(y);
   double fx = std::clamp(x - double(x0), 0.0, 1.0), fy = std::clamp(y - double(y0), 0.0, 1.0);
   glm::dvec3 top = glm::mix(texel(x0, y0), texel(x0 + 1, y0), fx);
   glm::dvec3 bottom = glm::mix(texel(x0, y0 + 1), texel(x0 + 1, y0 + 1), fx);
   return glm::mix(top, bottom, fy);
+}
+
+/// The texture at uv and level of detail `lod` (trace.h: Textures).
+glm::dvec3 sample(const LinearTexture& t, const glm::dvec2& uv, bool srgb, double lod) {
+  if (t.nearest) {
+    const LinearLevel& l = t.levels[0];
+    const std::vector<glm::dvec3>& texels = srgb ? l.texels : l.data;
+    int64_t x = wrapIndex(floorIndex(uv.x * double(l.width)), l.width, t.wrapS);
+    int64_t y = wrapIndex(floorIndex(uv.y * double(l.height)), l.height, t.wrapT);
+    return texels[size_t(y * l.width + x)];
+  }
+  if (!(lod > 0.0)) lod = 0.0;  // magnified, no footprint, or not finite: level 0
+  lod = std::min(lod, double(t.levels.size() - 1));
+  const size_t level = size_t(lod);
+  const double f = lod - double(level);
+  glm::dvec3 c = bilinear(t, level, uv, srgb);
+  if (f > 0.0) c = glm::mix(c, bilinear(t, level + 1, uv, srgb), f);
+  return c;
 }
 
 // ---------------------------------------------------------------------------
@@ -117,6 +142,7 @@ struct TextureUse {
   const LinearTexture* texture = nullptr;  // null: white
   int texCoord = 0;
   glm::dmat3 transform{1.0};
+  double lodOffset = 0.0;  // scene::textureLodOffset
 };
 
 struct ResolvedMaterial {
@@ -151,6 +177,8 @@ struct TriangleData {
   glm::dvec3 n[3];   // world, unit, or zero where the shape has none
   glm::dvec2 uv[2][3];  // TEXCOORD_0 and _1, (0, 0) where missing
   glm::dvec3 ng;     // unit geometric normal
+  double density[2] = {0.0, 0.0};  // 0.5 log2(UV area / world area) per UV set (trace.h: Textures)
+  double curvature = 0.0;          // the largest turn of the unit vertex normals per unit of edge
   int32_t item = -1, primitive = -1;
   int material = -1;
 };
@@ -207,11 +235,13 @@ class PreparedScene {
 
 PreparedScene::PreparedScene(const scene::Scene& scene, const scene::Pose& pose, const scene::View& view) {
   textures_.reserve(scene.textures.size());
-  for (const scene::Texture& t : scene.textures) textures_.push_back(decode(t));
+  const std::vector<bool> colour = scene::colourTextures(scene);
+  for (size_t t = 0; t < scene.textures.size(); ++t) textures_.push_back(decode(scene.textures[t], colour[t]));
   auto use = [&](const scene::TextureRef& ref) {
     TextureUse u;
-    if (ref.texture >= 0 && size_t(ref.texture) < textures_.size() && !textures_[size_t(ref.texture)].texels.empty()) {
+    if (ref.texture >= 0 && size_t(ref.texture) < textures_.size() && !textures_[size_t(ref.texture)].levels.empty()) {
       u.texture = &textures_[size_t(ref.texture)];
+      u.lodOffset = scene::textureLodOffset(scene.textures[size_t(ref.texture)], ref);
     }
     u.texCoord = ref.texCoord;
     u.transform = glm::dmat3(ref.transform);
@@ -314,6 +344,19 @@ void PreparedScene::addItem(const scene::Scene& scene, const scene::DrawItem& it
     glm::dvec3 e1 = d.v[1] - d.v[0], e2 = d.v[2] - d.v[0];
     d.ng = unitOrZero(glm::cross(e1, e2));
     if (d.ng == glm::dvec3(0.0)) continue;  // no area: never hit
+    const double worldArea = glm::length(glm::cross(e1, e2));
+    for (int set = 0; set < 2; ++set) {
+      glm::dvec2 d1 = d.uv[set][1] - d.uv[set][0], d2 = d.uv[set][2] - d.uv[set][0];
+      d.density[set] = 0.5 * std::log2(std::abs(d1.x * d2.y - d1.y * d2.x) / worldArea);
+    }
+    if (d.n[0] != glm::dvec3(0.0) && d.n[1] != glm::dvec3(0.0) && d.n[2] != glm::dvec3(0.0)) {
+      double k = 0.0;
+      for (int a = 0; a < 3; ++a) {
+        int b = (a + 1) % 3;
+        k = std::max(k, glm::length(d.n[b] - d.n[a]) / glm::length(d.v[b] - d.v[a]));
+      }
+      d.curvature = k < 1e30 ? k : 0.0;  // NaN and infinity: 0
+    }
     d.item = itemIndex;
     d.primitive = int32_t(t);
     d.material = shape.material;
@@ -480,16 +523,30 @@ Hit PreparedScene::intersect(const glm::dvec3& origin, const glm::dvec3& directi
 // ---------------------------------------------------------------------------
 // Tracing
 
-glm::dvec3 textureColor(const TextureUse& use, const TriangleData& tri, double b0, double b1, double b2,
-                        bool srgb = true) {
+/// Where a ray meets a face: its hit weights and the level of detail per UV
+/// set that a texture of lodOffset 0 is read at there.
+struct SurfacePoint {
+  double b0, b1, b2;
+  glm::dvec2 lods;
+};
+
+/// The cone's level of detail terms on `tri` (trace.h: Textures).
+glm::dvec2 coneLods(const TriangleData& tri, double width, const glm::dvec3& d) {
+  const double footprint = std::log2(width) - std::log2(std::abs(glm::dot(d, tri.ng)));
+  return {tri.density[0] + footprint, tri.density[1] + footprint};
+}
+
+glm::dvec3 textureColor(const TextureUse& use, const TriangleData& tri, const SurfacePoint& at, bool srgb = true) {
   if (!use.texture) return glm::dvec3(1.0);
+  const double b0 = at.b0, b1 = at.b1, b2 = at.b2;
   glm::dvec2 uv(0.0);
   if (use.texCoord == 0 || use.texCoord == 1) {
     const glm::dvec2* set = tri.uv[use.texCoord];
     uv = b0 * set[0] + b1 * set[1] + b2 * set[2];
   }
   glm::dvec3 transformed = use.transform * glm::dvec3(uv, 1.0);  // KHR_texture_transform
-  return sample(*use.texture, glm::dvec2(transformed), srgb);
+  const double lod = (use.texCoord == 1 ? at.lods.y : at.lods.x) + use.lodOffset;
+  return sample(*use.texture, glm::dvec2(transformed), srgb, lod);
 }
 
 /// Light `light` as seen from p: the unit direction towards it and its
@@ -657,9 +714,9 @@ struct Tracer {
     return kSecondaryEpsilon * std::max(maxAbs(origin), prepared.size());
   }
 
-  double surfaceIor(const ResolvedMaterial& m, const TriangleData& tri, double b0, double b1, double b2, int channel) const {
+  double surfaceIor(const ResolvedMaterial& m, const TriangleData& tri, const SurfacePoint& at, int channel) const {
     double ior = m.baseIor;
-    if (m.ior.texture) ior = std::max(1.0, ior + m.iorOffset + m.iorScale * textureColor(m.ior, tri, b0, b1, b2, false).r);
+    if (m.ior.texture) ior = std::max(1.0, ior + m.iorOffset + m.iorScale * textureColor(m.ior, tri, at, false).r);
     return channelIor(ior, m.dispersion, channel);
   }
 
@@ -677,18 +734,26 @@ struct Tracer {
     if (glm::dot(ns, tri.ng) < 0.0) ns = -ns;
   }
 
-  /// What a reflected ray from p sees: the opaque face it meets, else the environment.
-  glm::dvec3 reflected(const glm::dvec3& p, const glm::dvec3& d, uint32_t from) const {
+  /// Where a ray meets `tri`: its weights and level of detail terms (level 0 with Optics::textureLod off).
+  SurfacePoint pointOf(const Hit& hit, const TriangleData& tri, double width, double spread, const glm::dvec3& d) const {
+    SurfacePoint at{1.0 - hit.b1 - hit.b2, hit.b1, hit.b2, glm::dvec2(-kInfinity)};  // off: level 0
+    if (settings.optics.textureLod) at.lods = coneLods(tri, width + spread * hit.t, d);
+    return at;
+  }
+
+  /// What a reflected ray from p, its cone `width` wide there and opening by
+  /// `spread`, sees: the opaque face it meets, else the environment.
+  glm::dvec3 reflected(const glm::dvec3& p, const glm::dvec3& d, uint32_t from, double width, double spread) const {
     Hit hit = prepared.intersect(p, d, tMinFrom(p), from);
     if (hit.found()) {
       const TriangleData& tri = prepared.triangle(hit.triangle);
       const ResolvedMaterial& m = prepared.material(tri.material);
       if (!m.refractive) {
-        const double b1 = hit.b1, b2 = hit.b2, b0 = 1.0 - b1 - b2;
+        const SurfacePoint at = pointOf(hit, tri, width, spread, d);
         glm::dvec3 q, ns;
-        surfaceAt(tri, b0, b1, b2, q, ns);
-        return shadeOpaque(prepared, q, ns, d, m.baseFactor * textureColor(m.base, tri, b0, b1, b2),
-                           m.emissiveFactor * textureColor(m.emissive, tri, b0, b1, b2));
+        surfaceAt(tri, at.b0, at.b1, at.b2, q, ns);
+        return shadeOpaque(prepared, q, ns, d, m.baseFactor * textureColor(m.base, tri, at),
+                           m.emissiveFactor * textureColor(m.emissive, tri, at));
       }
     }
     return environmentColor(settings.optics, d);
@@ -697,7 +762,8 @@ struct Tracer {
   /// One path for `channel` (0-2, or -1: every channel at the base IOR).
   /// With channel -1, returns false at the first dispersive boundary: the
   /// caller traces the pixel once per channel.
-  bool path(glm::dvec3 origin, glm::dvec3 d, int channel, PixelResult& result) const {
+  /// The ray's cone (trace.h: Textures) is `width` wide at the origin and opens by `spread`.
+  bool path(glm::dvec3 origin, glm::dvec3 d, double width, double spread, int channel, PixelResult& result) const {
     result = PixelResult{};
     const bool fresnel = settings.optics.fresnel;
     uint32_t reflections = fresnel ? settings.optics.reflections : 0u;
@@ -725,15 +791,16 @@ struct Tracer {
         result.instance = tri.item;
         result.primitive = tri.primitive;
       }
-      const double b1 = hit.b1, b2 = hit.b2, b0 = 1.0 - b1 - b2;
+      const SurfacePoint here = pointOf(hit, tri, width, spread, d);
+      width += spread * hit.t;  // the cone where it meets the face
       const glm::dvec3& ng = tri.ng;
       glm::dvec3 p, ns;
-      surfaceAt(tri, b0, b1, b2, p, ns);
+      surfaceAt(tri, here.b0, here.b1, here.b2, p, ns);
 
       const ResolvedMaterial& material = prepared.material(tri.material);
-      const glm::dvec3 base = material.baseFactor * textureColor(material.base, tri, b0, b1, b2);
+      const glm::dvec3 base = material.baseFactor * textureColor(material.base, tri, here);
       if (!material.refractive) {
-        const glm::dvec3 emissive = material.emissiveFactor * textureColor(material.emissive, tri, b0, b1, b2);
+        const glm::dvec3 emissive = material.emissiveFactor * textureColor(material.emissive, tri, here);
         result.color += throughput * shadeOpaque(prepared, p, ns, d, base, emissive);
         result.outcome = gpu::kOutcomeOpaque;
         return true;
@@ -754,14 +821,14 @@ struct Tracer {
         boundary = inside < 0 || prepared.material(media.material[inside]).priority <= material.priority;
         if (boundary && channel < 0 && dispersive(inside)) return false;
         n1 = inside < 0 ? 1.0 : mediumIor(media.material[inside], channel);
-        n2 = surfaceIor(material, tri, b0, b1, b2, channel);
+        n2 = surfaceIor(material, tri, here, channel);
         media.enter(tri.material);
       } else {
         const int at = media.leave(tri.material);
         boundary = at < 0 || at == inside;
         const int outside = media.current(prepared);
         if (boundary && channel < 0 && dispersive(outside)) return false;
-        n1 = surfaceIor(material, tri, b0, b1, b2, channel);
+        n1 = surfaceIor(material, tri, here, channel);
         n2 = outside < 0 ? 1.0 : mediumIor(media.material[outside], channel);
       }
       const bool bends = boundary && result.interfaces < settings.maxBends;
@@ -775,9 +842,11 @@ struct Tracer {
           c = -glm::dot(d, n);
         }
         const double k = 1.0 - eta * eta * (1.0 - c * c);
+        const double widening = tri.curvature * width;  // how far the normal turns across the cone
         glm::dvec3 next;
         if (k < 0.0) {
           next = d + 2.0 * c * n;  // total internal reflection keeps everything
+          spread += 2.0 * widening;
         } else {
           const double r = fresnel ? fresnelReflectance(eta, c) : 0.0;
           if (fresnel) {
@@ -786,11 +855,13 @@ struct Tracer {
           if (reflections > 0) {
             --reflections;
             if (r > 0.0) {
-              result.color += throughput * (r * reflected(p, unitOrZero(d + 2.0 * c * n), hit.triangle) +
+              result.color += throughput * (r * reflected(p, unitOrZero(d + 2.0 * c * n), hit.triangle, width,
+                                                          spread + 2.0 * widening) +
                                             highlight(prepared, p, n, d, material.roughness, eta));
             }
           }
           next = eta * d + (eta * c - std::sqrt(k)) * n;
+          spread = eta * spread + std::abs(1.0 - eta) * widening;
           throughput *= 1.0 - r;
         }
         next = unitOrZero(next);
@@ -805,15 +876,15 @@ struct Tracer {
   }
 };
 
-PixelResult trace(const PreparedScene& prepared, const glm::dvec3& origin, const glm::dvec3& d,
-                  const ReferenceSettings& settings) {
+PixelResult trace(const PreparedScene& prepared, const glm::dvec3& origin, const glm::dvec3& d, double width,
+                  double spread, const ReferenceSettings& settings) {
   const Tracer tracer{prepared, settings};
   PixelResult result;
-  if (tracer.path(origin, d, -1, result)) return result;
+  if (tracer.path(origin, d, width, spread, -1, result)) return result;
   PixelResult red, blue;
-  tracer.path(origin, d, 0, red);
-  tracer.path(origin, d, 1, result);
-  tracer.path(origin, d, 2, blue);
+  tracer.path(origin, d, width, spread, 0, red);
+  tracer.path(origin, d, width, spread, 1, result);
+  tracer.path(origin, d, width, spread, 2, blue);
   result.color = {red.color.r, result.color.g, blue.color.b};
   result.energyError = std::max({red.energyError, result.energyError, blue.energyError});
   return result;
@@ -851,15 +922,18 @@ ReferenceImage renderReference(const scene::Scene& scene, const scene::Pose& pos
         double sx = (2.0 * (double(x) + 0.5) / w - 1.0) * view.halfHeight * w / h + view.shift.x;
         double sy = (1.0 - 2.0 * (double(y) + 0.5) / h) * view.halfHeight + view.shift.y;
         glm::dvec3 origin = view.eye, direction = forward;
+        double width = 0.0, spread = 0.0;  // listed rays have no footprint: level 0
         if (!settings.rays.empty()) {
           origin = settings.rays[image.index(x, y)].origin;
           direction = glm::normalize(settings.rays[image.index(x, y)].direction);
         } else if (view.orthographic) {
           origin = view.eye + view.right * sx + view.up * sy;
+          width = 2.0 * view.halfHeight / h;
         } else {
           direction = glm::normalize(view.forward + sx * view.right + sy * view.up);
+          spread = std::atan(2.0 * view.halfHeight / h);
         }
-        PixelResult r = trace(prepared, origin, direction, settings);
+        PixelResult r = trace(prepared, origin, direction, width, spread, settings);
         size_t i = image.index(x, y);
         image.color[i] = r.color;
         image.distance[i] = r.distance;

@@ -7,6 +7,7 @@
 #include "shared/present.h"
 #include "shared/radix_sort.h"
 #include "shared/raster.h"
+#include "shared/scene.h"
 #include "shared/trace.h"
 
 #include <cstddef>
@@ -42,8 +43,11 @@ static_assert(sizeof(BvhPush) == 16 && offsetof(BvhPush, total) == 12);
 static_assert(sizeof(GpuInstance) == 112 && offsetof(GpuInstance, worldToObject) == 48 &&
               offsetof(GpuInstance, geometry) == 96 && offsetof(GpuInstance, material) == 100);
 
-static_assert(sizeof(GpuMaterial) == 176 && offsetof(GpuMaterial, textures) == 96 && offsetof(GpuMaterial, attenuation) == 112 &&
-              offsetof(GpuMaterial, iorTexture) == 160);
+static_assert(sizeof(GpuTextureSlot) == 48 && offsetof(GpuTextureSlot, texture) == 32 &&
+              offsetof(GpuTextureSlot, lodOffset) == 40);
+static_assert(sizeof(GpuMaterial) == 224 && offsetof(GpuMaterial, transmission) == 48 &&
+              offsetof(GpuMaterial, attenuationDistance) == 76 && offsetof(GpuMaterial, base) == 80 &&
+              offsetof(GpuMaterial, emissive) == 128 && offsetof(GpuMaterial, iorMap) == 176);
 static_assert(sizeof(GpuTexture) == 16 && offsetof(GpuTexture, flags) == 12);
 static_assert(sizeof(TextureMipPush) == 32 && offsetof(TextureMipPush, srgb) == 24);
 static_assert(sizeof(GpuLight) == 64 && offsetof(GpuLight, cone) == 48);

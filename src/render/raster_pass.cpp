@@ -121,18 +121,11 @@ void RasterPass::recordDepthPass(vk::Commands& commands, const RasterScene& scen
   const float clearMask[4] = {0.0f, 0.0f, 0.0f, 0.0f};  // the uint attachment clears to 0
   {
     vk::RenderingScope scope(commands, mask ? *mask : colorTarget, &depth, area, mask ? clearMask : nullptr, true);
-    const SceneGpu& s = *scene.scene;
-    const vk::BufferBinding vertexStage[] = {{gpu::kRasterBindingInstances, scene.instances},
-                                             {gpu::kRasterBindingPositions, &s.positions},
-                                             {gpu::kRasterBindingNormals, &s.normals},
-                                             {gpu::kRasterBindingTexcoords, &s.texcoords},
-                                             {gpu::kRasterBindingIndices, &s.indices},
-                                             {gpu::kRasterBindingMaterials, &s.materials}};
-    static_assert(gpu::kRasterBindingInstances == 0 && gpu::kRasterBindingMaterials == gpu::kRasterBindingIndices + 1);
-    // The mask's fragment shader also reads the materials.
+    std::vector<vk::BufferBinding> resources;
+    scene.scene->appendBindings(resources, *scene.instances, *scene.lights);
     gpu::RasterPush p = push(scene, settings, options);
     p.flags |= extraFlags;
-    drawItems(commands, mask ? *mask_ : *depth_, scene, options, p, std::span(vertexStage).first(mask ? 6 : 5), area);
+    drawItems(commands, mask ? *mask_ : *depth_, scene, options, p, resources, area);
   }
   commands.endPass();
 }
@@ -164,18 +157,9 @@ void RasterPass::recordShadingPass(vk::Commands& commands, const RasterScene& sc
   float clear[4] = {settings.background.r, settings.background.g, settings.background.b, 1.0f};
   {
     vk::RenderingScope scope(commands, target, &depth, area, clear, false);
-    const SceneGpu& s = *scene.scene;
-    std::vector<vk::BufferBinding> resources = {{gpu::kRasterBindingInstances, scene.instances},
-                                                {gpu::kRasterBindingPositions, &s.positions},
-                                                {gpu::kRasterBindingNormals, &s.normals},
-                                                {gpu::kRasterBindingTexcoords, &s.texcoords},
-                                                {gpu::kRasterBindingIndices, &s.indices},
-                                                {gpu::kRasterBindingMaterials, &s.materials},
-                                                {gpu::kRasterBindingLights, scene.lights},
-                                                {gpu::kRasterBindingTraceImage, nullptr, &traceImage},
+    std::vector<vk::BufferBinding> resources = {{gpu::kRasterBindingTraceImage, nullptr, &traceImage},
                                                 {gpu::kRasterBindingBehindDepth, nullptr, &behindDepth}};
-    s.appendTextureBindings(resources, gpu::kRasterBindingTextures, gpu::kRasterBindingSrgbDecode,
-                            gpu::kRasterBindingTexelPages);
+    scene.scene->appendBindings(resources, *scene.instances, *scene.lights);
     gpu::RasterPush p = push(scene, settings, options);
     drawItems(commands, *fill_, scene, options, p, resources, area);
     if (options.wireframe) {

@@ -44,7 +44,7 @@ bool sameRequest(const ViewRequest& a, const ViewRequest& b) {
          r.screenSpace == q.screenSpace && r.offsetStrength == q.offsetStrength && r.wireframe == q.wireframe &&
          r.wireColor == q.wireColor && r.nearPlane == q.nearPlane && r.farPlane == q.farPlane &&
          s.optics.fresnel == t.optics.fresnel && s.optics.reflections == t.optics.reflections &&
-         s.optics.environment == t.optics.environment;
+         s.optics.environment == t.optics.environment && s.optics.textureLod == t.optics.textureLod;
 }
 
 std::vector<glm::vec4> unpackHalves(const std::byte* data, size_t pixels) {
@@ -481,7 +481,8 @@ gpu::TracePush Renderer::tracePush(const ViewRequest& request, bool masked) cons
   push.shiftX = float(v.shift.x);
   push.shiftY = float(v.shift.y);
   push.optics = (settings.optics.fresnel ? gpu::kOpticsFresnel : 0u) |
-                (settings.optics.environment ? gpu::kOpticsEnvironmentMap : 0u);
+                (settings.optics.environment ? gpu::kOpticsEnvironmentMap : 0u) |
+                (settings.optics.textureLod ? gpu::kOpticsTextureLod : 0u);
   push.reflections = settings.optics.reflections;
   return push;
 }
@@ -523,19 +524,11 @@ void Renderer::uploadEnvironments(const std::vector<ViewRequest>& views) {
 std::vector<vk::BufferBinding> Renderer::pathBindings(const ViewRequest& request, View& view) const {
   const FrameSettings& settings = request.settings;
   std::vector<vk::BufferBinding> bindings = {
-      {gpu::kTraceBindingInstances, &instances_},
-      {gpu::kTraceBindingPositions, &scene_.positions},
-      {gpu::kTraceBindingNormals, &scene_.normals},
-      {gpu::kTraceBindingTexcoords, &scene_.texcoords},
-      {gpu::kTraceBindingIndices, &scene_.indices},
-      {gpu::kTraceBindingMaterials, &scene_.materials},
-      {gpu::kTraceBindingLights, &lights_},
       {gpu::kTraceBindingEnvironment, &environmentBuffer(settings.optics)},
       {gpu::kTraceBindingImage, nullptr, &view.images.trace},
       {gpu::kTraceBindingAov, request.aov ? &view.images.aov : &placeholder_},
       {gpu::kTraceBindingRays, settings.rays.empty() ? &placeholder_ : &view.rays}};
-  scene_.appendTextureBindings(bindings, gpu::kTraceBindingTextures, gpu::kTraceBindingSrgbDecode,
-                               gpu::kTraceBindingTexelPages);
+  scene_.appendBindings(bindings, instances_, lights_);
   return bindings;
 }
 

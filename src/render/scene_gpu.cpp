@@ -1,11 +1,15 @@
 // Packing a scene into the buffers the passes read (shaders/shared/trace.h).
 #include "render/scene_gpu.h"
 
+#include "scene/texture_mips.h"
+
 #include "shared/trace.h"
 #include "vk/commands.h"
 #include "vk/compute_program.h"
 #include "texture_mips.spv.h"
 
+#include <algorithm>
+#include <chrono>
 #include <cstring>
 #include <stdexcept>
 #include <string>
@@ -37,26 +41,11 @@ vk::Buffer uploaded(vk::Context& context, const std::vector<T>& data, const std:
   return buffer;
 }
 
-// kTraceBindingSrgbDecode: each sRGB byte's linear value.
+// kSceneBindingSrgbDecode: each sRGB byte's linear value.
 std::vector<float> srgbDecodeTable() {
   std::vector<float> table(gpu::kSrgbDecodeWords);
   for (uint32_t v = 0; v < gpu::kSrgbDecodeWords; ++v) table[v] = float(scene::srgbToLinear(static_cast<uint8_t>(v)));
   return table;
-}
-
-// Textures only an IOR texture reads hold data, not colour: their mips average bytes.
-std::vector<bool> colourTextures(const scene::Scene& scene) {
-  std::vector<bool> data(scene.textures.size(), false), colour(scene.textures.size(), false);
-  auto mark = [&](const scene::TextureRef& ref, std::vector<bool>& as) {
-    if (ref.present() && size_t(ref.texture) < scene.textures.size()) as[size_t(ref.texture)] = true;
-  };
-  for (const scene::Material& m : scene.materials) {
-    mark(m.baseColorTexture, colour);
-    mark(m.emissiveTexture, colour);
-    mark(m.iorTexture, data);
-  }
-  for (size_t t = 0; t < colour.size(); ++t) colour[t] = colour[t] || !data[t];
-  return colour;
 }
 
 // Which page each texture's chain goes to, and where: first fit over the
@@ -67,6 +56,8 @@ struct TexturePlacement {
   std::array<uint64_t, gpu::kTexelPages> pageTexels{};
 };
 
+constexpr VkDeviceSize kStagingRingBytes = 32ull << 20;
+
 // Pages are read back by tests and tools (transfer source) as well as written.
 constexpr VkBufferUsageFlags kTexelPageUsage =
     VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT;
@@ -76,7 +67,7 @@ TexturePlacement placeTextures(const vk::Context& context, const scene::Scene& s
   TexturePlacement place;
   uint64_t total = 0;
   for (const scene::Texture& t : scene.textures) {
-    uint64_t texels = mipChainTexels(std::max(t.width, 1u), std::max(t.height, 1u));
+    uint64_t texels = scene::mipChainTexels(std::max(t.width, 1u), std::max(t.height, 1u));
     total += texels;
     uint32_t p = 0;
     while (p < gpu::kTexelPages && place.pageTexels[p] + texels > capacity) ++p;
@@ -105,29 +96,41 @@ void uploadTextures(vk::Context& context, const scene::Scene& scene, const Textu
     gpu.bytes += bytes;
   }
   if (scene.textures.empty()) return;
-  VkDeviceSize stagingBytes = 0;
-  for (const scene::Texture& t : scene.textures) stagingBytes += VkDeviceSize(t.rgba.size());
-  vk::Buffer staging(context, {std::max<VkDeviceSize>(stagingBytes, 4), VK_BUFFER_USAGE_TRANSFER_SRC_BIT,
-                               vk::MemoryDomain::Upload, name + " texture staging"});
+  // Level 0 goes through one staging ring of at most kStagingRingBytes: when
+  // it is full, what it holds is copied and the ring starts again, so a
+  // scene's textures never need a second copy of themselves in host memory.
+  VkDeviceSize total = 0;
+  for (const scene::Texture& t : scene.textures) total += VkDeviceSize(t.rgba.size());
+  const VkDeviceSize ringBytes = std::clamp<VkDeviceSize>(total, 4, kStagingRingBytes);
+  vk::Buffer staging(context, {ringBytes, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, vk::MemoryDomain::Upload,
+                               name + " texture staging ring"});
   vk::ComputeProgram mips(context, vk::ComputeProgramDesc{"texture mips", kSpvTextureMips, {}, false});
-  std::vector<bool> colour = colourTextures(scene);
+  std::vector<bool> colour = scene::colourTextures(scene);
   vk::Commands commands(context, "upload " + name + " textures");
   commands.begin();
   VkDeviceSize offset = 0;
   for (size_t i = 0; i < scene.textures.size(); ++i) {
     const scene::Texture& t = scene.textures[i];
-    if (t.rgba.empty()) continue;
-    std::memcpy(staging.mapped().data() + offset, t.rgba.data(), t.rgba.size());
-    commands.copyBuffer(staging, gpu.texelPages[place.page[i]], t.rgba.size(), offset, VkDeviceSize(place.first[i]) * 4);
-    offset += t.rgba.size();
+    for (VkDeviceSize done = 0; done < t.rgba.size();) {
+      if (offset == ringBytes) {
+        commands.submitAndWait();
+        commands.begin();
+        offset = 0;
+      }
+      VkDeviceSize bytes = std::min<VkDeviceSize>(t.rgba.size() - done, ringBytes - offset);
+      std::memcpy(staging.mapped().data() + offset, t.rgba.data() + done, bytes);
+      commands.copyBuffer(staging, gpu.texelPages[place.page[i]], bytes, offset, VkDeviceSize(place.first[i]) * 4 + done);
+      offset += bytes;
+      done += bytes;
+    }
   }
   commands.transferToCompute();
   uint32_t most = 1;
-  for (const scene::Texture& t : scene.textures) most = std::max(most, mipLevels(t.width, t.height));
+  for (const scene::Texture& t : scene.textures) most = std::max(most, scene::mipLevels(t.width, t.height));
   for (uint32_t level = 1; level < most; ++level) {
     for (size_t i = 0; i < scene.textures.size(); ++i) {
       const scene::Texture& t = scene.textures[i];
-      if (t.rgba.empty() || level >= mipLevels(t.width, t.height)) continue;
+      if (t.rgba.empty() || level >= scene::mipLevels(t.width, t.height)) continue;
       uint32_t first = place.first[i];
       uint32_t w = t.width, h = t.height;
       for (uint32_t l = 1; l < level; ++l) {
@@ -148,34 +151,34 @@ uint32_t wrapMode(bool repeat, bool mirror) {
   return mirror ? gpu::kWrapMirror : repeat ? gpu::kWrapRepeat : gpu::kWrapClamp;
 }
 
-void uvRows(const scene::TextureRef& ref, glm::vec4& row0, glm::vec4& row1) {
-  // glm is column-major: m[column][row].
-  const glm::mat3& m = ref.transform;
-  row0 = {m[0][0], m[1][0], m[2][0], row0.w};
-  row1 = {m[0][1], m[1][1], m[2][1], row1.w};
-}
-
 gpu::GpuMaterial packMaterial(const scene::Material& m, const scene::Scene& scene) {
-  auto texture = [&](const scene::TextureRef& ref) {
+  auto slot = [&](const scene::TextureRef& ref) {
+    gpu::GpuTextureSlot g{};
+    // glm is column-major: t[column][row].
+    const glm::mat3& t = ref.transform;
+    g.uvRow0 = {t[0][0], t[1][0], t[2][0], 0.0f};
+    g.uvRow1 = {t[0][1], t[1][1], t[2][1], 0.0f};
     bool usable = ref.present() && size_t(ref.texture) < scene.textures.size() && scene.textures[size_t(ref.texture)].width > 0;
-    return usable ? static_cast<uint32_t>(ref.texture) : gpu::kNoTexture;
+    g.texture = usable ? static_cast<uint32_t>(ref.texture) : gpu::kNoTexture;
+    g.texCoord = static_cast<uint32_t>(ref.texCoord);
+    if (usable) g.lodOffset = float(scene::textureLodOffset(scene.textures[size_t(ref.texture)], ref));
+    return g;
   };
   gpu::GpuMaterial g{};
   g.baseColorFactor = m.baseColorFactor;
-  g.emissiveFactor = glm::vec4(m.emissiveFactor, m.transmission);
-  g.baseUvRow0.w = m.ior;
-  uvRows(m.baseColorTexture, g.baseUvRow0, g.baseUvRow1);
-  uvRows(m.emissiveTexture, g.emissiveUvRow0, g.emissiveUvRow1);
-  g.textures = {texture(m.baseColorTexture), static_cast<uint32_t>(m.baseColorTexture.texCoord),
-                texture(m.emissiveTexture), static_cast<uint32_t>(m.emissiveTexture.texCoord)};
-  g.baseUvRow1.w = m.roughness;
-  g.emissiveUvRow0.w = m.dispersion;
-  g.emissiveUvRow1.w = static_cast<float>(m.priority);
-  g.attenuation = glm::vec4(m.attenuationColor, m.attenuates() ? m.attenuationDistance : 0.0f);
-  uvRows(m.iorTexture, g.iorUvRow0, g.iorUvRow1);
-  g.iorUvRow0.w = m.iorScale;
-  g.iorUvRow1.w = m.iorOffset;
-  g.iorTexture = {texture(m.iorTexture), static_cast<uint32_t>(m.iorTexture.texCoord), 0u, 0u};
+  g.emissiveFactor = glm::vec4(m.emissiveFactor, 0.0f);
+  g.attenuationColor = glm::vec4(m.attenuationColor, 0.0f);
+  g.transmission = m.transmission;
+  g.ior = m.ior;
+  g.roughness = m.roughness;
+  g.dispersion = m.dispersion;
+  g.priority = static_cast<float>(m.priority);
+  g.iorScale = m.iorScale;
+  g.iorOffset = m.iorOffset;
+  g.attenuationDistance = m.attenuates() ? m.attenuationDistance : 0.0f;
+  g.base = slot(m.baseColorTexture);
+  g.emissive = slot(m.emissiveTexture);
+  g.iorMap = slot(m.iorTexture);
   return g;
 }
 
@@ -246,7 +249,7 @@ SceneGpu uploadScene(vk::Context& context, const scene::Scene& scene, const scen
     const scene::Texture& t = scene.textures[i];
     uint32_t flags = wrapMode(t.repeatS, t.mirrorS) | (wrapMode(t.repeatT, t.mirrorT) << 2) |
                      (t.linearFilter ? 0u : gpu::kTextureFlagNearest) |
-                     (mipLevels(std::max(t.width, 1u), std::max(t.height, 1u)) << gpu::kTextureLevelsShift) |
+                     (scene::mipLevels(std::max(t.width, 1u), std::max(t.height, 1u)) << gpu::kTextureLevelsShift) |
                      (place.page[i] << gpu::kTexturePageShift);
     textures.push_back({place.first[i], t.width, t.height, flags});
   }
@@ -259,29 +262,24 @@ SceneGpu uploadScene(vk::Context& context, const scene::Scene& scene, const scen
   gpu.materials = uploaded(context, materials, name + " materials", gpu.bytes);
   gpu.textures = uploaded(context, textures, name + " texture table", gpu.bytes);
   gpu.srgbDecode = uploaded(context, srgbDecodeTable(), name + " sRGB decode", gpu.bytes);
+  const auto start = std::chrono::steady_clock::now();
   uploadTextures(context, scene, place, gpu);
+  gpu.textureUploadSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return gpu;
 }
 
-void SceneGpu::appendTextureBindings(std::vector<vk::BufferBinding>& out, uint32_t tableSlot, uint32_t decodeSlot,
-                                     uint32_t firstPageSlot) const {
-  out.push_back({tableSlot, &textures});
-  out.push_back({decodeSlot, &srgbDecode});
-  for (uint32_t p = 0; p < gpu::kTexelPages; ++p) out.push_back({firstPageSlot + p, &texelPages[p]});
-}
-
-uint64_t mipChainTexels(uint32_t width, uint32_t height) {
-  uint64_t texels = 0;
-  for (uint32_t level = 0; level < mipLevels(width, height); ++level) {
-    texels += uint64_t(std::max(width >> level, 1u)) * std::max(height >> level, 1u);
-  }
-  return texels;
-}
-
-uint32_t mipLevels(uint32_t width, uint32_t height) {
-  uint32_t levels = 1;
-  for (uint32_t size = std::max(width, height); size > 1; size >>= 1) ++levels;
-  return levels;
+void SceneGpu::appendBindings(std::vector<vk::BufferBinding>& out, const vk::Buffer& instances,
+                              const vk::Buffer& lights) const {
+  out.insert(out.end(), {{gpu::kSceneBindingInstances, &instances},
+                         {gpu::kSceneBindingPositions, &positions},
+                         {gpu::kSceneBindingNormals, &normals},
+                         {gpu::kSceneBindingTexcoords, &texcoords},
+                         {gpu::kSceneBindingIndices, &indices},
+                         {gpu::kSceneBindingMaterials, &materials},
+                         {gpu::kSceneBindingLights, &lights},
+                         {gpu::kSceneBindingTextures, &textures},
+                         {gpu::kSceneBindingSrgbDecode, &srgbDecode}});
+  for (uint32_t p = 0; p < gpu::kTexelPages; ++p) out.push_back({gpu::kSceneBindingTexelPages + p, &texelPages[p]});
 }
 
 }  // namespace snell::render

@@ -40,11 +40,11 @@ struct SceneGpu {
   vk::Buffer srgbDecode;          ///< float[kSrgbDecodeWords]: each sRGB byte's linear value
   std::array<vk::Buffer, gpu::kTexelPages> texelPages;  ///< RGBA8 mip chains (unused pages: 16 bytes)
   uint64_t textureBytes = 0;      ///< GPU memory the texel pages take, mips included
+  double textureUploadSeconds = 0.0;  ///< level 0 through the staging ring, then the mips made on the GPU
 
-  /// Appends the bindings of the scene's textures as trace.h numbers them for
-  /// a pass: the texture table, the sRGB decode table, then the pages from `firstPageSlot`.
-  void appendTextureBindings(std::vector<vk::BufferBinding>& out, uint32_t tableSlot, uint32_t decodeSlot,
-                             uint32_t firstPageSlot) const;
+  /// Appends the scene binding set (shared/scene.h) with the renderer's
+  /// `instances` and `lights`: every pass that reads the scene binds these.
+  void appendBindings(std::vector<vk::BufferBinding>& out, const vk::Buffer& instances, const vk::Buffer& lights) const;
   uint64_t bytes = 0;             ///< GPU memory the buffers above take
 };
 
@@ -52,11 +52,5 @@ struct SceneGpu {
 /// change with time). Throws std::runtime_error naming the scene when it is
 /// larger than the device's buffers can hold.
 SceneGpu uploadScene(vk::Context& context, const scene::Scene& scene, const scene::Pose& layout);
-
-/// Mip levels of a width x height texture: down to 1x1, each level half the
-/// one above (rounded down, at least 1).
-uint32_t mipLevels(uint32_t width, uint32_t height);
-/// Texels of a width x height texture's whole mip chain.
-uint64_t mipChainTexels(uint32_t width, uint32_t height);
 
 }  // namespace snell::render

@@ -4,18 +4,25 @@
 #include "scene/gltf_loader.h"
 
 #include "scene/gltf_accessors.h"
+#include "scene/texture_mips.h"
 
+#include <stb/stb_image.h>
 #include <tiny_gltf.h>
 
 #include <glm/gtc/matrix_transform.hpp>
 #include <glm/gtc/type_ptr.hpp>
 
 #include <algorithm>
+#include <atomic>
+#include <chrono>
 #include <cmath>
 #include <cstring>
 #include <fstream>
+#include <map>
+#include <mutex>
 #include <numeric>
 #include <set>
+#include <thread>
 
 namespace snell::scene {
 
@@ -723,6 +730,63 @@ std::vector<unsigned char> readHead(const std::string& path, size_t bytes) {
   return head;
 }
 
+// Images are decoded after parsing, all at once on every core: tinygltf
+// hands each image's encoded bytes to this loader, which keeps them.
+struct EncodedImages {
+  std::mutex mutex;
+  std::map<int, std::vector<unsigned char>> bytes;  // by image index
+};
+
+bool keepEncoded(tinygltf::Image*, const int index, std::string*, std::string*, int, int, const unsigned char* bytes,
+                 int size, void* user) {
+  auto* encoded = static_cast<EncodedImages*>(user);
+  std::lock_guard<std::mutex> lock(encoded->mutex);
+  encoded->bytes[index].assign(bytes, bytes + size);
+  return true;
+}
+
+// What tinygltf's own loader does with stb_image (RGBA, 16 bits where the
+// file has them); an image it cannot read stays empty, as tinygltf leaves it.
+void decodeImage(tinygltf::Image& image, const std::vector<unsigned char>& bytes) {
+  const int size = static_cast<int>(bytes.size());
+  int w = 0, h = 0, comp = 0, bits = 8;
+  unsigned char* data = nullptr;
+  if (stbi_is_16_bit_from_memory(bytes.data(), size)) {
+    data = reinterpret_cast<unsigned char*>(stbi_load_16_from_memory(bytes.data(), size, &w, &h, &comp, 4));
+    if (data) bits = 16;
+  }
+  if (!data) data = stbi_load_from_memory(bytes.data(), size, &w, &h, &comp, 4);
+  if (!data) return;
+  if (w > 0 && h > 0) {
+    image.width = w;
+    image.height = h;
+    image.component = 4;
+    image.bits = bits;
+    image.pixel_type = bits == 16 ? TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT : TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE;
+    image.image.assign(data, data + size_t(w) * size_t(h) * 4 * size_t(bits / 8));
+  }
+  stbi_image_free(data);
+}
+
+unsigned decodeImages(tinygltf::Model& model, EncodedImages& encoded) {
+  std::vector<std::pair<int, const std::vector<unsigned char>*>> work;
+  for (const auto& [index, bytes] : encoded.bytes) {
+    if (index >= 0 && size_t(index) < model.images.size()) work.emplace_back(index, &bytes);
+  }
+  // Largest first, so one big image does not start last.
+  std::sort(work.begin(), work.end(), [](const auto& a, const auto& b) { return a.second->size() > b.second->size(); });
+  unsigned threads = std::clamp<unsigned>(std::thread::hardware_concurrency(), 1u, std::max<unsigned>(1u, unsigned(work.size())));
+  std::atomic<size_t> next{0};
+  auto run = [&] {
+    for (size_t i = next++; i < work.size(); i = next++) decodeImage(model.images[size_t(work[i].first)], *work[i].second);
+  };
+  std::vector<std::thread> pool;
+  for (unsigned t = 1; t < threads; ++t) pool.emplace_back(run);
+  run();
+  for (std::thread& t : pool) t.join();
+  return threads;
+}
+
 }  // namespace
 
 const std::vector<std::string>& supportedExtensions() { return kSupported; }
@@ -739,7 +803,11 @@ Scene loadGltf(const std::string& path, const LoadOptions& options) {
     throw SceneError(path + ": starts with a UTF-8 byte-order mark, which glTF JSON must not have");
   }
 
+  using Clock = std::chrono::steady_clock;
+  const Clock::time_point start = Clock::now();
   tinygltf::TinyGLTF parser;
+  EncodedImages encoded;
+  parser.SetImageLoader(keepEncoded, &encoded);
   tinygltf::Model model;
   std::string error, warning;
   bool ok = binary ? parser.LoadBinaryFromFile(&model, &error, &warning, path)
@@ -752,6 +820,11 @@ Scene loadGltf(const std::string& path, const LoadOptions& options) {
 
   Scene scene;
   scene.source = path;
+  const Clock::time_point parsed = Clock::now();
+  scene.loadTimes.decodeThreads = decodeImages(model, encoded);
+  encoded.bytes.clear();
+  scene.loadTimes.parseSeconds = std::chrono::duration<double>(parsed - start).count();
+  scene.loadTimes.decodeSeconds = std::chrono::duration<double>(Clock::now() - parsed).count();
   Reader r{path, model, scene};
   for (const std::string& required : model.extensionsRequired) {
     bool supported = std::find(kSupported.begin(), kSupported.end(), required) != kSupported.end();
@@ -778,6 +851,9 @@ Scene loadGltf(const std::string& path, const LoadOptions& options) {
   loadNodes(r);
   chooseScene(r, options);
   loadAnimations(r);
+  if (options.textureBudget) {
+    for (std::string& note : fitTextureBudget(scene, options.textureBudget)) scene.warnings.push_back(std::move(note));
+  }
   return scene;
 }
 

@@ -23,6 +23,10 @@ struct LoadOptions {
   std::string scene;
   /// Required extensions to drop knowingly instead of refusing the file.
   std::vector<std::string> ignoredExtensions;
+  /// GPU memory the textures may take with their mips, in bytes (0: no
+  /// budget): beyond it the largest are loaded at a lower mip level, each
+  /// with a note in Scene::warnings (scene::fitTextureBudget).
+  uint64_t textureBudget = 0;
 };
 
 /// Loads a .gltf or .glb file (told apart by content, not by name).

@@ -31,6 +31,10 @@ struct Optics {
   bool fresnel = true;  ///< R and T at every boundary, the reflected ray and the lights' highlights
   uint32_t reflections = gpu::kDefaultReflections;  ///< boundaries per path that send a reflected ray
   std::shared_ptr<const Environment> environment;  ///< null: the studio gradient
+  /// Traced rays read textures at their cone's level of detail (trace.h:
+  /// Textures); false reads level 0 everywhere, what the filtering is measured
+  /// against (the raster pass filters either way).
+  bool textureLod = true;
 };
 
 }  // namespace snell::scene

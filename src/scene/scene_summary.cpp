@@ -1,6 +1,8 @@
 // Scene counts and the per-frame GPU memory estimate behind `snell info`.
 #include "scene/scene_summary.h"
 
+#include "scene/texture_mips.h"
+
 #include <cstdio>
 #include <functional>
 #include <sstream>
@@ -29,13 +31,13 @@ void forEachNode(const Scene& scene, const std::function<void(const Node&, size_
   }
 }
 
+}  // namespace
+
 std::string mebibytes(uint64_t bytes) {
   char text[32];
   std::snprintf(text, sizeof text, "%.1f MiB", static_cast<double>(bytes) / (1024.0 * 1024.0));
   return text;
 }
-
-}  // namespace
 
 SceneSummary summarize(const Scene& scene, uint32_t width, uint32_t height) {
   SceneSummary s;
@@ -62,7 +64,7 @@ SceneSummary summarize(const Scene& scene, uint32_t width, uint32_t height) {
     }
   });
   for (const Material& m : scene.materials) s.refractiveMaterials += m.refractive();
-  for (const Texture& t : scene.textures) s.textureBytes += t.rgba.size() * 4 / 3;  // with mip levels
+  s.textureBytes = textureChainBytes(scene);
   s.imageBytes = uint64_t(width) * height * kTraceBytesPerPixel;
   return s;
 }
@@ -75,6 +77,17 @@ std::string describe(const Scene& scene, uint32_t width, uint32_t height) {
       << "\n  triangles " << s.triangles << ", vertices " << s.vertices << " (drawn, all instances)\n";
   out << "  morphed shapes " << s.morphedShapes << ", skinned shapes " << s.skinnedShapes << ", skins " << scene.skins.size()
       << ", textures " << scene.textures.size() << "\n";
+  if (!scene.textures.empty()) {
+    uint64_t decoded = 0;
+    const Texture* largest = &scene.textures[0];
+    for (const Texture& t : scene.textures) {
+      decoded += t.rgba.size();
+      if (uint64_t(t.width) * t.height > uint64_t(largest->width) * largest->height) largest = &t;
+    }
+    out << "  texture memory " << mebibytes(decoded) << " decoded (RGBA8), " << mebibytes(s.textureBytes)
+        << " on the GPU with mips; largest " << (largest->name.empty() ? "(unnamed)" : "'" + largest->name + "'") << " "
+        << largest->width << "x" << largest->height << "\n";
+  }
   out << "  materials " << scene.materials.size() << ", refractive " << s.refractiveMaterials << "\n";
   for (size_t m = 0; m < scene.materials.size(); ++m) {
     const Material& material = scene.materials[m];

@@ -126,10 +126,6 @@ void ComputeProgram::record(Commands& commands, std::span<const BufferBinding> b
     throw VulkanError("program '" + name_ + "' takes " + std::to_string(reflection_.pushConstantBytes) +
                       " bytes of push constants; the call gave " + std::to_string(pushBytes));
   }
-  if (buffers.size() != reflection_.bindings.size()) {
-    throw VulkanError("program '" + name_ + "' has " + std::to_string(reflection_.bindings.size()) +
-                      " bindings; the call gave " + std::to_string(buffers.size()));
-  }
   if (groups == 0 && !indirect) return;
   VkDescriptorSet set =
       writeSet(commands, setLayout_, reflection_.bindings, buffers, name_);

@@ -29,9 +29,13 @@ VkDescriptorSetLayout createSetLayout(Context& context, std::span<const Reflecte
 
 VkDescriptorSet writeSet(Commands& commands, VkDescriptorSetLayout layout, std::span<const ReflectedBinding> bindings,
                          std::span<const BufferBinding> resources, const std::string& program) {
-  if (resources.size() != bindings.size()) {
-    throw VulkanError("program '" + program + "' has " + std::to_string(bindings.size()) + " bindings; the call gave " +
-                      std::to_string(resources.size()));
+  // Resources may name slots the program does not use (passes share the
+  // scene binding set whole); every slot it uses must be given.
+  for (const ReflectedBinding& r : bindings) {
+    auto given = std::find_if(resources.begin(), resources.end(), [&](const BufferBinding& b) { return b.slot == r.binding; });
+    if (given == resources.end()) {
+      throw VulkanError("program '" + program + "' uses binding " + std::to_string(r.binding) + "; the call gave none");
+    }
   }
   std::vector<VkDescriptorBufferInfo> infos;
   std::vector<VkDescriptorImageInfo> imageInfos;
@@ -42,7 +46,7 @@ VkDescriptorSet writeSet(Commands& commands, VkDescriptorSetLayout layout, std::
   for (const BufferBinding& b : resources) {
     auto reflected = std::find_if(bindings.begin(), bindings.end(),
                                   [&](const ReflectedBinding& r) { return r.binding == b.slot; });
-    if (reflected == bindings.end()) throw VulkanError("program '" + program + "' has no binding " + std::to_string(b.slot));
+    if (reflected == bindings.end()) continue;
     VkWriteDescriptorSet write{VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
     write.dstSet = set;
     write.dstBinding = b.slot;

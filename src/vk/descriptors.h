@@ -27,8 +27,8 @@ VkDescriptorSetLayout createSetLayout(Context& context, std::span<const Reflecte
                                       VkShaderStageFlags stages, const std::string& program);
 
 /// A set from `commands` (it lives until they are next begun) pointing every
-/// binding at its resource. Throws naming `program` when the resources given
-/// do not match the bindings one to one.
+/// binding at its resource. Resources for slots the program does not use are
+/// left out; throws naming `program` when a binding it uses is not given.
 VkDescriptorSet writeSet(Commands& commands, VkDescriptorSetLayout layout, std::span<const ReflectedBinding> bindings,
                          std::span<const BufferBinding> resources, const std::string& program);
 

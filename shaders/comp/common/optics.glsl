@@ -24,17 +24,14 @@ float channelIor(float ior, float dispersion, int channel) {
 
 float mediumIor(uint material, int channel) {
   GpuMaterial m = materials[material];
-  return channelIor(m.baseUvRow0.w, m.emissiveUvRow0.w, channel);
+  return channelIor(m.ior, m.dispersion, channel);
 }
 
 // The IOR of the material at a hit, its IOR texture applied.
-float surfaceIor(GpuMaterial m, vec4 uvs, int channel) {
-  float ior = m.baseUvRow0.w;
-  if (m.iorTexture.x != kNoTexture) {
-    float r = textured(m.iorTexture.x, uvs, m.iorTexture.y, m.iorUvRow0, m.iorUvRow1, false).r;
-    ior = max(1.0, ior + m.iorUvRow1.w + m.iorUvRow0.w * r);
-  }
-  return channelIor(ior, m.emissiveUvRow0.w, channel);
+float surfaceIor(GpuMaterial m, vec4 uvs, vec2 lods, int channel) {
+  float ior = m.ior;
+  if (m.iorMap.texture != kNoTexture) ior = max(1.0, ior + m.iorOffset + m.iorScale * textured(m.iorMap, uvs, lods, false).r);
+  return channelIor(ior, m.dispersion, channel);
 }
 
 // ---------------------------------------------------------------- media
@@ -44,7 +41,7 @@ float surfaceIor(GpuMaterial m, vec4 uvs, int channel) {
 uint media[kMaxMedia];
 uint mediaCount;
 
-float mediumPriority(uint material) { return materials[material].emissiveUvRow1.w; }
+float mediumPriority(uint material) { return materials[material].priority; }
 
 // The entry that decides the medium: highest priority, ties to the latest; -1 in air.
 int currentMedium() {

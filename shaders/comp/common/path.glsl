@@ -19,16 +19,13 @@ struct Hit {
   vec3 bary;       // weights of v0, v1, v2
 };
 
-vec3 vertexAt(uint v) {
-  return vec3(positions[3u * v], positions[3u * v + 1u], positions[3u * v + 2u]);
-}
-
 // The closest hit beyond tMin along the ray, not on triangle skipPrim of
 // instance skipInstance (the face the ray leaves); instance kNoHit on a miss.
 Hit traceClosest(vec3 origin, vec3 dir, uint skipInstance, uint skipPrim, float tMin);
 // The global index of the first triangle of the instance's geometry.
 uint firstTriangleOf(uint instance);
 
+#include "../../common/scene.glsl"
 #include "../../common/shading.glsl"
 #include "optics.glsl"
 
@@ -39,34 +36,48 @@ struct Surface {
   vec3 ng;        // geometric normal, unit
   vec3 ns;        // shading normal, unit, on ng's side
   vec4 uvs;
+  vec2 density;   // uvDensity() of the triangle, per UV set
+  vec2 lods;      // the level of detail of its textures (coneLod), once the ray's cone is known
   uint material;
 };
 
 Surface surfaceAt(Hit hit) {
   GpuInstance inst = instances[hit.instance];
-  uint i0 = indices[3u * hit.primitive], i1 = indices[3u * hit.primitive + 1u], i2 = indices[3u * hit.primitive + 2u];
-  vec3 p0 = vertexAt(i0), p1 = vertexAt(i1), p2 = vertexAt(i2);
+  uvec3 i = triangleAt(hit.primitive);
+  vec3 p0 = vertexAt(i.x), p1 = vertexAt(i.y), p2 = vertexAt(i.z);
   vec3 p = hit.bary.x * p0 + hit.bary.y * p1 + hit.bary.z * p2;
-  vec3 n0 = vec3(normals[3u * i0], normals[3u * i0 + 1u], normals[3u * i0 + 2u]);
-  vec3 n1 = vec3(normals[3u * i1], normals[3u * i1 + 1u], normals[3u * i1 + 2u]);
-  vec3 n2 = vec3(normals[3u * i2], normals[3u * i2 + 1u], normals[3u * i2 + 2u]);
-  vec3 ns = hit.bary.x * n0 + hit.bary.y * n1 + hit.bary.z * n2;
+  vec3 ns = hit.bary.x * normalAt(i.x) + hit.bary.y * normalAt(i.y) + hit.bary.z * normalAt(i.z);
   vec3 ng = cross(p1 - p0, p2 - p0);
-  // Object to world; normals by the inverse transpose.
-  // worldToObject holds the rows of W^-1, and mat3() takes columns: this is
-  // (W^-1)^T. (It was transposed once more, which is right only when W is
-  // symmetric: rotated instances got their normals turned the wrong way.)
-  mat3 toWorldNormal = mat3(inst.worldToObject[0].xyz, inst.worldToObject[1].xyz, inst.worldToObject[2].xyz);
+  mat3 toWorldNormal = normalToWorld(inst);
   Surface s;
-  s.position = vec3(dot(inst.objectToWorld[0], vec4(p, 1.0)), dot(inst.objectToWorld[1], vec4(p, 1.0)),
-                    dot(inst.objectToWorld[2], vec4(p, 1.0)));
+  s.position = pointToWorld(inst, p);
   s.ng = normalize(toWorldNormal * ng);
   ns = toWorldNormal * ns;
   s.ns = dot(ns, ns) > 0.0 ? normalize(ns) : s.ng;
   if (dot(s.ns, s.ng) < 0.0) s.ns = -s.ns;
-  s.uvs = hit.bary.x * texcoords[i0] + hit.bary.y * texcoords[i1] + hit.bary.z * texcoords[i2];
+  vec4 uv0 = texcoords[i.x], uv1 = texcoords[i.y], uv2 = texcoords[i.z];
+  s.uvs = hit.bary.x * uv0 + hit.bary.y * uv1 + hit.bary.z * uv2;
+  s.density = uvDensity(vectorToWorld(inst, p1 - p0), vectorToWorld(inst, p2 - p0), uv0, uv1, uv2);
+  s.lods = vec2(0.0);
   s.material = inst.material;
   return s;
+}
+
+// How fast the triangle's surface turns (trace.h: Textures): the largest
+// change of its unit world vertex normals per unit of edge length; 0 where
+// it has no normals or a degenerate edge.
+float curvatureAt(Hit hit) {
+  GpuInstance inst = instances[hit.instance];
+  uvec3 i = triangleAt(hit.primitive);
+  mat3 toWorldNormal = normalToWorld(inst);
+  vec3 n0 = toWorldNormal * normalAt(i.x), n1 = toWorldNormal * normalAt(i.y), n2 = toWorldNormal * normalAt(i.z);
+  if (dot(n0, n0) == 0.0 || dot(n1, n1) == 0.0 || dot(n2, n2) == 0.0) return 0.0;
+  n0 = normalize(n0), n1 = normalize(n1), n2 = normalize(n2);
+  vec3 p0 = vectorToWorld(inst, vertexAt(i.x)), p1 = vectorToWorld(inst, vertexAt(i.y)),
+       p2 = vectorToWorld(inst, vertexAt(i.z));
+  float k = max(max(length(n1 - n0) / length(p1 - p0), length(n2 - n1) / length(p2 - p1)),
+                length(n0 - n2) / length(p0 - p2));
+  return k < 1e30 ? k : 0.0;  // NaN and infinity: 0
 }
 
 // Wächter & Binder (Ray Tracing Gems, ch. 6): move the point off the surface
@@ -110,7 +121,9 @@ vec3 leave(Surface s, vec3 dir, out float tMin) {
 // A reflected ray is traced by the next pass of the same loop, the path's
 // continuation parked meanwhile: one traversal call site, because compilers
 // that inline (lavapipe's) paid seconds of compile time for a second one.
-bool tracePath(vec3 origin, vec3 dir, int channel, out Path path) {
+// The ray's cone (trace.h: Textures) starts `width` wide at the origin and
+// opens by `spread` radians.
+bool tracePath(vec3 origin, vec3 dir, float width, float spread, int channel, out Path path) {
   path = Path(vec3(0.0), 0u, kOutcomeMiss, -1.0, kNoHit, kNoHit);
   bool fresnel = (pc.optics & kOpticsFresnel) != 0u;
   uint reflections = fresnel ? pc.reflections : 0u;
@@ -121,7 +134,7 @@ bool tracePath(vec3 origin, vec3 dir, int channel, out Path path) {
   bool reflecting = false;  // this pass traces a reflected ray, weighted by `reflectedWeight`
   vec3 reflectedWeight = vec3(0.0);
   vec3 parkedOrigin = vec3(0.0), parkedDir = vec3(0.0);
-  float parkedTMin = 0.0;
+  float parkedTMin = 0.0, parkedWidth = 0.0, parkedSpread = 0.0;
   // maxInterfaces + 1 segments of the path at most, and its reflected rays.
   uint passes = pc.maxInterfaces + 1u + min(reflections, pc.maxInterfaces);
   bool segmentZero = true;
@@ -130,18 +143,22 @@ bool tracePath(vec3 origin, vec3 dir, int channel, out Path path) {
     Surface s;
     GpuMaterial m;
     bool opaque = false;
+    float hitWidth = width + spread * hit.t;  // the cone where it meets the face
     if (hit.instance != kNoHit) {
       s = surfaceAt(hit);
+      s.lods = coneLod(s.density, hitWidth, dot(dir, s.ng));
       m = materials[s.material];
-      opaque = m.emissiveFactor.w <= 0.0;
+      opaque = !refractive(m);
     }
     if (reflecting) {  // an opaque face is shaded; a miss or glass sees the environment
-      path.colour += reflectedWeight * (opaque ? phong(s.position, s.ns, s.uvs, m, dir, pc.lightCount, pc.forward.xyz)
+      path.colour += reflectedWeight * (opaque ? phong(s.position, s.ns, s.uvs, s.lods, m, dir, pc.lightCount, pc.forward.xyz)
                                                : environmentColour(dir));
       reflecting = false;
       origin = parkedOrigin;
       dir = parkedDir;
-      tMin = parkedTMin;  // the skipped face is the same: the reflection left the face the path leaves
+      tMin = parkedTMin;
+      width = parkedWidth;
+      spread = parkedSpread;  // the skipped face is the same: the reflection left the face the path leaves
       continue;
     }
     if (hit.instance == kNoHit) {
@@ -151,8 +168,10 @@ bool tracePath(vec3 origin, vec3 dir, int channel, out Path path) {
     }
     int inside = currentMedium();
     if (inside >= 0) {  // Beer-Lambert over the segment
-      vec4 attenuation = materials[media[inside]].attenuation;
-      if (attenuation.w > 0.0) throughput *= pow(attenuation.rgb, vec3(hit.t / attenuation.w));
+      GpuMaterial volume = materials[media[inside]];
+      if (volume.attenuationDistance > 0.0) {
+        throughput *= pow(volume.attenuationColor.rgb, vec3(hit.t / volume.attenuationDistance));
+      }
     }
     if (segmentZero) {
       segmentZero = false;
@@ -161,7 +180,7 @@ bool tracePath(vec3 origin, vec3 dir, int channel, out Path path) {
       path.firstPrimitive = hit.primitive - firstTriangleOf(hit.instance);
     }
     if (opaque) {
-      path.colour += throughput * phong(s.position, s.ns, s.uvs, m, dir, pc.lightCount, pc.forward.xyz);
+      path.colour += throughput * phong(s.position, s.ns, s.uvs, s.lods, m, dir, pc.lightCount, pc.forward.xyz);
       path.outcome = kOutcomeOpaque;
       return false;
     }
@@ -172,11 +191,11 @@ bool tracePath(vec3 origin, vec3 dir, int channel, out Path path) {
     }
     bool entering = dot(dir, s.ng) < 0.0;
     bool boundary;  // a true boundary: the medium changes here
-    float surface = surfaceIor(m, s.uvs, channel);
+    float surface = surfaceIor(m, s.uvs, s.lods, channel);
     uint other = kNoHit;  // the material of the medium on the far side; kNoHit: air
     if (entering) {
       if (inside >= 0) other = media[inside];
-      boundary = inside < 0 || mediumPriority(other) <= m.emissiveUvRow1.w;
+      boundary = inside < 0 || mediumPriority(other) <= m.priority;
       enterMedium(s.material);
     } else {
       int at = leaveMedium(s.material);
@@ -185,14 +204,17 @@ bool tracePath(vec3 origin, vec3 dir, int channel, out Path path) {
       if (outside >= 0) other = media[outside];
     }
     float otherIor = other == kNoHit ? 1.0 : mediumIor(other, channel);
-    bool dispersive = m.emissiveUvRow0.w > 0.0 || (other != kNoHit && materials[other].emissiveUvRow0.w > 0.0);
+    bool dispersive = m.dispersion > 0.0 || (other != kNoHit && materials[other].dispersion > 0.0);
     if (boundary && channel < 0 && dispersive) return true;
     float n1 = entering ? otherIor : surface, n2 = entering ? surface : otherIor;
     // Past maxBends the ray crosses glass straight (an approximation's path, not physics).
     bool bends = boundary && path.interfaces < pc.maxBends;
     ++path.interfaces;
     vec3 reflected = vec3(0.0);
+    float reflectedSpread = 0.0;
+    width = hitWidth;
     if (bends) {
+      float widening = curvatureAt(hit) * hitWidth;  // how far the normal turns across the cone
       vec3 n = entering ? s.ns : -s.ns;
       float eta = n1 / n2;
       float c = -dot(dir, n);
@@ -203,21 +225,24 @@ bool tracePath(vec3 origin, vec3 dir, int channel, out Path path) {
       float k = 1.0 - eta * eta * (1.0 - c * c);
       if (k < 0.0) {
         dir = normalize(dir + 2.0 * c * n);  // total internal reflection keeps everything
+        spread += 2.0 * widening;
       } else {
         float r = fresnel ? fresnelReflectance(eta, c) : 0.0;
         if (reflections > 0u) {
           --reflections;
           if (r > 0.0) {
-            path.colour += throughput * highlight(s.position, n, dir, m.baseUvRow1.w, eta);
+            path.colour += throughput * highlight(s.position, n, dir, m.roughness, eta);
             reflectedWeight = throughput * r;
             reflected = normalize(dir + 2.0 * c * n);
+            reflectedSpread = spread + 2.0 * widening;
           }
         }
         dir = normalize(eta * dir + (eta * c - sqrt(k)) * n);
+        spread = eta * spread + abs(1.0 - eta) * widening;
         throughput *= 1.0 - r;
       }
     }
-    if (boundary) throughput *= baseColour(m, s.uvs);
+    if (boundary) throughput *= baseColour(m, s.uvs, s.lods);
     origin = leave(s, dir, tMin);
     skipInstance = hit.instance;
     skipPrim = hit.primitive;
@@ -225,8 +250,11 @@ bool tracePath(vec3 origin, vec3 dir, int channel, out Path path) {
       parkedOrigin = origin;
       parkedDir = dir;
       parkedTMin = tMin;
+      parkedWidth = width;
+      parkedSpread = spread;
       origin = leave(s, reflected, tMin);
       dir = reflected;
+      spread = reflectedSpread;
       reflecting = true;
     }
   }
@@ -239,6 +267,7 @@ void tracePixel(uvec2 pixel) {
   float sx = (2.0 * (float(pixel.x) + 0.5) / float(pc.width) - 1.0) * pc.right.w + pc.shiftX;
   float sy = (1.0 - 2.0 * (float(pixel.y) + 0.5) / float(pc.height)) * pc.up.w + pc.shiftY;
   vec3 origin = pc.eye.xyz, dir;
+  float width = 0.0, spread = 0.0;  // listed rays have no footprint: level 0
   if ((pc.flags & kTraceFlagRayList) != 0u) {
     GpuRay ray = rays[pixel.y * pc.width + pixel.x];
     origin = ray.origin.xyz;
@@ -246,9 +275,12 @@ void tracePixel(uvec2 pixel) {
   } else if ((pc.flags & kTraceFlagOrthographic) != 0u) {
     origin += sx * pc.right.xyz + sy * pc.up.xyz;
     dir = pc.forward.xyz;
+    width = 2.0 * pc.up.w / float(pc.height);
   } else {
     dir = normalize(pc.forward.xyz + sx * pc.right.xyz + sy * pc.up.xyz);
+    spread = atan(2.0 * pc.up.w / float(pc.height));
   }
+  if ((pc.optics & kOpticsTextureLod) == 0u) width = spread = 0.0;
 
   visits = 0u;
   // One call site for the path (a compiler that inlines would copy it per
@@ -258,7 +290,7 @@ void tracePixel(uvec2 pixel) {
   vec3 colour = vec3(0.0);
   int channel = -1;
   for (int pass = 0; pass < 4; ++pass) {
-    bool split = tracePath(origin, dir, channel, path);
+    bool split = tracePath(origin, dir, width, spread, channel, path);
     if (channel < 0) {
       colour = path.colour;
       if (!split) break;
