@@ -122,6 +122,15 @@ TEST_F(GpuTest, EachMipLevelIsTheMeanOfTheTwoByTwoTexelsAboveInLinearLight) {
   EXPECT_LE(worst, 1);
 }
 
+TEST_F(GpuTest, TexturesNoMaterialDrawsTakeNoGpuMemory) {
+  scene::Scene s = texturedQuads(1, 256);
+  s.textures.push_back(checker(1024, 7));  // read by no material: a normal map, say
+  scene::Pose pose = scene::evaluate(s, 0.0);
+  render::SceneGpu gpu = render::uploadScene(context(), s, pose);
+  EXPECT_EQ(gpu.textureBytes, scene::mipChainTexels(256, 256) * 4);
+  EXPECT_EQ(scene::textureChainBytes(s), gpu.textureBytes);
+}
+
 TEST_F(GpuTest, TexturesBeyondEveryPageAreAClearErrorNamingTheNumbers) {
   uint64_t limit = context().caps().maxStorageBufferRange;
   if (limit > (256ull << 20)) GTEST_SKIP() << "pages of " << (limit >> 20) << " MiB: too large to fill in a test";
@@ -135,6 +144,9 @@ TEST_F(GpuTest, TexturesBeyondEveryPageAreAClearErrorNamingTheNumbers) {
     t.name = "huge " + std::to_string(i);
     t.width = t.height = size;
     s.textures.push_back(t);  // no texels: the placement refuses before anything is read
+    scene::Material m;
+    m.baseColorTexture.texture = int(i);  // drawn, so it goes to the GPU
+    s.materials.push_back(m);
   }
   scene::Pose pose = scene::evaluate(s, 0.0);
   try {

@@ -66,8 +66,11 @@ TexturePlacement placeTextures(const vk::Context& context, const scene::Scene& s
   const uint64_t capacity = context.caps().maxStorageBufferRange / 4;
   TexturePlacement place;
   uint64_t total = 0;
-  for (const scene::Texture& t : scene.textures) {
-    uint64_t texels = scene::mipChainTexels(std::max(t.width, 1u), std::max(t.height, 1u));
+  const std::vector<bool> drawn = scene::drawnTextures(scene);
+  for (size_t i = 0; i < scene.textures.size(); ++i) {
+    const scene::Texture& t = scene.textures[i];
+    // A texture no material reads takes no texels (its table entry stays, unread).
+    uint64_t texels = drawn[i] ? scene::mipChainTexels(std::max(t.width, 1u), std::max(t.height, 1u)) : 0;
     total += texels;
     uint32_t p = 0;
     while (p < gpu::kTexelPages && place.pageTexels[p] + texels > capacity) ++p;
@@ -99,18 +102,19 @@ void uploadTextures(vk::Context& context, const scene::Scene& scene, const Textu
   // Level 0 goes through one staging ring of at most kStagingRingBytes: when
   // it is full, what it holds is copied and the ring starts again, so a
   // scene's textures never need a second copy of themselves in host memory.
+  const std::vector<bool> colour = scene::colourTextures(scene), drawn = scene::drawnTextures(scene);
   VkDeviceSize total = 0;
-  for (const scene::Texture& t : scene.textures) total += VkDeviceSize(t.rgba.size());
+  for (size_t i = 0; i < scene.textures.size(); ++i) total += drawn[i] ? VkDeviceSize(scene.textures[i].rgba.size()) : 0;
   const VkDeviceSize ringBytes = std::clamp<VkDeviceSize>(total, 4, kStagingRingBytes);
   vk::Buffer staging(context, {ringBytes, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, vk::MemoryDomain::Upload,
                                name + " texture staging ring"});
   vk::ComputeProgram mips(context, vk::ComputeProgramDesc{"texture mips", kSpvTextureMips, {}, false});
-  std::vector<bool> colour = scene::colourTextures(scene);
   vk::Commands commands(context, "upload " + name + " textures");
   commands.begin();
   VkDeviceSize offset = 0;
   for (size_t i = 0; i < scene.textures.size(); ++i) {
     const scene::Texture& t = scene.textures[i];
+    if (!drawn[i]) continue;
     for (VkDeviceSize done = 0; done < t.rgba.size();) {
       if (offset == ringBytes) {
         commands.submitAndWait();
@@ -130,7 +134,7 @@ void uploadTextures(vk::Context& context, const scene::Scene& scene, const Textu
   for (uint32_t level = 1; level < most; ++level) {
     for (size_t i = 0; i < scene.textures.size(); ++i) {
       const scene::Texture& t = scene.textures[i];
-      if (t.rgba.empty() || level >= scene::mipLevels(t.width, t.height)) continue;
+      if (!drawn[i] || t.rgba.empty() || level >= scene::mipLevels(t.width, t.height)) continue;
       uint32_t first = place.first[i];
       uint32_t w = t.width, h = t.height;
       for (uint32_t l = 1; l < level; ++l) {

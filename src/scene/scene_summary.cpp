@@ -3,6 +3,7 @@
 
 #include "scene/texture_mips.h"
 
+#include <algorithm>
 #include <cstdio>
 #include <functional>
 #include <sstream>
@@ -84,9 +85,13 @@ std::string describe(const Scene& scene, uint32_t width, uint32_t height) {
       decoded += t.rgba.size();
       if (uint64_t(t.width) * t.height > uint64_t(largest->width) * largest->height) largest = &t;
     }
+    const std::vector<bool> drawn = drawnTextures(scene);
+    const size_t undrawn = size_t(std::count(drawn.begin(), drawn.end(), false));
     out << "  texture memory " << mebibytes(decoded) << " decoded (RGBA8), " << mebibytes(s.textureBytes)
         << " on the GPU with mips; largest " << (largest->name.empty() ? "(unnamed)" : "'" + largest->name + "'") << " "
-        << largest->width << "x" << largest->height << "\n";
+        << largest->width << "x" << largest->height;
+    if (undrawn) out << "; " << undrawn << " not uploaded (normal, occlusion or metallic-roughness maps: not drawn)";
+    out << "\n";
   }
   out << "  materials " << scene.materials.size() << ", refractive " << s.refractiveMaterials << "\n";
   for (size_t m = 0; m < scene.materials.size(); ++m) {

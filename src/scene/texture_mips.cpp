@@ -23,6 +23,16 @@ uint64_t mipChainTexels(uint32_t width, uint32_t height) {
   return texels;
 }
 
+std::vector<bool> drawnTextures(const Scene& scene) {
+  std::vector<bool> drawn(scene.textures.size(), false);
+  for (const Material& m : scene.materials) {
+    for (const TextureRef* ref : {&m.baseColorTexture, &m.emissiveTexture, &m.iorTexture}) {
+      if (ref->present() && size_t(ref->texture) < drawn.size()) drawn[size_t(ref->texture)] = true;
+    }
+  }
+  return drawn;
+}
+
 std::vector<bool> colourTextures(const Scene& scene) {
   std::vector<bool> data(scene.textures.size(), false), colour(scene.textures.size(), false);
   auto mark = [&](const TextureRef& ref, std::vector<bool>& as) {
@@ -93,9 +103,11 @@ std::vector<MipLevel> mipChain(const Texture& texture, bool colour) {
 }
 
 uint64_t textureChainBytes(const Scene& scene) {
+  const std::vector<bool> drawn = drawnTextures(scene);
   uint64_t bytes = 0;
-  for (const Texture& t : scene.textures) {
-    if (t.width && t.height) bytes += mipChainTexels(t.width, t.height) * 4;
+  for (size_t i = 0; i < scene.textures.size(); ++i) {
+    const Texture& t = scene.textures[i];
+    if (drawn[i] && t.width && t.height) bytes += mipChainTexels(t.width, t.height) * 4;
   }
   return bytes;
 }
@@ -103,7 +115,7 @@ uint64_t textureChainBytes(const Scene& scene) {
 std::vector<std::string> fitTextureBudget(Scene& scene, uint64_t budgetBytes) {
   const uint64_t before = textureChainBytes(scene);
   if (before <= budgetBytes) return {};
-  const std::vector<bool> colour = colourTextures(scene);
+  const std::vector<bool> colour = colourTextures(scene), drawn = drawnTextures(scene);
   std::map<size_t, std::pair<uint32_t, uint32_t>> original;  // texture: its size as loaded
   uint64_t bytes = before;
   while (bytes > budgetBytes) {
@@ -112,7 +124,7 @@ std::vector<std::string> fitTextureBudget(Scene& scene, uint64_t budgetBytes) {
     for (size_t i = 0; i < scene.textures.size(); ++i) {
       const Texture& t = scene.textures[i];
       uint64_t texels = uint64_t(t.width) * t.height;
-      if (texels > most && t.rgba.size() >= texels * 4) most = texels, largest = i;
+      if (drawn[i] && texels > most && t.rgba.size() >= texels * 4) most = texels, largest = i;
     }
     if (largest == scene.textures.size()) {
       throw SceneError(scene.source + ": textures need " + mebibytes(bytes) + " with their mips even at 1x1; the texture budget is " +

@@ -26,6 +26,11 @@ std::vector<bool> colourTextures(const Scene& scene);
 /// of the texture level of detail (shaders/shared/trace.h: Textures).
 double textureLodOffset(const Texture& texture, const TextureRef& ref);
 
+/// Per texture: true where a material reads it (base colour, emissive or
+/// IOR). Only those go to the GPU; normal, occlusion and metallic-roughness
+/// maps, which snell does not draw, stay on the host.
+std::vector<bool> drawnTextures(const Scene& scene);
+
 /// One RGBA8 level of a mip chain.
 struct MipLevel {
   uint32_t width = 0, height = 0;
@@ -40,11 +45,11 @@ MipLevel nextMipLevel(const MipLevel& above, bool colour);
 /// Every level of `texture`, level 0 its own bytes. Empty for an unusable texture.
 std::vector<MipLevel> mipChain(const Texture& texture, bool colour);
 
-/// GPU bytes of every texture's whole mip chain (RGBA8).
+/// GPU bytes of every drawn texture's whole mip chain (RGBA8).
 uint64_t textureChainBytes(const Scene& scene);
 
-/// Fits the scene's textures, mips included, within `budgetBytes`: while
-/// they take more, the largest texture is replaced by its next mip level.
+/// Fits the scene's drawn textures, mips included, within `budgetBytes`:
+/// while they take more, the largest is replaced by its next mip level.
 /// Returns one note per texture made smaller, naming its sizes and the budget.
 /// Throws SceneError naming the numbers when even 1x1 textures do not fit.
 std::vector<std::string> fitTextureBudget(Scene& scene, uint64_t budgetBytes);
