@@ -3,7 +3,11 @@
 // 8 bits, and the seed's GLSL decoder runs the same in C++ and on the GPU.
 #include "gpu_test.h"
 
+#include "golden_support.h"
+
 #include "bake/refraction_map.h"
+#include "ref/reference_tracer.h"
+#include "render/renderer.h"
 #include "vk/buffer.h"
 #include "vk/commands.h"
 #include "vk/compute_program.h"
@@ -161,6 +165,44 @@ TEST_F(GpuTest, TheSeedDecoderRunsBitForBitTheSameInGlslAndCpp) {
     }
   }
   EXPECT_EQ(mismatches, 0u) << first;
+}
+
+// What a refraction map is baked from: where each pixel's refracted ray
+// lands, in the texture space of the surface behind the glass.
+TEST_F(GpuTest, TheTraceReportsWhereRefractedRaysLandInTextureSpace) {
+  scene::Scene s = eyeWith(1.376f);
+  scene::Pose pose = scene::evaluate(s, 0.0);
+  scene::View view = scene::resolveView(s, pose, {});
+  const uint32_t width = 128, height = 96;
+  render::Renderer renderer(context(), s, pose);
+  render::RenderedFrame frame =
+      render::renderFrame(context(), renderer, pose, {width, height, view, {0.02f, 0.02f, 0.025f}, 8}, true);
+  ref::ReferenceSettings settings;
+  settings.width = width;
+  settings.height = height;
+  settings.view = view;
+  ref::ReferenceImage reference = ref::renderReference(s, pose, settings);
+  size_t landed = 0, agreeing = 0, sameMark = 0, worstAt = 0;
+  double worst = 0.0;
+  for (size_t i = 0; i < frame.aov.size(); ++i) {
+    const gpu::TraceAov& a = frame.aov[i];
+    glm::dvec2 want = reference.landing[i];
+    bool gpuLanded = !std::isnan(a.landingU), refLanded = !std::isnan(want.x);
+    sameMark += gpuLanded == refLanded;
+    if (a.interfaces == 0) {
+      EXPECT_FALSE(gpuLanded) << "pixel " << i << " crossed no glass but reports a landing";
+    }
+    if (!gpuLanded || !refLanded) continue;
+    ++landed;
+    double d = std::max(std::abs(a.landingU - want.x), std::abs(a.landingV - want.y));
+    agreeing += d <= 1e-3;
+    if (d > worst) worst = d, worstAt = i;
+  }
+  std::printf("%zu pixels land on the iris; %zu within 1e-3 in UV of the reference (worst %.3g at pixel %zu); "
+              "landed or not agrees on %zu of %zu\n", landed, agreeing, worst, worstAt, sameMark, frame.aov.size());
+  EXPECT_GT(landed, 500u);
+  EXPECT_GE(double(agreeing), 0.995 * double(landed));
+  EXPECT_GE(double(sameMark), 0.999 * double(frame.aov.size()));
 }
 
 }  // namespace

@@ -78,8 +78,10 @@ vec3 sampleTexture(uint index, vec2 uv, bool srgb, float lod) {
   return c;
 }
 
-// A lookup's level of detail comes in two parts: per UV set, what a texture
-// of lodOffset 0 is read at on this face (below), plus the slot's lodOffset.
+// A lookup's level of detail (trace.h: Textures) comes in two parts: per UV
+// set, what a texture of lodOffset 0 is read at on this face (uvDensity, then
+// coneLod where the ray's cone meets it), plus the slot's lodOffset.
+
 // 0.5 log2(UV area / world area) of a triangle, per UV set, from its world
 // edges e1 = p1 - p0, e2 = p2 - p0 and its corners' UVs.
 vec2 uvDensity(vec3 e1, vec3 e2, vec4 uv0, vec4 uv1, vec4 uv2) {
@@ -95,11 +97,16 @@ vec2 coneLod(vec2 density, float width, float cosine) {
   return density + vec2(log2(width) - log2(abs(cosine)));
 }
 
+// The slot's UV set through its KHR_texture_transform.
+vec2 textureUv(GpuTextureSlot slot, vec4 uvs) {
+  vec3 uv = vec3(slot.texCoord == 1u ? uvs.zw : uvs.xy, 1.0);
+  return vec2(dot(slot.uvRow0.xyz, uv), dot(slot.uvRow1.xyz, uv));
+}
+
 vec3 textured(GpuTextureSlot slot, vec4 uvs, vec2 lods, bool srgb) {
   if (slot.texture == kNoTexture) return vec3(1.0);
-  vec3 uv = vec3(slot.texCoord == 1u ? uvs.zw : uvs.xy, 1.0);
   float lod = (slot.texCoord == 1u ? lods.y : lods.x) + slot.lodOffset;
-  return sampleTexture(slot.texture, vec2(dot(slot.uvRow0.xyz, uv), dot(slot.uvRow1.xyz, uv)), srgb, lod);
+  return sampleTexture(slot.texture, textureUv(slot, uvs), srgb, lod);
 }
 
 vec3 baseColour(GpuMaterial m, vec4 uvs, vec2 lods) {

@@ -175,8 +175,8 @@ struct TraceAov {
   uint interfaces;  // 4: refractive faces crossed
   uint outcome;     // 4: kOutcome*
   uint nodeVisits;  // 4: BVH nodes visited over the whole path (the cost heat map)
-  uint pad0;        // 4
-  uint pad1;        // 4
+  float landingU;   // 4: where a path that crossed glass ended on an opaque face with a base
+  float landingV;   // 4: colour texture, that texture's UV (transformed); NaN otherwise (refraction maps)
 };
 
 SNELL_CONST kNoHit = 0xffffffffu;

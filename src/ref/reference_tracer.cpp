@@ -536,17 +536,20 @@ glm::dvec2 coneLods(const TriangleData& tri, double width, const glm::dvec3& d) 
   return {tri.density[0] + footprint, tri.density[1] + footprint};
 }
 
-glm::dvec3 textureColor(const TextureUse& use, const TriangleData& tri, const SurfacePoint& at, bool srgb = true) {
-  if (!use.texture) return glm::dvec3(1.0);
-  const double b0 = at.b0, b1 = at.b1, b2 = at.b2;
+/// The UV `use` reads at `at`: its set's UV through its KHR_texture_transform.
+glm::dvec2 textureUv(const TextureUse& use, const TriangleData& tri, const SurfacePoint& at) {
   glm::dvec2 uv(0.0);
   if (use.texCoord == 0 || use.texCoord == 1) {
     const glm::dvec2* set = tri.uv[use.texCoord];
-    uv = b0 * set[0] + b1 * set[1] + b2 * set[2];
+    uv = at.b0 * set[0] + at.b1 * set[1] + at.b2 * set[2];
   }
-  glm::dvec3 transformed = use.transform * glm::dvec3(uv, 1.0);  // KHR_texture_transform
+  return glm::dvec2(use.transform * glm::dvec3(uv, 1.0));
+}
+
+glm::dvec3 textureColor(const TextureUse& use, const TriangleData& tri, const SurfacePoint& at, bool srgb = true) {
+  if (!use.texture) return glm::dvec3(1.0);
   const double lod = (use.texCoord == 1 ? at.lods.y : at.lods.x) + use.lodOffset;
-  return sample(*use.texture, glm::dvec2(transformed), srgb, lod);
+  return sample(*use.texture, textureUv(use, tri, at), srgb, lod);
 }
 
 /// Light `light` as seen from p: the unit direction towards it and its
@@ -601,6 +604,7 @@ struct PixelResult {
   uint32_t interfaces = 0;
   uint32_t outcome = gpu::kOutcomeMiss;
   double energyError = 0.0;
+  glm::dvec2 landing{std::numeric_limits<double>::quiet_NaN()};
 };
 
 // ---------------------------------------------------------------------------
@@ -800,6 +804,7 @@ struct Tracer {
       const ResolvedMaterial& material = prepared.material(tri.material);
       const glm::dvec3 base = material.baseFactor * textureColor(material.base, tri, here);
       if (!material.refractive) {
+        if (result.interfaces > 0 && material.base.texture) result.landing = textureUv(material.base, tri, here);
         const glm::dvec3 emissive = material.emissiveFactor * textureColor(material.emissive, tri, here);
         result.color += throughput * shadeOpaque(prepared, p, ns, d, base, emissive);
         result.outcome = gpu::kOutcomeOpaque;
@@ -904,6 +909,7 @@ ReferenceImage renderReference(const scene::Scene& scene, const scene::Pose& pos
   image.interfaces.assign(pixels, 0);
   image.outcome.assign(pixels, gpu::kOutcomeMiss);
   image.energyError.assign(pixels, 0.0);
+  image.landing.assign(pixels, glm::dvec2(std::numeric_limits<double>::quiet_NaN()));
   if (pixels == 0) return image;
   if (!settings.rays.empty() && settings.rays.size() != pixels) {
     throw std::invalid_argument("reference: " + std::to_string(settings.rays.size()) + " rays for " +
@@ -942,6 +948,7 @@ ReferenceImage renderReference(const scene::Scene& scene, const scene::Pose& pos
         image.interfaces[i] = r.interfaces;
         image.outcome[i] = r.outcome;
         image.energyError[i] = r.energyError;
+        image.landing[i] = r.landing;
       }
     }
   };

@@ -40,6 +40,9 @@ struct ReferenceImage {
   /// The largest |R + T - 1| over the pixel's refracting boundaries, with T from
   /// the Fresnel transmission amplitudes (not 1 - R): energy bookkeeping's check.
   std::vector<double> energyError;
+  /// Where a path that crossed glass ended on an opaque face with a base
+  /// colour texture: that texture's UV (transformed); NaN otherwise.
+  std::vector<glm::dvec2> landing;
 
   size_t index(uint32_t x, uint32_t y) const { return size_t(y) * width + x; }
 };

@@ -51,7 +51,7 @@ static_assert(sizeof(GpuMaterial) == 224 && offsetof(GpuMaterial, transmission) 
 static_assert(sizeof(GpuTexture) == 16 && offsetof(GpuTexture, flags) == 12);
 static_assert(sizeof(TextureMipPush) == 32 && offsetof(TextureMipPush, srgb) == 24);
 static_assert(sizeof(GpuLight) == 64 && offsetof(GpuLight, cone) == 48);
-static_assert(sizeof(TraceAov) == 32 && offsetof(TraceAov, nodeVisits) == 20);
+static_assert(sizeof(TraceAov) == 32 && offsetof(TraceAov, nodeVisits) == 20 && offsetof(TraceAov, landingV) == 28);
 static_assert(sizeof(GpuRay) == 32 && offsetof(GpuRay, direction) == 16);
 static_assert(sizeof(TracePixelListHeader) == 32 && offsetof(TracePixelListHeader, dispatchX) == kTracePixelListDispatchOffset);
 static_assert(sizeof(TraceCompactPush) == 16 && offsetof(TraceCompactPush, pixelsPerGroup) == 12);

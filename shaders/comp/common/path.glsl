@@ -100,6 +100,7 @@ struct Path {
   uint outcome;
   float firstDistance;
   uint firstInstance, firstPrimitive;
+  vec2 landing;  // TraceAov::landingU, landingV
 };
 
 // A ray leaving the surface of `hit` at `s` along dir: its offset origin and
@@ -124,7 +125,7 @@ vec3 leave(Surface s, vec3 dir, out float tMin) {
 // The ray's cone (trace.h: Textures) starts `width` wide at the origin and
 // opens by `spread` radians.
 bool tracePath(vec3 origin, vec3 dir, float width, float spread, int channel, out Path path) {
-  path = Path(vec3(0.0), 0u, kOutcomeMiss, -1.0, kNoHit, kNoHit);
+  path = Path(vec3(0.0), 0u, kOutcomeMiss, -1.0, kNoHit, kNoHit, vec2(uintBitsToFloat(0x7fc00000u)));
   bool fresnel = (pc.optics & kOpticsFresnel) != 0u;
   uint reflections = fresnel ? pc.reflections : 0u;
   vec3 throughput = vec3(1.0);
@@ -180,6 +181,7 @@ bool tracePath(vec3 origin, vec3 dir, float width, float spread, int channel, ou
       path.firstPrimitive = hit.primitive - firstTriangleOf(hit.instance);
     }
     if (opaque) {
+      if (path.interfaces > 0u && m.base.texture != kNoTexture) path.landing = textureUv(m.base, s.uvs);
       path.colour += throughput * phong(s.position, s.ns, s.uvs, s.lods, m, dir, pc.lightCount, pc.forward.xyz);
       path.outcome = kOutcomeOpaque;
       return false;
@@ -305,7 +307,7 @@ void tracePixel(uvec2 pixel) {
   imageStore(outImage, ivec2(pixel), vec4(path.colour, 1.0));
   if ((pc.flags & kTraceFlagAov) != 0u) {
     aovs[pixel.y * pc.width + pixel.x] = TraceAov(path.firstDistance, path.firstInstance, path.firstPrimitive,
-                                                  path.interfaces, path.outcome, visits, 0u, 0u);
+                                                  path.interfaces, path.outcome, visits, path.landing.x, path.landing.y);
   }
 }
 
