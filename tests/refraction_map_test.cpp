@@ -142,6 +142,11 @@ TEST_F(GpuTest, TheSeedDecoderRunsBitForBitTheSameInGlslAndCpp) {
   vk::ComputeProgram program(context(), vk::ComputeProgramDesc{"sky8 decode", kSpvSky8Decode, {}, false});
   vk::Buffer decoded(context(), {VkDeviceSize(chunk) * 8, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT,
                                  vk::MemoryDomain::Device, "sky8 decoded"});
+  std::vector<float> unorm8(256);
+  for (int v = 0; v < 256; ++v) unorm8[size_t(v)] = float(v) / 255.0f;
+  vk::Buffer table(context(), {256 * sizeof(float), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
+                               vk::MemoryDomain::Device, "unorm8"});
+  vk::upload(context(), table, unorm8.data(), 256 * sizeof(float));
   std::vector<glm::vec2> gpu(chunk);
   size_t mismatches = 0;
   std::string first;
@@ -151,7 +156,7 @@ TEST_F(GpuTest, TheSeedDecoderRunsBitForBitTheSameInGlslAndCpp) {
     } push{start, chunk};
     vk::Commands commands(context(), "sky8 decode");
     commands.begin();
-    program.dispatchThreads(commands, {{0, &decoded}}, push, chunk);
+    program.dispatchThreads(commands, {{0, &decoded}, {1, &table}}, push, chunk);
     commands.submitAndWait();
     vk::download(context(), decoded, gpu.data(), VkDeviceSize(chunk) * 8);
     for (uint32_t i = 0; i < chunk; ++i) {

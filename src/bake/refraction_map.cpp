@@ -33,18 +33,24 @@ glm::dvec2 decodeSky8(Sky8 code) {
 }
 
 glm::vec2 decodeSky8Seed(Sky8 code) {
-  // The seed, line by line; `volatile` keeps each float operation a separate,
-  // rounded step (no fused multiply-add, no wider intermediate).
+  // shaders/common/sky8.glsl line by line: divisions as products with 1/255
+  // and 1/16, each float operation a separate rounded step (`volatile`: no
+  // fused multiply-add, no wider intermediate). The bytes come in as a
+  // texture unit reads them: byte / 255, correctly rounded.
+  const float inv255 = 1.0f / 255.0f;
   volatile float r = float(code.r) / 255.0f, g = float(code.g) / 255.0f, b = float(code.b) / 255.0f;
   volatile float u = r * 16.0f;
   volatile float v = g * 16.0f;
   volatile float bu = b * 16.0f;
-  u = u + std::floor(float(bu)) * 16.0f;
+  volatile float tileU = std::floor(float(bu)) * 16.0f;
+  u = u + tileU;
   volatile float b255 = b * 255.0f;
-  float m = float(b255) - 16.0f * std::floor(float(b255) / 16.0f);  // GLSL mod(x, y) = x - y floor(x / y)
-  v = v + m * 16.0f;
-  u = u / 255.0f;
-  v = v / 255.0f;
+  volatile float whole = 16.0f * std::floor(float(b255) * 0.0625f);
+  volatile float m = float(b255) - whole;  // mod(b * 255, 16)
+  volatile float tileV = m * 16.0f;
+  v = v + tileV;
+  u = u * inv255;
+  v = v * inv255;
   return {float(u), float(v)};
 }
 

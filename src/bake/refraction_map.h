@@ -34,9 +34,11 @@ Sky8 encodeSky8(glm::dvec2 uv);
 /// the blue byte's high nibble (v: green and the low nibble).
 glm::dvec2 decodeSky8(Sky8 code);
 
-/// The seed's GLSL decoder, operation for operation in float (as a desktop
-/// GPU runs its mediump), the bytes first normalised to byte / 255 as a
-/// texture fetch of an 8-bit channel gives them.
+/// The seed's GLSL decoder as shaders/common/sky8.glsl keeps it, operation
+/// for operation in float (as a desktop GPU runs its mediump), the bytes
+/// first normalised to byte / 255 (correctly rounded, as a texture unit
+/// reads them), its divisions as products (so that every conforming GPU
+/// computes the same bits; a shader's division may be 2.5 ulp off).
 glm::vec2 decodeSky8Seed(Sky8 code);
 
 /// 16-bit unsigned normalised: round(clamp(x, 0, 1) * 65535).

@@ -10,12 +10,15 @@ layout(push_constant) uniform Push {
   uint count;
 };
 layout(std430, binding = 0) writeonly buffer Decoded { vec2 decoded[]; };
+// byte / 255 correctly rounded, as a texture unit reads an 8-bit channel (a
+// shader's own division may be 2.5 ulp off).
+layout(std430, binding = 1) readonly buffer Unorm8 { float unorm8[256]; };
 
 void main() {
   // Workgroups beyond the device's x limit continue along y (ComputeProgram).
   uint id = (gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x) * gl_WorkGroupSize.x + gl_LocalInvocationID.x;
   if (id >= count) return;
   uint code = first + id;
-  precise vec4 texel = vec4(float(code & 255u), float((code >> 8) & 255u), float(code >> 16), 255.0) / 255.0;
+  vec4 texel = vec4(unorm8[code & 255u], unorm8[(code >> 8) & 255u], unorm8[code >> 16], 1.0);
   decoded[id] = sky8Decode(texel);
 }
