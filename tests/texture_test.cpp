@@ -8,7 +8,6 @@
 
 #include "cli/image_file.h"
 #include "ref/reference_tracer.h"
-#include "render/raster_pass.h"
 #include "render/renderer.h"
 #include "render/scene_gpu.h"
 #include "scene/texture_mips.h"
@@ -241,11 +240,8 @@ TEST_F(GpuTest, ACheckerboardFloorBehindGlassDoesNotShimmer) {
   render::Renderer tracer(context(), behind.scene, behind.pose);
   render::RenderedFrame traced = render::renderFrame(context(), tracer, behind.pose, settings);
 
-  settings.view = open.view;
   render::Renderer raster(context(), open.scene, open.pose);
-  render::RasterOptions options;
-  render::fitDepthRange(open.view, {-40.0, -1.0, -400.0}, {40.0, 1.0, 3.0}, options);
-  render::CompositeFrame drawn = render::renderComposite(context(), raster, open.pose, settings, options);
+  render::CompositeFrame drawn = compositeOf(context(), raster, open.scene, open.pose, open.view, kFloorWidth, kFloorHeight);
 
   ref::ReferenceSettings unfiltered;
   unfiltered.width = kFloorWidth;

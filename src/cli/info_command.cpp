@@ -86,9 +86,10 @@ int runInfo(const Args& args) {
     render::SceneGpu gpu = render::uploadScene(*context, scene, pose);
     double upload = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     std::printf("  load times: parse %.1f ms, image decode %.1f ms (%u threads), upload %.1f ms "
-                "(textures %.1f ms: %s with mips through a 32 MiB staging ring) on %s\n",
+                "(textures %.1f ms: %s with mips through a %llu MiB staging ring) on %s\n",
                 t.parseSeconds * 1e3, t.decodeSeconds * 1e3, t.decodeThreads, upload * 1e3,
-                gpu.textureUploadSeconds * 1e3, scene::mebibytes(gpu.textureBytes).c_str(), context->facts().name.c_str());
+                gpu.textureUploadSeconds * 1e3, scene::mebibytes(gpu.textureBytes).c_str(),
+                static_cast<unsigned long long>(render::kTextureStagingRingBytes >> 20), context->facts().name.c_str());
   }
   return 0;
 }

@@ -235,8 +235,11 @@ class PreparedScene {
 
 PreparedScene::PreparedScene(const scene::Scene& scene, const scene::Pose& pose, const scene::View& view) {
   textures_.reserve(scene.textures.size());
-  const std::vector<bool> colour = scene::colourTextures(scene);
-  for (size_t t = 0; t < scene.textures.size(); ++t) textures_.push_back(decode(scene.textures[t], colour[t]));
+  // Only drawn textures get their mip chains (normal maps and the like are never sampled).
+  const std::vector<bool> colour = scene::colourTextures(scene), drawn = scene::drawnTextures(scene);
+  for (size_t t = 0; t < scene.textures.size(); ++t) {
+    textures_.push_back(drawn[t] ? decode(scene.textures[t], colour[t]) : LinearTexture{});
+  }
   auto use = [&](const scene::TextureRef& ref) {
     TextureUse u;
     if (ref.texture >= 0 && size_t(ref.texture) < textures_.size() && !textures_[size_t(ref.texture)].levels.empty()) {

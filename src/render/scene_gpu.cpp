@@ -56,8 +56,6 @@ struct TexturePlacement {
   std::array<uint64_t, gpu::kTexelPages> pageTexels{};
 };
 
-constexpr VkDeviceSize kStagingRingBytes = 32ull << 20;
-
 // Pages are read back by tests and tools (transfer source) as well as written.
 constexpr VkBufferUsageFlags kTexelPageUsage =
     VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT;
@@ -99,13 +97,13 @@ void uploadTextures(vk::Context& context, const scene::Scene& scene, const Textu
     gpu.bytes += bytes;
   }
   if (scene.textures.empty()) return;
-  // Level 0 goes through one staging ring of at most kStagingRingBytes: when
+  // Level 0 goes through one staging ring of at most kTextureStagingRingBytes: when
   // it is full, what it holds is copied and the ring starts again, so a
   // scene's textures never need a second copy of themselves in host memory.
   const std::vector<bool> colour = scene::colourTextures(scene), drawn = scene::drawnTextures(scene);
   VkDeviceSize total = 0;
   for (size_t i = 0; i < scene.textures.size(); ++i) total += drawn[i] ? VkDeviceSize(scene.textures[i].rgba.size()) : 0;
-  const VkDeviceSize ringBytes = std::clamp<VkDeviceSize>(total, 4, kStagingRingBytes);
+  const VkDeviceSize ringBytes = std::clamp<VkDeviceSize>(total, 4, kTextureStagingRingBytes);
   vk::Buffer staging(context, {ringBytes, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, vk::MemoryDomain::Upload,
                                name + " texture staging ring"});
   vk::ComputeProgram mips(context, vk::ComputeProgramDesc{"texture mips", kSpvTextureMips, {}, false});

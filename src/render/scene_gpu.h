@@ -48,6 +48,9 @@ struct SceneGpu {
   uint64_t bytes = 0;             ///< GPU memory the buffers above take
 };
 
+/// Level 0 of the textures goes to the GPU through one staging ring of at most this many bytes.
+inline constexpr uint64_t kTextureStagingRingBytes = 32ull << 20;
+
 /// Uploads the scene for the draw items of `layout` (which items exist does not
 /// change with time). Throws std::runtime_error naming the scene when it is
 /// larger than the device's buffers can hold.
