@@ -25,7 +25,8 @@ options:
   --play              start playing
   --split             two viewports side by side
   --method M          how glass is drawn (default masked): trace, trace-1,
-                      masked, iris-plane, normal-offset, none (the overlay's
+                      masked, iris-plane, normal-offset, refraction-map (baked
+                      when picked; B bakes again), none (the overlay's
                       drop-down switches it)
   --no-vsync          present as fast as the GPU renders
   --frames N          render N frames, then exit (0 when all went well)

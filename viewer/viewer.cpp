@@ -8,6 +8,7 @@
 
 #include "cli/cli.h"
 #include "cli/image_file.h"
+#include "bake/refraction_bake.h"
 #include "render/raster_pass.h"
 #include "render/method.h"
 #include "render/renderer.h"
@@ -130,6 +131,11 @@ class Viewer {
   std::vector<vk::PassTime> lastPasses_;
   render::FrameStats lastStats_;
   uint64_t pendingFrame_ = 0;  ///< the renderer's frame submitted last, not yet waited for
+  /// refraction-map: per viewport, the map the trace baked when the method was
+  /// picked (or B pressed); it stays as the scene and the camera move on.
+  std::vector<std::unique_ptr<render::RefractionMapBuffer>> maps_;
+  bool rebake_ = false;
+  void bakeRefractionMaps();
   double pendingCpuMs_ = 0;
   double fps_ = 0;
 };
@@ -250,6 +256,7 @@ void Viewer::useScene(std::unique_ptr<scene::Scene> scene, int camera) {
 
   if (renderer_) vkDeviceWaitIdle(context_->device());
   pendingFrame_ = 0;  // its numbers belong to the renderer that goes
+  maps_.clear();
   renderer_ = std::move(renderer);  // the old renderer goes before the scene it refers to
   scene_ = std::move(scene);
   pose_ = std::move(pose);
@@ -338,6 +345,7 @@ void Viewer::onKey(GLFWwindow* w, int key, int, int action, int mods) {
     case GLFW_KEY_R: t.refraction = !t.refraction; break;
     case GLFW_KEY_W: t.wireframe = !t.wireframe && self->context_->caps().fillModeNonSolid; break;
     case GLFW_KEY_H: t.heatMap = !t.heatMap; break;
+    case GLFW_KEY_B: self->rebake_ = true; break;
     case GLFW_KEY_G: t.gate = !t.gate; break;
     case GLFW_KEY_2: t.split = !t.split; break;
     case GLFW_KEY_TAB: t.ui = !t.ui; break;
@@ -594,6 +602,7 @@ void Viewer::drawUi(double frameSeconds) {
       }
       ImGui::EndCombo();
     }
+    if (toggles_.method == render::Method::RefractionMap && ImGui::Button("bake again here (B)")) rebake_ = true;
   }
   if (context_->caps().fillModeNonSolid) ImGui::Checkbox("wireframe (W)", &toggles_.wireframe);
   ImGui::Checkbox("BVH cost heat map (H)", &toggles_.heatMap);
@@ -615,10 +624,45 @@ void Viewer::drawUi(double frameSeconds) {
         "\\              2D pan/zoom of the film back\n"
         "F frame  Space play  Left/Right step  Home start\n"
         "R refraction  W wireframe  H heat map  G gate\n"
+        "B bake the refraction map again (refraction-map)\n"
         "2 two viewports  Tab hide this  Esc quit\n"
         "drop a .gltf/.glb on the window to open it");
   }
   ImGui::End();
+}
+
+// refraction-map's maps, baked by the trace at the pose and views of now
+// for viewports that have none of their size (or all, after B). The frames in
+// flight finish first: they may read the maps replaced.
+void Viewer::bakeRefractionMaps() {
+  bool wanted = toggles_.refraction && toggles_.method == render::Method::RefractionMap;
+  if (!wanted) {
+    rebake_ = false;
+    return;
+  }
+  std::vector<size_t> due;
+  for (size_t i = 0; i < viewports_.size(); ++i) {
+    const Viewport& vp = viewports_[i];
+    if (!vp.width) continue;
+    const render::RefractionMapBuffer* map = i < maps_.size() ? maps_[i].get() : nullptr;
+    if (rebake_ || !map || map->width != vp.width || map->height != vp.height) due.push_back(i);
+  }
+  rebake_ = false;
+  if (due.empty()) return;
+  if (pendingFrame_) noteFrame(renderer_->wait(pendingFrame_), pendingCpuMs_);
+  pendingFrame_ = 0;
+  renderer_->finish();
+  if (maps_.size() < viewports_.size()) maps_.resize(viewports_.size());
+  for (size_t i : due) {
+    const Viewport& vp = viewports_[i];
+    render::FrameSettings settings{vp.width, vp.height, viewOf(vp), {0.02f, 0.02f, 0.025f}, gpu::kDefaultMaxInterfaces};
+    bake::RefractionBake baked = bake::bakeRefraction(*context_, *renderer_, pose_, settings);
+    maps_[i] = std::make_unique<render::RefractionMapBuffer>(bake::uploadRefractionMap(*context_, baked));
+    char when[32];
+    std::snprintf(when, sizeof when, "%.2f s", pose_.time);
+    message_ = "refraction map baked at " + std::string(when) + ": " + bake::describe(baked, *scene_);
+  }
+  renderer_->invalidateViews();
 }
 
 // The frame the renderer runs: one composite view per viewport shown, then
@@ -632,6 +676,8 @@ render::FrameRequest Viewer::frameRequest(std::optional<uint32_t> swapImage, boo
     render::RasterOptions raster;
     raster.wireframe = toggles_.wireframe;
     render::fitDepthRange(settings.view, boundsLo_, boundsHi_, raster);
+    size_t index = size_t(&vp - viewports_.data());
+    if (index < maps_.size()) raster.refractionMap = maps_[index].get();
     render::ViewRequest view =
         render::methodViewport(toggles_.refraction ? toggles_.method : render::Method::None, settings, raster);
     // The heat map counts nodes for every pixel, so it traces them all.
@@ -891,6 +937,7 @@ int Viewer::run() {
         continue;
       }
     }
+    bakeRefractionMaps();
     bool last_frame = options_.frames != 0 && frame + 1 == options_.frames;
     bool screenshot = last_frame && !options_.screenshot.empty();
     uint64_t submitted = renderer_->submit(frameRequest(image, screenshot));

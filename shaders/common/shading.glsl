@@ -149,15 +149,19 @@ bool lightAt(uint i, uint lightCount, vec3 headlight, vec3 position, out vec3 l,
   return true;
 }
 
-// Lit colour of a surface point seen along `dir`: `position` camera-relative,
-// `ns` the shading normal, `lods` its textures' level of detail, `lightCount`
-// lights (0: the headlight shining along `headlight`).
-vec3 phong(vec3 position, vec3 ns, vec4 uvs, vec2 lods, GpuMaterial m, vec3 dir, uint lightCount, vec3 headlight) {
-  vec3 base = baseColour(m, uvs, lods);
+// Lit colour of a surface point seen along `dir`, in two parts: what it adds
+// whatever its base colour texture holds (emissive light, highlights), the
+// return value, and `weight`, what that texture's colour is multiplied by
+// (ambient and diffuse light times the base colour factor). A baked
+// refraction map redraws a landing from these two (TraceAov). `position` is
+// camera-relative, `ns` the shading normal, `lods` its textures' level of
+// detail, `lightCount` lights (0: the headlight shining along `headlight`).
+vec3 phongParts(vec3 position, vec3 ns, vec4 uvs, vec2 lods, GpuMaterial m, vec3 dir, uint lightCount, vec3 headlight,
+                out vec3 weight) {
   vec3 n = dot(ns, dir) > 0.0 ? -ns : ns;  // towards the viewer
   vec3 v = -dir;
-  vec3 colour = m.emissiveFactor.rgb * textured(m.emissive, uvs, lods, true) +
-                kAmbient * base;
+  vec3 shine = m.emissiveFactor.rgb * textured(m.emissive, uvs, lods, true);
+  vec3 diffuse = vec3(kAmbient);
   uint count = max(lightCount, 1u);
   for (uint i = 0u; i < count; ++i) {
     vec3 l, e;
@@ -165,9 +169,17 @@ vec3 phong(vec3 position, vec3 ns, vec4 uvs, vec2 lods, GpuMaterial m, vec3 dir,
     float nl = dot(n, l);
     if (nl <= 0.0) continue;
     vec3 h = normalize(l + v);
-    colour += e * nl * (base / kPi + kSpecular * pow(max(dot(n, h), 0.0), kShininess));
+    diffuse += e * (nl / kPi);
+    shine += e * (nl * kSpecular * pow(max(dot(n, h), 0.0), kShininess));
   }
-  return colour;
+  weight = diffuse * m.baseColorFactor.rgb;
+  return shine;
+}
+
+vec3 phong(vec3 position, vec3 ns, vec4 uvs, vec2 lods, GpuMaterial m, vec3 dir, uint lightCount, vec3 headlight) {
+  vec3 weight;
+  vec3 shine = phongParts(position, ns, uvs, lods, m, dir, lightCount, headlight, weight);
+  return shine + weight * textured(m.base, uvs, lods, true);
 }
 
 #endif

@@ -3,6 +3,7 @@
 // it before a barrier; it never leaves the GPU. With a screen-space method
 // the "trace image" is the picture of what lies behind the glass, read at a
 // pixel displaced the way the method says, and tinted by the glass once.
+// With a baked refraction map, the baked pixel at this place on the screen.
 #version 460
 #extension GL_GOOGLE_include_directive : require
 #include "../shared/raster.h"
@@ -12,6 +13,7 @@
 layout(push_constant) uniform Push { RasterPush pc; };
 layout(binding = kRasterBindingTraceImage, rgba16f) uniform readonly image2D traceImage;
 layout(binding = kRasterBindingBehindDepth, r32ui) uniform readonly uimage2D behindDepth;
+layout(std430, binding = kRasterBindingRefractionMap) readonly buffer RefractionMap { RefractionTexel refractionMap[]; };
 
 // The depth pre-pass has settled visibility: each pixel is shaded once.
 layout(early_fragment_tests) in;
@@ -51,6 +53,20 @@ vec2 irisPlaneLookup(vec3 dir, vec3 ns, float ior, vec2 size) {
   return pixelOf(inPosition + t * (gap / along), size);
 }
 
+// The baked pixel at this fragment's place on the screen (nearest: a map
+// is never filtered, that would crack it), redrawn from its two parts.
+vec3 refractionMapLookup(vec2 size) {
+  uvec2 mapSize = uvec2(pc.mapWidth, pc.mapHeight);
+  uvec2 at = min(uvec2(gl_FragCoord.xy * vec2(mapSize) / size), mapSize - 1u);
+  RefractionTexel t = refractionMap[at.y * mapSize.x + at.x];
+  vec3 texel = vec3(1.0);
+  if (t.material != kNoHit) {
+    uint texture = materials[t.material].base.texture;
+    if (texture != kNoTexture) texel = sampleTexture(texture, vec2(t.u, t.v), true, t.weight.w);
+  }
+  return t.shine.rgb + t.weight.rgb * texel;
+}
+
 void main() {
   if ((pc.flags & kRasterFlagWireframe) != 0u) {
     outColour = pc.wireColor;
@@ -67,6 +83,10 @@ void main() {
   float width = ortho ? 2.0 / (pc.up.w * height) : atan(2.0 / (pc.up.w * height)) * length(inPosition - pc.eye.xyz);
   vec2 lods = coneLod(inDensity, width, dot(dir, ng));
   if (refractive(m)) {
+    if ((pc.flags & kRasterFlagRefractionMap) != 0u) {
+      outColour = vec4(refractionMapLookup(vec2(imageSize(traceImage))), 1.0);
+      return;
+    }
     if ((pc.flags & (kRasterFlagNormalOffset | kRasterFlagIrisPlane)) == 0u) {
       outColour = vec4(imageLoad(traceImage, ivec2(gl_FragCoord.xy)).rgb, 1.0);
       return;

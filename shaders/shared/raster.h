@@ -20,10 +20,27 @@ SNELL_CONST kRasterFlagIrisPlane = 16u;    // where the refracted ray meets the 
 // The pre-pass's uint attachment takes the view depth's float bits of the
 // nearest face (0: nothing), for kRasterFlagIrisPlane, instead of the transmissive mask.
 SNELL_CONST kRasterFlagBehindDepth = 32u;
+// A baked refraction map (no trace): a transmissive fragment redraws the
+// baked pixel at its place on the screen, shine + weight * the texture
+// behind at the baked UV (RefractionTexel), however the scene moved since.
+SNELL_CONST kRasterFlagRefractionMap = 64u;
 
 // The raster pass's own binding slots, after the scene binding set (shared/scene.h).
 SNELL_CONST kRasterBindingTraceImage = kSceneBindingCount + 0;   // rgba16f storage image, read at the fragment's pixel (or displaced)
 SNELL_CONST kRasterBindingBehindDepth = kSceneBindingCount + 1;  // r32ui storage image: view depth bits behind the glass (kRasterFlagIrisPlane)
+SNELL_CONST kRasterBindingRefractionMap = kSceneBindingCount + 2;  // RefractionTexel per baked pixel (kRasterFlagRefractionMap)
+
+// One pixel of a baked refraction map as the raster pass reads it: what
+// TraceAov split the traced colour into at the baked pose and view.
+// 48 bytes, total: 48 bytes
+struct RefractionTexel {
+  vec4 shine;     // 16: rgb: added whatever the texture holds; w: 1 where the baked pixel showed glass, else 0
+  vec4 weight;    // 16: rgb: what the texture's colour is multiplied by; w: the level of detail it is read at
+  float u;        // 4: the UV in `material`'s base colour texture (transformed)
+  float v;        // 4
+  uint material;  // 4: whose base colour texture; kNoHit: none (the texture reads as 1)
+  uint pad0;      // 4
+};
 
 // One draw per draw item: gl_InstanceIndex is the item, gl_VertexIndex / 3
 // the absolute triangle. Vectors are relative to the frame's origin.
@@ -39,9 +56,9 @@ struct RasterPush {
   float shiftX;    // 4: the film back's offset (View::shift)
   float shiftY;    // 4
   float offsetStrength;  // 4: kRasterFlagNormalOffset's displacement per unit of normal, in image heights
+  uint mapWidth;   // 4: the refraction map's size in pixels (kRasterFlagRefractionMap)
+  uint mapHeight;  // 4
   uint pad0;       // 4
-  uint pad1;       // 4
-  uint pad2;       // 4
 };
 
 SNELL_GPU_END

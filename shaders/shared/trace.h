@@ -167,7 +167,7 @@ SNELL_CONST kOutcomeInterfaceLimit = 2;  // more refractive faces than maxInterf
 
 
 // Per-pixel outputs for tests and tools, written when TracePush::flags has kTraceFlagAov.
-// 32 bytes, total: 32 bytes
+// 64 bytes, total: 64 bytes
 struct TraceAov {
   float distance;   // 4: to the first hit along the unit primary ray; -1 on a miss
   uint instance;    // 4: draw item of the first hit, kNoHit on a miss
@@ -177,6 +177,19 @@ struct TraceAov {
   uint nodeVisits;  // 4: BVH nodes visited over the whole path (the cost heat map)
   float landingU;   // 4: where a path that crossed glass ended on an opaque face with a base
   float landingV;   // 4: colour texture, that texture's UV (transformed); NaN otherwise (refraction maps)
+  // A path that crossed glass, split the way a baked refraction map redraws
+  // it: colour = shine + weight * (landingMaterial's base colour texture at
+  // landing UV and level of detail landingLod), or shine + weight where it
+  // ended on an untextured opaque face, or shine alone where it ended
+  // elsewhere (weight 0). Zero where the path crossed no glass.
+  uint landingMaterial;  // 4: the opaque face's material; kNoHit where it met none
+  float landingLod;      // 4: the level of detail its base colour texture was read at
+  float shineR;     // 4: reflections, highlights and emissive light
+  float shineG;     // 4
+  float shineB;     // 4
+  float weightR;    // 4: light times the glass's transmittance times the base colour factor
+  float weightG;    // 4
+  float weightB;    // 4
 };
 
 SNELL_CONST kNoHit = 0xffffffffu;

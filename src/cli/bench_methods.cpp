@@ -3,6 +3,7 @@
 // double-precision reference of each frame, never against another GPU image.
 #include "cli/cli.h"
 
+#include "bake/refraction_bake.h"
 #include "cli/image_file.h"
 #include "ref/reference_tracer.h"
 #include "render/method.h"
@@ -50,7 +51,9 @@ a PNG would hold them: RMSE, the share of pixels over 1/255 and over 8/255,
 the largest difference, over the pixels whose first hit in the reference is
 transmissive, and over the whole image.
 
-methods: trace, trace-1, masked, iris-plane, normal-offset, none, and
+methods: trace, trace-1, masked, iris-plane, normal-offset, refraction-map
+(a map baked by the trace at the first frame, read by every frame after: a
+table shows its glass error against animation time beside the others'), none, and
 driver-rt, the peer: the same rays and shading code with the hits found by
 the driver's own ray tracing (VK_KHR_ray_tracing_pipeline), where the device
 has it (not lavapipe: reported unsupported). For it the table adds the share
@@ -117,12 +120,17 @@ struct MethodResult {
   std::map<std::string, double> firstFrameMs;         ///< per pass, the warm-up frame (builds)
   uint64_t hitsCompared = 0, hitsAgreeing = 0;        ///< first hits against trace's (driver-rt)
   Error glass, image;
-  double worstFrameWithin1 = 1.0;  ///< the lowest share of pixels within 1/255 of any frame
+  std::vector<double> frameGlassRmse;  ///< per frame of the sequence, in order
+  double worstFrameWithin1 = 1.0;
+  /// refraction-map: the map, baked by the trace at the sequence's first frame.
+  std::shared_ptr<render::RefractionMapBuffer> map;
+  double bakeMs = 0.0;  ///< its bake, wall time (trace, read back, upload)  ///< the lowest share of pixels within 1/255 of any frame
   uint64_t memoryBytes = 0;
 };
 
-void accumulate(const Rgb8Image& got, const Frame& frame, Error& glass, Error& image, double& worstWithin1) {
-  Error frameError;
+// Adds a frame's differences to the row's errors; returns the frame's own glass error.
+Error accumulate(const Rgb8Image& got, const Frame& frame, Error& glass, Error& image, double& worstWithin1) {
+  Error frameError, frameGlass;
   for (size_t i = 0; i < size_t(got.width) * got.height; ++i) {
     int worst = 0;
     double squares = 0;
@@ -131,7 +139,8 @@ void accumulate(const Rgb8Image& got, const Frame& frame, Error& glass, Error& i
       worst = std::max(worst, d);
       squares += double(d) * d;
     }
-    for (Error* e : {&image, &frameError, frame.transmissive[i] ? &glass : nullptr}) {
+    for (Error* e : {&image, &frameError, frame.transmissive[i] ? &glass : nullptr,
+                     frame.transmissive[i] ? &frameGlass : nullptr}) {
       if (!e) continue;
       e->sumSquares += squares;
       e->channels += 3;
@@ -142,6 +151,7 @@ void accumulate(const Rgb8Image& got, const Frame& frame, Error& glass, Error& i
     }
   }
   worstWithin1 = std::min(worstWithin1, 1.0 - frameError.share(frameError.over1));
+  return frameGlass;
 }
 
 // The camera swings about the view's up axis around the scene's centre.
@@ -167,18 +177,6 @@ std::vector<std::string> splitList(const std::string& value) {
 }
 
 // ------------------------------------------------------------------ chart
-
-std::string xmlEscape(const std::string& text) {
-  std::string out;
-  for (char c : text) {
-    if (c == '&') out += "&amp;";
-    else if (c == '<') out += "&lt;";
-    else if (c == '>') out += "&gt;";
-    else if (c == '"') out += "&quot;";
-    else out += c;
-  }
-  return out;
-}
 
 double niceFloor(double v) { return std::pow(10.0, std::floor(std::log10(v))); }
 double niceCeil(double v) { return std::pow(10.0, std::ceil(std::log10(v))); }
@@ -478,6 +476,16 @@ int runBenchMethods(const Args& args) {
       continue;
     }
     renderers[m] = std::make_unique<render::Renderer>(*context, *results[m].scene, results[m].frames->at(0).pose);
+    if (results[m].info.method == render::Method::RefractionMap) {
+      // Baked once, by the trace, at the first frame's pose and view; every frame after drifts from it.
+      const Frame& first = results[m].frames->at(0);
+      render::FrameSettings settings{width, height, first.view, glm::vec3(0.02f, 0.02f, 0.025f), maxInterfaces};
+      settings.optics = results[m].optics;
+      auto bakeStart = std::chrono::steady_clock::now();
+      bake::RefractionBake baked = bake::bakeRefraction(*context, *renderers[m], first.pose, settings);
+      results[m].map = std::make_shared<render::RefractionMapBuffer>(bake::uploadRefractionMap(*context, baked));
+      results[m].bakeMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - bakeStart).count();
+    }
   }
   auto hitsOf = [](render::Method method) {
     return method == render::Method::Trace || method == render::Method::DriverRt;
@@ -486,7 +494,9 @@ int runBenchMethods(const Args& args) {
     const Frame& frame = row.frames->at(f);
     render::FrameSettings settings{width, height, frame.view, glm::vec3(0.02f, 0.02f, 0.025f), maxInterfaces};
     settings.optics = row.optics;
-    render::ViewRequest view = render::methodView(row.info.method, settings, frame.raster);
+    render::RasterOptions raster = frame.raster;
+    raster.refractionMap = row.map.get();
+    render::ViewRequest view = render::methodView(row.info.method, settings, raster);
     view.readback = readback;
     view.aov = readback && hitsOf(row.info.method);
     render::FrameRequest r;
@@ -549,7 +559,10 @@ int runBenchMethods(const Args& args) {
         if (method == render::Method::DriverRt) driver = &result;
       }
       LinearImage image{width, height, render::drawsComposite(method) ? pixels.composite : pixels.trace};
-      if (reference) accumulate(toSrgb8(image), frame, result.glass, result.image, result.worstFrameWithin1);
+      if (reference) {
+        Error glass = accumulate(toSrgb8(image), frame, result.glass, result.image, result.worstFrameWithin1);
+        result.frameGlassRmse.push_back(glass.rmse());
+      }
       if (!images.empty() && f + 1 == frameCount) writeImage(images + "/" + result.name + ".png", image);
       if (f + 1 == frameCount) result.memoryBytes = renderers[m]->memoryBytes();
     }
@@ -607,6 +620,28 @@ int runBenchMethods(const Args& args) {
                   r.summary.c_str());
     }
   }
+  // Error against animation time: what a baked map loses as the pose and the
+  // view drift from the ones it was baked at, beside methods that follow them.
+  const MethodResult* baked = nullptr;
+  for (const MethodResult& r : results) {
+    if (r.info.method == render::Method::RefractionMap && r.unsupported.empty() && !r.frameGlassRmse.empty()) baked = &r;
+  }
+  if (baked && !optics) {
+    std::printf("\nglass RMSE against animation time (refraction-map baked at frame 0 in %.1f ms, wall):\n%5s %8s %7s",
+                baked->bakeMs, "frame", "time s", "orbit");
+    for (const MethodResult& r : results) {
+      if (r.unsupported.empty()) std::printf(" %14s", r.name.c_str());
+    }
+    std::printf("\n");
+    for (uint32_t f = 0; f < frameCount; ++f) {
+      double along = frameCount > 1 ? double(f) / double(frameCount - 1) : 0.0;
+      std::printf("%5u %8.3f %6.1f%s", f, baked->frames->at(f).time, 80.0 * along, "\u00b0");
+      for (const MethodResult& r : results) {
+        if (r.unsupported.empty()) std::printf(" %14.5f", r.frameGlassRmse.at(f));
+      }
+      std::printf("\n");
+    }
+  }
   const MethodResult *traced = nullptr, *driver = nullptr;
   for (const MethodResult& r : results) {
     if (r.info.method == render::Method::Trace) traced = &r;
@@ -653,18 +688,17 @@ int runBenchMethods(const Args& args) {
       out << ", \"summary\": \"" << jsonEscape(r.summary)
           << "\", \"refraction_median_ms\": " << median(r.refractionMs) << ", \"glass\": " << errorJson(r.glass)
           << ", \"image\": " << errorJson(r.image) << ", \"worst_frame_within_1\": " << r.worstFrameWithin1
-          << ", \"memory_bytes\": " << r.memoryBytes << "}" << (i + 1 < results.size() ? "," : "") << "\n";
+          << ", \"memory_bytes\": " << r.memoryBytes << ", \"glass_rmse_per_frame\": [";
+      for (size_t f = 0; f < r.frameGlassRmse.size(); ++f) out << (f ? ", " : "") << r.frameGlassRmse[f];
+      out << "]";
+      if (r.map) out << ", \"bake_ms\": " << r.bakeMs;
+      out << "}" << (i + 1 < results.size() ? "," : "") << "\n";
     }
     out << "  ]\n}\n";
     writeTextFile(json, out.str());
   }
   if (!svg.empty()) writeTextFile(svg, chartSvg(results, title));
-  if (context->validationMessageCount() > 0) {
-    std::fprintf(stderr, "snell: the validation layer reported %llu message(s)\n",
-                 static_cast<unsigned long long>(context->validationMessageCount()));
-    return 1;
-  }
-  return 0;
+  return validationExitCode(*context);
 }
 
 }  // namespace snell::cli

@@ -1,7 +1,13 @@
 // Option parsing and the device choice shared by `snell` and `snell-view`.
 #include "cli/cli.h"
 
+#include "render/renderer.h"
+#include "scene/procedural_eye.h"
+
 #include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <sstream>
 #include <charconv>
 #include <cstdlib>
 
@@ -39,6 +45,128 @@ uint64_t parseTextureBudget(const std::string& option, const std::string& value)
   unsigned long long mib = parseCount(option, value);
   if (mib == 0 || mib > (1ull << 20)) throw UsageError{option + " " + value + " is out of range (1 to 1048576 MiB)"};
   return uint64_t(mib) << 20;
+}
+
+std::vector<double> parseNumbers(const std::string& option, const std::string& value, size_t count) {
+  std::vector<double> numbers;
+  std::stringstream in(value);
+  std::string part;
+  while (std::getline(in, part, ',')) {
+    char* end = nullptr;
+    double v = std::strtod(part.c_str(), &end);
+    if (part.empty() || *end != '\0' || !std::isfinite(v)) break;
+    numbers.push_back(v);
+  }
+  if (numbers.size() != count || std::count(value.begin(), value.end(), ',') != long(count - 1)) {
+    throw UsageError{option + " expects " + std::to_string(count) + " comma-separated numbers, got '" + value + "'"};
+  }
+  return numbers;
+}
+
+bool ShotOptions::take(const std::string& command, const Args& args, size_t& i) {
+  const std::string& a = args[i];
+  if (a == "--eye") {
+    eye = true;
+    return true;
+  }
+  if (!a.empty() && a[0] != '-') {
+    if (!input.empty()) throw UsageError{command + ": more than one scene given ('" + input + "', '" + a + "')"};
+    input = a;
+    return true;
+  }
+  static const char* const kWithValue[] = {"--size", "--camera", "--look-at", "--fov", "--time", "--max-interfaces",
+                                           "--background", "--scene", "--ignore-extension", "--texture-budget"};
+  if (std::find(std::begin(kWithValue), std::end(kWithValue), a) == std::end(kWithValue)) return false;
+  if (i + 1 >= args.size()) throw UsageError{command + ": " + a + " needs a value"};
+  const std::string& v = args[++i];
+  if (a == "--size") {
+    parseSize(a, v, width, height);
+  } else if (a == "--camera") {
+    view.camera = int(parseCount(a, v));
+  } else if (a == "--look-at") {
+    std::vector<double> n = parseNumbers(a, v, 6);
+    view.lookAt = scene::LookAt{{n[0], n[1], n[2]}, {n[3], n[4], n[5]}, {0.0, 1.0, 0.0}};
+  } else if (a == "--fov") {
+    double deg = parseNumbers(a, v, 1)[0];
+    if (!(deg > 0.0 && deg < 180.0)) throw UsageError{"--fov must be between 0 and 180 degrees, got " + v};
+    view.yfov = deg * 3.14159265358979 / 180.0;
+  } else if (a == "--time") {
+    time = parseNumbers(a, v, 1)[0];
+  } else if (a == "--max-interfaces") {
+    maxInterfaces = uint32_t(std::min<unsigned long long>(parseCount(a, v), 1024));
+  } else if (a == "--background") {
+    std::vector<double> n = parseNumbers(a, v, 3);
+    background = glm::vec3(glm::dvec3(n[0], n[1], n[2]));
+  } else if (a == "--scene") {
+    load.scene = v;
+  } else if (a == "--ignore-extension") {
+    load.ignoredExtensions.push_back(v);
+  } else {
+    load.textureBudget = parseTextureBudget(a, v);
+  }
+  return true;
+}
+
+void ShotOptions::require(const std::string& command) const {
+  if (input.empty() && !eye) throw UsageError{command + ": give a scene file (or --eye)"};
+  if (!input.empty() && eye) throw UsageError{command + ": give a scene file or --eye, not both"};
+}
+
+scene::Scene ShotOptions::loadScene() const {
+  scene::Scene scene = eye ? scene::makeEye() : scene::loadGltf(input, load);
+  if (eye) scene.source = "procedural eye";
+  for (const std::string& w : scene.warnings) std::fprintf(stderr, "snell: note: %s\n", w.c_str());
+  return scene;
+}
+
+scene::View ShotOptions::resolveView(const std::string& command, const scene::Scene& scene,
+                                     const scene::Pose& pose) const {
+  try {
+    return scene::resolveView(scene, pose, view);
+  } catch (const std::invalid_argument& e) {
+    throw UsageError{command + ": " + e.what()};
+  }
+}
+
+std::unique_ptr<vk::Context> ShotOptions::openContext(const std::string& command) const {
+  std::unique_ptr<vk::Context> context = vk::Context::create(contextDescFromEnvironment());
+  try {
+    render::checkImageSize(*context, width, height);
+  } catch (const std::invalid_argument& e) {
+    throw UsageError{command + ": " + e.what()};
+  }
+  return context;
+}
+
+uint32_t findTexturedMaterial(const std::string& command, const scene::Scene& scene, const std::string& wanted) {
+  for (size_t i = 0; i < scene.materials.size(); ++i) {
+    if (scene.materials[i].name != wanted && std::to_string(i) != wanted) continue;
+    if (!scene.materials[i].baseColorTexture.present()) {
+      throw UsageError{command + ": --material " + wanted + " has no base colour texture for the UVs to address"};
+    }
+    return uint32_t(i);
+  }
+  throw UsageError{command + ": --material " + wanted + ": the scene has no such material (" +
+                   std::to_string(scene.materials.size()) + " materials)"};
+}
+
+int validationExitCode(const vk::Context& context) {
+  if (context.validationMessageCount() == 0) return 0;
+  std::fprintf(stderr, "snell: the validation layer reported %llu message(s)\n",
+               static_cast<unsigned long long>(context.validationMessageCount()));
+  return 1;
+}
+
+std::string xmlEscape(const std::string& text) {
+  std::string out;
+  for (char c : text) {
+    if (c == '&') out += "&amp;";
+    else if (c == '<') out += "&lt;";
+    else if (c == '>') out += "&gt;";
+    else if (c == '"') out += "&quot;";
+    else out += c;
+  }
+  return out;
 }
 
 double median(std::vector<double> values) {

@@ -16,6 +16,7 @@
 #include <iterator>
 
 #include <algorithm>
+#include <cstring>
 #include <cmath>
 #include <filesystem>
 #include <stdexcept>
@@ -111,16 +112,26 @@ void writeRgb8(const std::string& path, const Rgb8Image& image) {
   writeAtomically(path, [&](const std::string& temp) { writeBytes(path, temp, pngBytes(image.width, image.height, image.rgb)); });
 }
 
-Rgb8Image readRgb8(const std::string& path) {
+namespace {
+
+// A PNG file decoded by stb (through tinygltf) to RGBA of 8 or 16 bits.
+tinygltf::Image decodeImageFile(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   if (!in) throw std::runtime_error(path + ": cannot open");
   std::vector<unsigned char> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   tinygltf::Image decoded;
   std::string err, warn;
-  if (!tinygltf::LoadImageData(&decoded, 0, &err, &warn, 0, 0, bytes.data(), int(bytes.size()), nullptr) ||
-      decoded.bits != 8 || decoded.component < 3) {
-    throw std::runtime_error(path + ": not an 8-bit RGB(A) image " + err);
+  if (!tinygltf::LoadImageData(&decoded, 0, &err, &warn, 0, 0, bytes.data(), int(bytes.size()), nullptr)) {
+    throw std::runtime_error(path + ": not an image snell reads " + err);
   }
+  return decoded;
+}
+
+}  // namespace
+
+Rgb8Image readRgb8(const std::string& path) {
+  tinygltf::Image decoded = decodeImageFile(path);
+  if (decoded.bits != 8 || decoded.component < 3) throw std::runtime_error(path + ": not an 8-bit RGB(A) image");
   Rgb8Image image{uint32_t(decoded.width), uint32_t(decoded.height), {}};
   size_t pixels = size_t(decoded.width) * size_t(decoded.height);
   image.rgb.resize(pixels * 3);
@@ -199,6 +210,81 @@ scene::Environment readEnvironment(const std::string& path) {
   }
   while (env.width > kMaxEnvironmentWidth) halve(env);
   return env;
+}
+
+void writePngRgba8(const std::string& path, uint32_t width, uint32_t height, const std::vector<uint8_t>& rgba) {
+  writeAtomically(path, [&](const std::string& temp) { writeBytes(path, temp, scene::encodePng(width, height, rgba)); });
+}
+
+void writeMapFile(const std::string& path, const bake::MapPixels& pixels, bake::Encoding encoding) {
+  std::string ext = lowerExtension(path);
+  const char* wanted = encoding == bake::Encoding::Exr ? ".exr" : ".png";
+  if (ext != wanted) {
+    throw std::runtime_error(path + ": a " + bake::encodingName(encoding) + " map is written as " + wanted + ", not '" +
+                             ext + "'");
+  }
+#if !SNELL_WITH_OPENIMAGEIO
+  if (encoding == bake::Encoding::Exr) throw std::runtime_error(path + ": this build has no OpenImageIO, so no EXR");
+#endif
+  writeAtomically(path, [&](const std::string& temp) {
+    switch (encoding) {
+      case bake::Encoding::Sky8: writeBytes(path, temp, scene::encodePng(pixels.width, pixels.height, pixels.sky8)); return;
+      case bake::Encoding::Rg16: writeBytes(path, temp, scene::encodePng16(pixels.width, pixels.height, pixels.rg16)); return;
+      case bake::Encoding::Exr: {
+#if SNELL_WITH_OPENIMAGEIO
+        OIIO::ImageSpec spec(int(pixels.width), int(pixels.height), 4, OIIO::TypeDesc::FLOAT);
+        spec.channelnames = {"R", "G", "B", "A"};
+        spec.attribute("compression", "zip");
+        spec.attribute("snell:content", "refraction map: R, G the UV; A 1 lands, 0.5 marked, 0 not glass");
+        auto out = OIIO::ImageOutput::create(temp);
+        if (!out) throw std::runtime_error(path + ": cannot write EXR (" + OIIO::geterror() + ")");
+        if (!out->open(temp, spec) || !out->write_image(OIIO::TypeDesc::FLOAT, pixels.rgba32f.data()) || !out->close()) {
+          throw std::runtime_error(path + ": " + out->geterror());
+        }
+#endif
+        return;
+      }
+    }
+  });
+}
+
+bake::MapPixels readMapFile(const std::string& path, bake::Encoding& encoding) {
+  bake::MapPixels pixels;
+  if (lowerExtension(path) == ".exr") {
+#if SNELL_WITH_OPENIMAGEIO
+    auto in = OIIO::ImageInput::open(path);
+    if (!in) throw std::runtime_error(path + ": cannot read the map (" + OIIO::geterror() + ")");
+    const OIIO::ImageSpec& spec = in->spec();
+    if (spec.nchannels != 4 || spec.width <= 0 || spec.height <= 0) {
+      throw std::runtime_error(path + ": a refraction map has 4 channels (RGBA), this has " + std::to_string(spec.nchannels));
+    }
+    pixels.width = uint32_t(spec.width);
+    pixels.height = uint32_t(spec.height);
+    pixels.rgba32f.resize(size_t(pixels.width) * pixels.height * 4);
+    if (!in->read_image(0, 0, 0, 4, OIIO::TypeDesc::FLOAT, pixels.rgba32f.data())) {
+      throw std::runtime_error(path + ": cannot read the map's pixels (" + in->geterror() + ")");
+    }
+    encoding = bake::Encoding::Exr;
+    return pixels;
+#else
+    throw std::runtime_error(path + ": this build has no OpenImageIO, so no EXR");
+#endif
+  }
+  tinygltf::Image decoded = decodeImageFile(path);
+  if (decoded.component != 4 || (decoded.bits != 8 && decoded.bits != 16)) {
+    throw std::runtime_error(path + ": a refraction map is an RGBA PNG of 8 or 16 bits");
+  }
+  pixels.width = uint32_t(decoded.width);
+  pixels.height = uint32_t(decoded.height);
+  if (decoded.bits == 8) {
+    encoding = bake::Encoding::Sky8;
+    pixels.sky8.assign(decoded.image.begin(), decoded.image.end());
+  } else {
+    encoding = bake::Encoding::Rg16;
+    pixels.rg16.resize(decoded.image.size() / 2);
+    std::memcpy(pixels.rg16.data(), decoded.image.data(), decoded.image.size());  // stb gives native-endian samples
+  }
+  return pixels;
 }
 
 void writeTextFile(const std::string& path, const std::string& text) {

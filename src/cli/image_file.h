@@ -2,6 +2,7 @@
 // written atomically so a failed or interrupted write leaves nothing behind.
 #pragma once
 
+#include "bake/refraction_bake.h"
 #include "scene/optics.h"
 
 #include <glm/glm.hpp>
@@ -24,6 +25,16 @@ uint8_t linearToSrgb8(float linear);
 /// temporary file beside it, renamed into place once complete. Throws
 /// std::runtime_error naming the file and the problem; leaves no file then.
 void writeImage(const std::string& path, const LinearImage& image);
+
+/// Writes a refraction map file as `encoding` asks (rg16 and sky8: PNG,
+/// 16-bit and 8-bit RGBA; exr: float RGBA), complete or not at all. Throws
+/// std::runtime_error naming the file when its extension does not fit.
+void writeMapFile(const std::string& path, const bake::MapPixels& pixels, bake::Encoding encoding);
+/// Reads one back; the encoding follows from the file (8-bit PNG: sky8,
+/// 16-bit PNG: rg16, EXR: exr).
+bake::MapPixels readMapFile(const std::string& path, bake::Encoding& encoding);
+/// Writes RGBA bytes to a PNG as they are (no colour conversion).
+void writePngRgba8(const std::string& path, uint32_t width, uint32_t height, const std::vector<uint8_t>& rgba);
 
 /// Writes `text` to `path` the same way: complete, or not at all.
 void writeTextFile(const std::string& path, const std::string& text);

@@ -20,6 +20,8 @@ commands:
   info SCENE.glb        what a glTF file holds and the GPU memory a frame needs
   eye -o EYE.glb        write the procedural eye (see 'snell eye --help')
   render SCENE -o IMG   ray trace a frame (or frames) to PNG/EXR (see 'snell render --help')
+  bake SCENE -o MAP     bake a refraction map: the UV behind the glass per pixel (rg16, exr, sky8)
+  export-web SCENE -o DIR   a self-contained WebGL page drawing the glass from a sky8 map
   bench sort [options]  time the GPU radix sort (see 'snell bench sort --help')
   bench bvh [scenes]    GPU BVH quality (SAH cost) against a CPU binned-SAH build
   bench frame [options] per-pass GPU time of a frame of the eye
@@ -71,6 +73,8 @@ int main(int argc, char** argv) {
     if (args[0] == "bench") return runBench(rest);
     if (args[0] == "eye") return runEye(rest);
     if (args[0] == "render") return runRender(rest);
+    if (args[0] == "bake") return runBake(rest);
+    if (args[0] == "export-web") return runExportWeb(rest);
     throw UsageError{"unknown command '" + args[0] + "'"};
   } catch (const UsageError& e) {
     std::fprintf(stderr, "snell: %s\nRun 'snell help' for usage.\n", e.message.c_str());

@@ -3,6 +3,7 @@
 // --viewport the viewer's composite: rasterized, with the trace on glass.
 #include "cli/cli.h"
 
+#include "bake/refraction_bake.h"
 #include "cli/image_file.h"
 #include "ref/reference_tracer.h"
 #include "render/method.h"
@@ -63,10 +64,15 @@ options:
                          trace-1 (bends at the first interface only), masked
                          (the viewport: raster, glass pixels traced),
                          iris-plane and normal-offset (raster, no trace),
+                         refraction-map (raster, no trace: the texture
+                         behind the glass read where a map baked by the
+                         trace at --bake-time says, as the scene moves on),
                          none (glass seen straight through), driver-rt
                          (the trace's rays through the driver's own ray
                          tracing, where the GPU has it)
   --offset-strength S    normal-offset's displacement in image heights (0.02)
+  --bake-time T          refraction-map's pose: the seconds the map is baked at
+                         (default: the first frame's time)
   --viewport             write the viewport's composite instead of the trace
                          alone: every face rasterized and Phong-shaded, and
                          transmissive faces showing the traced image (what
@@ -80,18 +86,12 @@ options:
 )";
 
 struct Options {
-  std::string input;
-  bool eye = false;
+  ShotOptions shot;
   std::string output;
-  uint32_t width = 640, height = 480;
-  scene::ViewRequest view;
-  double time = 0.0;
   bool frames = false;
   long firstFrame = 0, lastFrame = 0;
   double fps = 24.0;
-  uint32_t maxInterfaces = gpu::kDefaultMaxInterfaces;
-  glm::vec3 background{0.02f, 0.02f, 0.025f};
-  scene::LoadOptions load;
+  std::optional<double> bakeTime;
   bool reference = false;
   bool viewport = false;
   std::optional<render::Method> method;
@@ -101,55 +101,23 @@ struct Options {
   std::string environment;
 };
 
-std::vector<double> parseNumbers(const std::string& option, const std::string& value, size_t count) {
-  std::vector<double> numbers;
-  std::stringstream in(value);
-  std::string part;
-  while (std::getline(in, part, ',')) {
-    char* end = nullptr;
-    double v = std::strtod(part.c_str(), &end);
-    if (part.empty() || *end != '\0' || !std::isfinite(v)) break;
-    numbers.push_back(v);
-  }
-  if (numbers.size() != count || std::count(value.begin(), value.end(), ',') != long(count - 1)) {
-    throw UsageError{option + " expects " + std::to_string(count) + " comma-separated numbers, got '" + value + "'"};
-  }
-  return numbers;
-}
-
 Options parse(const Args& args) {
   Options o;
   for (size_t i = 0; i < args.size(); ++i) {
     const std::string& a = args[i];
-    if (a == "--eye") { o.eye = true; continue; }
     if (a == "--reference") { o.reference = true; continue; }
     if (a == "--viewport") { o.viewport = true; continue; }
     if (a == "--no-refraction") { o.raster.refraction = false; continue; }
     if (a == "--wireframe") { o.raster.wireframe = true; continue; }
     if (a == "--stats") { o.stats = true; continue; }
     if (a == "--no-fresnel") { o.optics.fresnel = false; continue; }
-    if (!a.empty() && a[0] != '-') {
-      if (!o.input.empty()) throw UsageError{"render: more than one scene given ('" + o.input + "', '" + a + "')"};
-      o.input = a;
-      continue;
-    }
+    if (o.shot.take("render", args, i)) continue;
     if (i + 1 >= args.size()) throw UsageError{"render: " + a + " needs a value (or is unknown)"};
     const std::string& v = args[++i];
     if (a == "-o" || a == "--output") {
       o.output = v;
-    } else if (a == "--size") {
-      parseSize(a, v, o.width, o.height);
-    } else if (a == "--camera") {
-      o.view.camera = int(parseCount(a, v));
-    } else if (a == "--look-at") {
-      std::vector<double> n = parseNumbers(a, v, 6);
-      o.view.lookAt = scene::LookAt{{n[0], n[1], n[2]}, {n[3], n[4], n[5]}, {0.0, 1.0, 0.0}};
-    } else if (a == "--fov") {
-      double deg = parseNumbers(a, v, 1)[0];
-      if (!(deg > 0.0 && deg < 180.0)) throw UsageError{"--fov must be between 0 and 180 degrees, got " + v};
-      o.view.yfov = deg * 3.14159265358979 / 180.0;
-    } else if (a == "--time") {
-      o.time = parseNumbers(a, v, 1)[0];
+    } else if (a == "--bake-time") {
+      o.bakeTime = parseNumbers(a, v, 1)[0];
     } else if (a == "--frames") {
       size_t colon = v.find(':');
       if (colon == std::string::npos) throw UsageError{"--frames expects A:B, e.g. 1:48, got '" + v + "'"};
@@ -170,27 +138,15 @@ Options parse(const Args& args) {
         throw UsageError{"render: --offset-strength expects a number, got '" + v + "'"};
       }
       o.raster.offsetStrength = float(strength);
-    } else if (a == "--max-interfaces") {
-      o.maxInterfaces = uint32_t(std::min<unsigned long long>(parseCount(a, v), 1024));
-    } else if (a == "--background") {
-      std::vector<double> n = parseNumbers(a, v, 3);
-      o.background = glm::vec3(glm::dvec3(n[0], n[1], n[2]));
     } else if (a == "--environment") {
       o.environment = v;
     } else if (a == "--reflections") {
       o.optics.reflections = uint32_t(std::min<unsigned long long>(parseCount(a, v), 1024));
-    } else if (a == "--scene") {
-      o.load.scene = v;
-    } else if (a == "--ignore-extension") {
-      o.load.ignoredExtensions.push_back(v);
-    } else if (a == "--texture-budget") {
-      o.load.textureBudget = parseTextureBudget(a, v);
     } else {
       throw UsageError{"render: unknown option " + a};
     }
   }
-  if (o.input.empty() && !o.eye) throw UsageError{"render: give a scene file (or --eye)"};
-  if (!o.input.empty() && o.eye) throw UsageError{"render: give a scene file or --eye, not both"};
+  o.shot.require("render");
   if (o.stats && o.reference) throw UsageError{"render: --stats counts GPU work; the reference (--reference) has none"};
   if (o.output.empty()) throw UsageError{"render: give the output image with -o FILE.png or FILE.exr"};
   if (o.viewport && o.reference) {
@@ -277,15 +233,16 @@ int runRender(const Args& args) {
   }
   Options o = parse(args);
   if (!o.environment.empty()) o.optics.environment = std::make_shared<scene::Environment>(readEnvironment(o.environment));
-  scene::Scene scene = o.eye ? scene::makeEye() : scene::loadGltf(o.input, o.load);
-  if (o.eye) scene.source = "procedural eye";
-  for (const std::string& w : scene.warnings) std::fprintf(stderr, "snell: note: %s\n", w.c_str());
+  scene::Scene scene = o.shot.loadScene();
 
+  if (o.bakeTime && *o.method != render::Method::RefractionMap) {
+    throw UsageError{"render: --bake-time is for --method refraction-map"};
+  }
   std::vector<std::pair<long, double>> frames;  // (frame number, time)
   if (o.frames) {
     for (long f = o.firstFrame; f <= o.lastFrame; ++f) frames.emplace_back(f, double(f) / o.fps);
   } else {
-    frames.emplace_back(0, o.time);
+    frames.emplace_back(0, o.shot.time);
   }
 
   scene::Pose layout = scene::evaluate(scene, frames.front().second);
@@ -300,11 +257,31 @@ int runRender(const Args& args) {
                                " offers no ray tracing pipelines (VK_KHR_ray_tracing_pipeline)");
     }
     try {
-      render::checkImageSize(*context, o.width, o.height);
+      render::checkImageSize(*context, o.shot.width, o.shot.height);
     } catch (const std::invalid_argument& e) {
       throw UsageError{std::string("render: ") + e.what()};
     }
     renderer = std::make_unique<render::Renderer>(*context, scene, layout);
+  }
+
+  // refraction-map: the trace bakes the map once, at --bake-time (default:
+  // the first frame's), and every frame reads it as the scene moves on.
+  render::RefractionMapBuffer map;
+  if (renderer && *o.method == render::Method::RefractionMap) {
+    double t = o.bakeTime.value_or(frames.front().second);
+    scene::Pose bakePose = scene::evaluate(scene, t);
+    scene::View bakeView;
+    try {
+      bakeView = scene::resolveView(scene, bakePose, o.shot.view);
+    } catch (const std::invalid_argument& e) {
+      throw UsageError{std::string("render: ") + e.what()};
+    }
+    render::FrameSettings settings{o.shot.width, o.shot.height, bakeView, o.shot.background, o.shot.maxInterfaces};
+    settings.optics = o.optics;
+    bake::RefractionBake baked = bake::bakeRefraction(*context, *renderer, bakePose, settings);
+    map = bake::uploadRefractionMap(*context, baked);
+    o.raster.refractionMap = &map;
+    std::printf("baked the refraction map at %g s: %s\n", t, bake::describe(baked, scene).c_str());
   }
 
   auto start = std::chrono::steady_clock::now();
@@ -312,24 +289,24 @@ int runRender(const Args& args) {
     scene::Pose pose = i == 0 ? layout : scene::evaluate(scene, frames[i].second);
     scene::View view;
     try {
-      view = scene::resolveView(scene, pose, o.view);
+      view = scene::resolveView(scene, pose, o.shot.view);
     } catch (const std::invalid_argument& e) {
       throw UsageError{std::string("render: ") + e.what()};
     }
-    LinearImage image{o.width, o.height, {}};
+    LinearImage image{o.shot.width, o.shot.height, {}};
     if (o.reference) {
       ref::ReferenceSettings settings;
-      settings.width = o.width;
-      settings.height = o.height;
+      settings.width = o.shot.width;
+      settings.height = o.shot.height;
       settings.view = view;
-      settings.background = glm::dvec3(o.background);
-      settings.maxInterfaces = o.maxInterfaces;
+      settings.background = glm::dvec3(o.shot.background);
+      settings.maxInterfaces = o.shot.maxInterfaces;
       settings.optics = o.optics;
       ref::ReferenceImage r = ref::renderReference(scene, pose, settings);
       image.rgba.reserve(r.color.size());
       for (const glm::dvec3& c : r.color) image.rgba.emplace_back(glm::vec3(c), 1.0f);
     } else {
-      render::FrameSettings settings{o.width, o.height, view, o.background, o.maxInterfaces};
+      render::FrameSettings settings{o.shot.width, o.shot.height, view, o.shot.background, o.shot.maxInterfaces};
       settings.optics = o.optics;
       render::RasterOptions raster = o.raster;
       glm::dvec3 lo, hi;
@@ -351,7 +328,7 @@ int runRender(const Args& args) {
     if (frames.size() > 1) {
       progress(long(i + 1), long(frames.size()), seconds);
     } else {
-      std::printf("wrote %s: %ux%u, %s, %s, %.2f s\n", path.c_str(), o.width, o.height, view.description.c_str(),
+      std::printf("wrote %s: %ux%u, %s, %s, %.2f s\n", path.c_str(), o.shot.width, o.shot.height, view.description.c_str(),
                   o.reference ? "CPU reference" : context->facts().name.c_str(), seconds);
       if (!o.reference) {
         for (const render::MethodInfo& m : render::methods()) {

@@ -51,12 +51,15 @@ static_assert(sizeof(GpuMaterial) == 224 && offsetof(GpuMaterial, transmission) 
 static_assert(sizeof(GpuTexture) == 16 && offsetof(GpuTexture, flags) == 12);
 static_assert(sizeof(TextureMipPush) == 32 && offsetof(TextureMipPush, srgb) == 24);
 static_assert(sizeof(GpuLight) == 64 && offsetof(GpuLight, cone) == 48);
-static_assert(sizeof(TraceAov) == 32 && offsetof(TraceAov, nodeVisits) == 20 && offsetof(TraceAov, landingV) == 28);
+static_assert(sizeof(TraceAov) == 64 && offsetof(TraceAov, nodeVisits) == 20 && offsetof(TraceAov, landingV) == 28 &&
+              offsetof(TraceAov, landingMaterial) == 32 && offsetof(TraceAov, shineR) == 40 && offsetof(TraceAov, weightB) == 60);
 static_assert(sizeof(GpuRay) == 32 && offsetof(GpuRay, direction) == 16);
 static_assert(sizeof(TracePixelListHeader) == 32 && offsetof(TracePixelListHeader, dispatchX) == kTracePixelListDispatchOffset);
 static_assert(sizeof(TraceCompactPush) == 16 && offsetof(TraceCompactPush, pixelsPerGroup) == 12);
 static_assert(sizeof(PresentPush) == 48 && offsetof(PresentPush, gate) == 16 && offsetof(PresentPush, flags) == 32);
 static_assert(sizeof(RasterPush) == 112 && offsetof(RasterPush, offsetStrength) == 96 && offsetof(RasterPush, flags) == 80 && offsetof(RasterPush, lightCount) == 84);
+static_assert(sizeof(RasterPush) == 112 && offsetof(RasterPush, mapWidth) == 100);
+static_assert(sizeof(RefractionTexel) == 48 && offsetof(RefractionTexel, weight) == 16 && offsetof(RefractionTexel, material) == 40);
 static_assert(sizeof(TracePush) == 128 && offsetof(TracePush, eye) == 64 && offsetof(TracePush, width) == 80 &&
               offsetof(TracePush, tilesX) == 100 && offsetof(TracePush, pixelsPerGroup) == 112 &&
               offsetof(TracePush, optics) == 120);

@@ -9,6 +9,7 @@ const std::vector<MethodInfo>& methods() {
       {Method::Masked, "masked", "viewport: raster, glass pixels traced"},
       {Method::IrisPlane, "iris-plane", "viewport: refracted once onto the plane behind the glass, no trace"},
       {Method::NormalOffset, "normal-offset", "viewport: picture behind the glass offset by the normal, no trace"},
+      {Method::RefractionMap, "refraction-map", "viewport: a refraction map baked at another pose, no trace"},
       {Method::None, "none", "viewport: glass seen straight through"},
       {Method::DriverRt, "driver-rt", "traced like trace, hits from the driver's ray tracing pipeline (the peer)"},
   };
@@ -56,6 +57,10 @@ ViewRequest methodView(Method method, const FrameSettings& settings, const Raste
     case Method::NormalOffset:
       view.output = ViewOutput::Composite;
       view.raster.screenSpace = ScreenSpace::NormalOffset;
+      break;
+    case Method::RefractionMap:
+      view.output = ViewOutput::Composite;
+      view.raster.screenSpace = ScreenSpace::RefractionMap;
       break;
     case Method::None:
       view.output = ViewOutput::Composite;

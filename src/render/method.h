@@ -20,6 +20,7 @@ enum class Method {
   Masked,        ///< the viewport: raster, and the trace of the glass pixels alone
   IrisPlane,     ///< raster: refracted once, met with the plane behind the glass (game engines' eyes)
   NormalOffset,  ///< raster: the picture behind the glass displaced by the normal (GPU Gems 2, ch. 19)
+  RefractionMap, ///< raster: a refraction map baked by the trace at another pose, the texture behind read where it says (Sky)
   None,          ///< raster, glass seen straight through
   DriverRt,      ///< traced like `trace`, the hits found by the driver's own ray tracing (the peer)
 };
@@ -44,7 +45,8 @@ inline bool needsDriverRayTracing(Method method) { return method == Method::Driv
 bool drawsComposite(Method method);
 
 /// The view that draws `settings` with `method`. `raster` carries the
-/// composite's depth range and options (fitDepthRange); the method sets the rest.
+/// composite's depth range and options (fitDepthRange) and, for
+/// refraction-map, the baked map; the method sets the rest.
 ViewRequest methodView(Method method, const FrameSettings& settings, const RasterOptions& raster);
 
 /// The same, always as the viewport composite (the viewer's): `trace` traces

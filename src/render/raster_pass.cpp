@@ -36,7 +36,10 @@ void fitDepthRange(const scene::View& view, const glm::dvec3& lo, const glm::dve
   }
 }
 
-RasterPass::RasterPass(vk::Context& context) : context_(context) {
+RasterPass::RasterPass(vk::Context& context)
+    : context_(context),
+      noMap_(context, {sizeof(gpu::RefractionTexel), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, vk::MemoryDomain::Device,
+                       "no refraction map"}) {
   vk::GraphicsProgramDesc desc;
   desc.name = "raster";
   desc.vertexSpirv = kSpvRasterVertex;
@@ -85,6 +88,14 @@ gpu::RasterPush RasterPass::push(const RasterScene& scene, const FrameSettings& 
   push.shiftY = float(v.shift.y);
   if (options.refraction && options.screenSpace == ScreenSpace::NormalOffset) push.flags |= gpu::kRasterFlagNormalOffset;
   if (options.refraction && options.screenSpace == ScreenSpace::IrisPlane) push.flags |= gpu::kRasterFlagIrisPlane;
+  if (options.refraction && options.screenSpace == ScreenSpace::RefractionMap) {
+    if (!options.refractionMap || options.refractionMap->width == 0 || options.refractionMap->height == 0) {
+      throw vk::VulkanError("raster pass: the refraction-map method needs a baked map (RasterOptions::refractionMap)");
+    }
+    push.flags |= gpu::kRasterFlagRefractionMap;
+    push.mapWidth = options.refractionMap->width;
+    push.mapHeight = options.refractionMap->height;
+  }
   push.offsetStrength = options.offsetStrength;
   return push;
 }
@@ -157,8 +168,12 @@ void RasterPass::recordShadingPass(vk::Commands& commands, const RasterScene& sc
   float clear[4] = {settings.background.r, settings.background.g, settings.background.b, 1.0f};
   {
     vk::RenderingScope scope(commands, target, &depth, area, clear, false);
+    const vk::Buffer& map = options.refractionMap && options.screenSpace == ScreenSpace::RefractionMap
+                                ? options.refractionMap->texels
+                                : noMap_;
     std::vector<vk::BufferBinding> resources = {{gpu::kRasterBindingTraceImage, nullptr, &traceImage},
-                                                {gpu::kRasterBindingBehindDepth, nullptr, &behindDepth}};
+                                                {gpu::kRasterBindingBehindDepth, nullptr, &behindDepth},
+                                                {gpu::kRasterBindingRefractionMap, &map, nullptr}};
     scene.scene->appendBindings(resources, *scene.instances, *scene.lights);
     gpu::RasterPush p = push(scene, settings, options);
     drawItems(commands, *fill_, scene, options, p, resources, area);

@@ -33,6 +33,14 @@ enum class ScreenSpace {
   Off,           ///< the trace image at the fragment's own pixel
   NormalOffset,  ///< the picture behind the glass, displaced by the shading normal (GPU Gems 2, ch. 19)
   IrisPlane,     ///< the picture behind the glass where the refracted ray meets the plane through it
+  RefractionMap, ///< a baked refraction map (RasterOptions::refractionMap), the texture behind read where it says
+};
+
+/// A baked refraction map on the GPU, as the raster pass reads it: one
+/// gpu::RefractionTexel per baked pixel, row 0 at the top (bake/refraction_bake.h makes it).
+struct RefractionMapBuffer {
+  vk::Buffer texels;
+  uint32_t width = 0, height = 0;
 };
 
 struct RasterOptions {
@@ -41,6 +49,10 @@ struct RasterOptions {
   bool refraction = true;
   /// With refraction: a screen-space approximation instead of the trace.
   ScreenSpace screenSpace = ScreenSpace::Off;
+  /// RefractionMap's map, owned by the caller while frames that read it are in
+  /// flight. A map baked again into the same object is new content the
+  /// renderer cannot see: call Renderer::invalidateViews() after.
+  const RefractionMapBuffer* refractionMap = nullptr;
   /// NormalOffset's displacement per unit of normal, in image heights.
   float offsetStrength = 0.02f;
   /// Draws every triangle's edges over the shaded image.
@@ -107,6 +119,7 @@ class RasterPass {
 
   vk::Context& context_;
   std::unique_ptr<vk::GraphicsProgram> depth_, mask_, fill_, wire_;
+  vk::Buffer noMap_;  ///< bound as the refraction map when a view has none
 };
 
 }  // namespace snell::render

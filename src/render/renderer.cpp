@@ -42,6 +42,7 @@ bool sameRequest(const ViewRequest& a, const ViewRequest& b) {
          s.maxInterfaces == t.maxInterfaces && s.rays.empty() && t.rays.empty() && a.output == b.output &&
          s.maxBends == t.maxBends && a.driverTrace == b.driverTrace && a.masked == b.masked && a.aov == b.aov && r.refraction == q.refraction &&
          r.screenSpace == q.screenSpace && r.offsetStrength == q.offsetStrength && r.wireframe == q.wireframe &&
+         r.refractionMap == q.refractionMap &&
          r.wireColor == q.wireColor && r.nearPlane == q.nearPlane && r.farPlane == q.farPlane &&
          s.optics.fresnel == t.optics.fresnel && s.optics.reflections == t.optics.reflections &&
          s.optics.environment == t.optics.environment && s.optics.textureLod == t.optics.textureLod;
@@ -122,7 +123,6 @@ Renderer::Renderer(vk::Context& context, const scene::Scene& scene, const scene:
                                     name + " instances"});
   lights_ = vk::Buffer(context, {std::max<size_t>(lightNodes, 1) * sizeof(gpu::GpuLight), kStorage,
                                  vk::MemoryDomain::Device, name + " lights"});
-  static_assert(sizeof(gpu::TraceAov) == sizeof(gpu::GpuRay));
   placeholder_ = vk::Buffer(context, {sizeof(gpu::TracePixelListHeader), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
                                       vk::MemoryDomain::Device, "placeholder"});
   for (char r : scene_.itemRefractive) refractive_ = refractive_ || r;
@@ -618,7 +618,7 @@ void Renderer::recordView(vk::Commands& commands, Slot& slot, size_t index, cons
       bool traces = glass && request.raster.screenSpace == ScreenSpace::Off;
       bool masked = traces && request.masked;
       // A screen-space method draws what lies behind the glass first, into the trace image.
-      if (glass && !traces) {
+      if (glass && !traces && request.raster.screenSpace != ScreenSpace::RefractionMap) {
         raster_->recordBehind(commands, scene, settings, request.raster, view.images.depth, view.images.mask,
                               view.images.trace);
       }

@@ -5,6 +5,7 @@
 #include "scene/gltf_loader.h"
 
 #include <tiny_gltf.h>
+#include <stb/stb_image_write.h>
 
 #include <glm/gtc/type_ptr.hpp>
 
@@ -15,6 +16,8 @@
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
+#include <stdexcept>
+#include <string>
 
 namespace snell::scene {
 
@@ -103,20 +106,36 @@ tinygltf::Value numbers(std::initializer_list<double> values) {
 }  // namespace
 
 std::vector<uint8_t> encodePng(uint32_t width, uint32_t height, const std::vector<uint8_t>& rgba) {
-  std::vector<uint8_t> raw;  // filter byte 0, then the row
-  raw.reserve(size_t(height) * (size_t(width) * 4 + 1));
+  if (rgba.size() != size_t(width) * height * 4) throw std::invalid_argument("encodePng: pixels do not fill the image");
+  // stb picks a filter per row and deflates: a frame is a tenth of its bytes stored.
+  std::vector<uint8_t> png;
+  auto append = [](void* context, void* data, int size) {
+    auto* out = static_cast<std::vector<uint8_t>*>(context);
+    out->insert(out->end(), static_cast<uint8_t*>(data), static_cast<uint8_t*>(data) + size);
+  };
+  if (!stbi_write_png_to_func(append, &png, int(width), int(height), 4, rgba.data(), int(width * 4))) {
+    throw std::runtime_error("encodePng: stb could not encode a " + std::to_string(width) + "x" + std::to_string(height) + " image");
+  }
+  return png;
+}
+
+std::vector<uint8_t> encodePng16(uint32_t width, uint32_t height, const std::vector<uint16_t>& rgba) {
+  if (rgba.size() != size_t(width) * height * 4) throw std::invalid_argument("encodePng16: pixels do not fill the image");
+  std::vector<uint8_t> raw;  // filter byte 0, then the row, big-endian samples
+  raw.reserve(size_t(height) * (size_t(width) * 8 + 1));
   for (uint32_t y = 0; y < height; ++y) {
     raw.push_back(0);
-    raw.insert(raw.end(), rgba.begin() + std::ptrdiff_t(size_t(y) * width * 4), rgba.begin() + std::ptrdiff_t(size_t(y + 1) * width * 4));
+    for (size_t i = size_t(y) * width * 4; i < size_t(y + 1) * width * 4; ++i) {
+      raw.push_back(uint8_t(rgba[i] >> 8));
+      raw.push_back(uint8_t(rgba[i]));
+    }
   }
   std::vector<uint8_t> zlib = {0x78, 0x01};
-  for (size_t at = 0; at < raw.size() || at == 0; at += 65535) {
+  for (size_t at = 0; at < raw.size(); at += 65535) {
     size_t n = std::min<size_t>(65535, raw.size() - at);
-    bool last = at + n >= raw.size();
-    zlib.push_back(last ? 1 : 0);  // stored block
+    zlib.push_back(at + n >= raw.size() ? 1 : 0);  // stored block
     zlib.insert(zlib.end(), {uint8_t(n), uint8_t(n >> 8), uint8_t(~n), uint8_t((~n) >> 8)});
     zlib.insert(zlib.end(), raw.begin() + std::ptrdiff_t(at), raw.begin() + std::ptrdiff_t(at + n));
-    if (last) break;
   }
   uint32_t a = 1, b = 0;
   for (uint8_t c : raw) a = (a + c) % 65521, b = (b + a) % 65521;
@@ -125,7 +144,7 @@ std::vector<uint8_t> encodePng(uint32_t width, uint32_t height, const std::vecto
   std::vector<uint8_t> header;
   putBigEndian(header, width);
   putBigEndian(header, height);
-  header.insert(header.end(), {8, 6, 0, 0, 0});  // 8-bit RGBA, no interlace
+  header.insert(header.end(), {16, 6, 0, 0, 0});  // 16-bit RGBA, no interlace
   chunk(png, "IHDR", header);
   chunk(png, "IDAT", zlib);
   chunk(png, "IEND", {});

@@ -101,6 +101,13 @@ struct Path {
   float firstDistance;
   uint firstInstance, firstPrimitive;
   vec2 landing;  // TraceAov::landingU, landingV
+  // Where it crossed glass and ended on an opaque face: that face's material,
+  // its base colour texture's value and level of detail, and what the value
+  // is multiplied by (TraceAov's weight).
+  uint landingMaterial;
+  vec3 landingTexel;
+  float landingLod;
+  vec3 landingWeight;
 };
 
 // A ray leaving the surface of `hit` at `s` along dir: its offset origin and
@@ -125,7 +132,8 @@ vec3 leave(Surface s, vec3 dir, out float tMin) {
 // The ray's cone (trace.h: Textures) starts `width` wide at the origin and
 // opens by `spread` radians.
 bool tracePath(vec3 origin, vec3 dir, float width, float spread, int channel, out Path path) {
-  path = Path(vec3(0.0), 0u, kOutcomeMiss, -1.0, kNoHit, kNoHit, vec2(uintBitsToFloat(0x7fc00000u)));
+  path = Path(vec3(0.0), 0u, kOutcomeMiss, -1.0, kNoHit, kNoHit, vec2(uintBitsToFloat(0x7fc00000u)), kNoHit, vec3(0.0),
+              0.0, vec3(0.0));
   bool fresnel = (pc.optics & kOpticsFresnel) != 0u;
   uint reflections = fresnel ? pc.reflections : 0u;
   vec3 throughput = vec3(1.0);
@@ -181,8 +189,17 @@ bool tracePath(vec3 origin, vec3 dir, float width, float spread, int channel, ou
       path.firstPrimitive = hit.primitive - firstTriangleOf(hit.instance);
     }
     if (opaque) {
-      if (path.interfaces > 0u && m.base.texture != kNoTexture) path.landing = textureUv(m.base, s.uvs);
-      path.colour += throughput * phong(s.position, s.ns, s.uvs, s.lods, m, dir, pc.lightCount, pc.forward.xyz);
+      vec3 weight;
+      vec3 shine = phongParts(s.position, s.ns, s.uvs, s.lods, m, dir, pc.lightCount, pc.forward.xyz, weight);
+      vec3 texel = textured(m.base, s.uvs, s.lods, true);
+      if (path.interfaces > 0u) {
+        if (m.base.texture != kNoTexture) path.landing = textureUv(m.base, s.uvs);
+        path.landingMaterial = s.material;
+        path.landingTexel = texel;
+        path.landingLod = (m.base.texCoord == 1u ? s.lods.y : s.lods.x) + m.base.lodOffset;
+        path.landingWeight = throughput * weight;
+      }
+      path.colour += throughput * (shine + weight * texel);
       path.outcome = kOutcomeOpaque;
       return false;
     }
@@ -306,8 +323,13 @@ void tracePixel(uvec2 pixel) {
 
   imageStore(outImage, ivec2(pixel), vec4(path.colour, 1.0));
   if ((pc.flags & kTraceFlagAov) != 0u) {
+    // The colour less its landing's textured part is the shine (every channel's path, so dispersion too).
+    vec3 shine = path.interfaces > 0u ? path.colour - path.landingWeight * path.landingTexel : vec3(0.0);
+    vec3 weight = path.interfaces > 0u ? path.landingWeight : vec3(0.0);
     aovs[pixel.y * pc.width + pixel.x] = TraceAov(path.firstDistance, path.firstInstance, path.firstPrimitive,
-                                                  path.interfaces, path.outcome, visits, path.landing.x, path.landing.y);
+                                                  path.interfaces, path.outcome, visits, path.landing.x, path.landing.y,
+                                                  path.landingMaterial, path.landingLod, shine.r, shine.g, shine.b,
+                                                  weight.r, weight.g, weight.b);
   }
 }
 
