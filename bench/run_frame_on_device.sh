@@ -9,6 +9,7 @@
 #   bench/run_frame_on_device.sh methods # bench methods at 1920x1080, its chart
 #   bench/run_frame_on_device.sh optics  # each optics feature's cost (1920x1080) and error (320x240), stress grid's optics group
 #   bench/run_frame_on_device.sh textures # load times of the textured sample models (three runs each)
+#   bench/run_frame_on_device.sh maps    # refraction-map beside the trace and the raster methods (1920x1080), drift table
 # Results land in $OUT.
 set -uo pipefail
 for f in .gl/*.deb; do dpkg -x "$f" /; done
@@ -24,7 +25,7 @@ step=${1:-all}
 if [[ $step == all || $step == tests ]]; then
   echo "== tests on the GPU, validation on (not the ones that run the CLI, the viewer or node)"
   SNELL_VALIDATION=1 .carry/snell_tests --gtest_brief=1 \
-    --gtest_filter='-SceneInfoCommand.*:RenderCommand.*:BenchMethods.*:Viewer.*:ProceduralEye.PassesTheKhronos*' > "$OUT/tests.log" 2>&1
+    --gtest_filter='-SceneInfoCommand.*:RenderCommand.*:BenchMethods.*:BakeCommand.*:ExportWebCommand.*:Viewer.*:ProceduralEye.PassesTheKhronos*' > "$OUT/tests.log" 2>&1
   echo "tests exit $?"; grep -E "FAILED|PASSED|tests ran" "$OUT/tests.log" | tail -12
 fi
 if [[ $step == all || $step == bench ]]; then
@@ -45,6 +46,11 @@ if [[ $step == all || $step == bench ]]; then
     $s bench bvh --eye-resolution 256 "${assets[@]}" --json "$json/bvh.json"
   } 2>&1 | tee "$OUT/bench.log"
   tar -C "$json" -cf "$OUT/results.tar" .
+fi
+if [[ $step == all || $step == maps ]]; then
+  .carry/snell bench methods --size 1920x1080 --frames 24 --methods trace,masked,iris-plane,normal-offset,refraction-map,none \
+    --json "$OUT/maps.json" --svg "$OUT/maps.svg" 2>&1 | tee "$OUT/maps.log"
+  .carry/snell bench frame --json "$OUT/frame.json" 2>&1 | tee -a "$OUT/maps.log"
 fi
 if [[ $step == all || $step == methods ]]; then
   s=.carry/snell
