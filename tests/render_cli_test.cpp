@@ -30,6 +30,12 @@ TEST(RenderCommand, StatsReportTheFirstFramesBuildAndTracedPixels) {
   EXPECT_NE(run.output.find("GPU ms:"), std::string::npos) << run.output;
 }
 
+TEST(SnellCommand, VersionPrintsTheVersionAndExitsZero) {
+  CommandRun run = snell("--version");
+  EXPECT_EQ(run.exitCode, 0) << run.output;
+  EXPECT_TRUE(std::regex_search(run.output, std::regex("^snell [0-9]+\\.[0-9]+\\.[0-9]+\n$"))) << run.output;
+}
+
 TEST(RenderCommand, StatsWithTheCpuReferenceIsAUsageError) {
   CommandRun run = snell("render --eye --reference --stats -o /tmp/never_written.png");
   EXPECT_EQ(run.exitCode, 2) << run.output;

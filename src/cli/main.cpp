@@ -29,6 +29,7 @@ commands:
   bench scale [options] BVH build and refit times from 1e4 to 1e7 triangles
   bench methods [SCENE] run time against error of each way of drawing refraction
   help                  show this text
+  --version             print snell's version
 
 environment:
   SNELL_DEVICE=<index|name>  use this device (an index from 'snell info --devices',
@@ -67,6 +68,10 @@ int main(int argc, char** argv) {
     if (args.empty() || args[0] == "help" || args[0] == "--help" || args[0] == "-h") {
       std::fputs(kUsage, args.empty() ? stderr : stdout);
       return args.empty() ? 2 : 0;
+    }
+    if (args[0] == "--version" || args[0] == "version") {
+      std::printf("snell %s\n", SNELL_VERSION);
+      return 0;
     }
     Args rest(args.begin() + 1, args.end());
     if (args[0] == "info") return runInfo(rest);
