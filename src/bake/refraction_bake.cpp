@@ -188,7 +188,7 @@ DecodedMap decodeMap(const MapPixels& pixels, Encoding encoding) {
   if (have != 4 * n) throw std::invalid_argument("decodeMap: the pixels do not fill the map");
   out.coverage.resize(n, Coverage::Empty);
   out.uv.resize(n, glm::dvec2(std::numeric_limits<double>::quiet_NaN()));
-  // Alpha's thirds: above 3/4 lands, above 1/4 marked.
+  // Alpha 1, 1/2 or 0, read with margin: above 3/4 lands, above 1/4 marked.
   auto coverageOf = [](double alpha) {
     return alpha > 0.75 ? Coverage::Lands : alpha > 0.25 ? Coverage::Marked : Coverage::Empty;
   };
