@@ -26,6 +26,8 @@ struct FrameSettings {
   std::vector<scene::Ray> rays;
   /// Fresnel, reflected rays, highlights and the environment they see.
   scene::Optics optics;
+  /// The composite's alpha where nothing is drawn (0: a host composites the image over its own).
+  float backgroundAlpha = 1.0f;
 };
 
 }  // namespace snell::render

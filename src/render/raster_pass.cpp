@@ -165,7 +165,7 @@ void RasterPass::recordShadingPass(vk::Commands& commands, const RasterScene& sc
                    VK_PIPELINE_STAGE_EARLY_FRAGMENT_TESTS_BIT, VK_ACCESS_DEPTH_STENCIL_ATTACHMENT_READ_BIT);
   commands.beginPass(passName);
   VkRect2D area{{0, 0}, {settings.width, settings.height}};
-  float clear[4] = {settings.background.r, settings.background.g, settings.background.b, 1.0f};
+  float clear[4] = {settings.background.r, settings.background.g, settings.background.b, settings.backgroundAlpha};
   {
     vk::RenderingScope scope(commands, target, &depth, area, clear, false);
     const vk::Buffer& map = options.refractionMap && options.screenSpace == ScreenSpace::RefractionMap

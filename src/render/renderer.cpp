@@ -39,7 +39,7 @@ bool sameRequest(const ViewRequest& a, const ViewRequest& b) {
   const FrameSettings &s = a.settings, &t = b.settings;
   const RasterOptions &r = a.raster, &q = b.raster;
   return s.width == t.width && s.height == t.height && sameView(s.view, t.view) && s.background == t.background &&
-         s.maxInterfaces == t.maxInterfaces && s.rays.empty() && t.rays.empty() && a.output == b.output &&
+         s.backgroundAlpha == t.backgroundAlpha && s.maxInterfaces == t.maxInterfaces && s.rays.empty() && t.rays.empty() && a.output == b.output &&
          s.maxBends == t.maxBends && a.driverTrace == b.driverTrace && a.masked == b.masked && a.aov == b.aov && r.refraction == q.refraction &&
          r.screenSpace == q.screenSpace && r.offsetStrength == q.offsetStrength && r.wireframe == q.wireframe &&
          r.refractionMap == q.refractionMap &&
@@ -106,7 +106,8 @@ struct Renderer::Update {
 };
 
 Renderer::Renderer(vk::Context& context, const scene::Scene& scene, const scene::Pose& layout, RendererOptions options)
-    : context_(context), sceneModel_(scene), options_(options), scene_(uploadScene(context, scene, layout)) {
+    : context_(context), sceneModel_(scene), options_(options),
+      scene_(uploadScene(context, scene, layout, options.host.positions ? &options.host : nullptr)) {
   if (options_.framesInFlight == 0) throw std::invalid_argument("renderer: framesInFlight must be at least 1");
   deform_ = std::make_unique<DeformPass>(context, scene, layout, [&](int item) {
     for (const GeometryRange& g : scene_.geometries) {
@@ -143,8 +144,10 @@ Renderer::Renderer(vk::Context& context, const scene::Scene& scene, const scene:
       lo = glm::min(lo, glm::dvec3(p));
       hi = glm::max(hi, glm::dvec3(p));
     }
+    if (shape.host) lo = glm::dvec3(shape.host->lo), hi = glm::dvec3(shape.host->hi);
     Sphere sphere;
-    if (!shape.positions.empty()) sphere = {0.5 * (lo + hi), 0.5 * glm::length(hi - lo)};
+    if (lo.x <= hi.x && lo.y <= hi.y && lo.z <= hi.z) sphere = {0.5 * (lo + hi), 0.5 * glm::length(hi - lo)};
+    if (shape.host && !(lo.x <= hi.x)) sphere.radius = INFINITY;  // no promise: never culled
     std::vector<double> reach;
     for (const scene::MorphTarget& target : shape.targets) {
       double most = 0.0;
@@ -169,6 +172,16 @@ const ViewImages& Renderer::viewImages(size_t index) const { return views_.at(in
 
 void Renderer::invalidateViews() {
   for (View& v : views_) v.rendered = false;
+}
+
+void Renderer::markDirty(int shape) {
+  if (shape < 0 || size_t(shape) >= sceneModel_.shapes.size()) {
+    throw std::invalid_argument("renderer: no shape " + std::to_string(shape) + " to mark dirty");
+  }
+  for (size_t g = 0; g < scene_.geometries.size(); ++g) {
+    if (scene_.geometries[g].shape == shape) geometryDirty_[g] = driverMoved_[g] = 1;
+  }
+  ++sceneVersion_;
 }
 
 void Renderer::invalidateTrees() {

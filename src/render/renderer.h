@@ -114,6 +114,8 @@ struct RendererOptions {
   double rebuildGrowth = 1.5;
   /// Triangles rebuilt per frame at most (refitted meanwhile), so rebuilds spread over frames.
   uint64_t rebuildBudget = 1u << 20;
+  /// A host scene's vertex buffers (every shape a host shape); null handles: none.
+  HostBuffers host;
 };
 
 /// The images of one view; they keep the last frame's result until the next frame that renders the view.
@@ -147,6 +149,10 @@ class Renderer {
   /// The images of view `index` (valid once a frame rendered it; a view's
   /// images are rewritten by later frames that render it).
   const ViewImages& viewImages(size_t index) const;
+
+  /// The host rewrote shape `shape`'s vertices in its buffers (RendererOptions::host):
+  /// the next frame refits its tree and redraws every view.
+  void markDirty(int shape);
 
   /// Forces the next frame that needs trees to rebuild every tree.
   void invalidateTrees();

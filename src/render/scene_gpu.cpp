@@ -186,7 +186,33 @@ gpu::GpuMaterial packMaterial(const scene::Material& m, const scene::Scene& scen
 
 }  // namespace
 
-SceneGpu uploadScene(vk::Context& context, const scene::Scene& scene, const scene::Pose& layout) {
+// A host scene's checks: every shape on the host, inside the buffers, with no
+// deformation of snell's (the host deforms its own vertices).
+static void checkHostShapes(const scene::Scene& scene, const HostBuffers& host) {
+  if (!host.positions || !host.normals) throw std::invalid_argument(scene.source + ": the host's vertex buffers are null");
+  for (const scene::Shape& shape : scene.shapes) {
+    if (!shape.host) throw std::invalid_argument(scene.source + ": shape '" + shape.name + "' has no host vertices");
+    if (uint64_t(shape.host->first) + shape.host->count > host.vertexCapacity) {
+      throw std::invalid_argument(scene.source + ": shape '" + shape.name + "' uses vertices " +
+                                  std::to_string(shape.host->first) + " to " +
+                                  std::to_string(uint64_t(shape.host->first) + shape.host->count) +
+                                  ", past the host buffers' " + std::to_string(host.vertexCapacity));
+    }
+    for (uint32_t index : shape.indices) {
+      if (index >= shape.host->count) {
+        throw std::invalid_argument(scene.source + ": shape '" + shape.name + "' has index " + std::to_string(index) +
+                                    " for " + std::to_string(shape.host->count) + " vertices");
+      }
+    }
+    if (shape.morphed() || shape.skinned()) {
+      throw std::invalid_argument(scene.source + ": host shape '" + shape.name + "' has morph targets or a skin; the host deforms its own vertices");
+    }
+  }
+}
+
+SceneGpu uploadScene(vk::Context& context, const scene::Scene& scene, const scene::Pose& layout,
+                     const HostBuffers* host) {
+  if (host) checkHostShapes(scene, *host);
   SceneGpu gpu;
   std::vector<int> shapeGeometry(scene.shapes.size(), -1);
   uint64_t vertices = 0, triangles = 0;
@@ -199,7 +225,7 @@ SceneGpu uploadScene(vk::Context& context, const scene::Scene& scene, const scen
       GeometryRange range;
       range.shape = item.shape;
       range.item = item.deforms() ? static_cast<int>(i) : -1;
-      range.firstVertex = static_cast<uint32_t>(vertices);
+      range.firstVertex = host ? shape.host->first : static_cast<uint32_t>(vertices);
       range.vertexCount = static_cast<uint32_t>(shape.vertexCount());
       range.firstTriangle = static_cast<uint32_t>(triangles);
       range.triangleCount = static_cast<uint32_t>(shape.triangleCount());
@@ -217,6 +243,7 @@ SceneGpu uploadScene(vk::Context& context, const scene::Scene& scene, const scen
                                            : static_cast<uint32_t>(scene.materials.size()));
     gpu.itemRefractive.push_back(hasMaterial && scene.materials[size_t(shape.material)].refractive() ? 1 : 0);
   }
+  if (host) vertices = host->vertexCapacity;  // the host's numbering, gaps and all
   gpu.vertexCount = static_cast<uint32_t>(vertices);
   gpu.triangleCount = static_cast<uint32_t>(triangles);
 
@@ -227,9 +254,15 @@ SceneGpu uploadScene(vk::Context& context, const scene::Scene& scene, const scen
   normals.reserve(vertices * 3);
   texcoords.reserve(vertices);
   indices.reserve(triangles * 3);
+  if (host) texcoords.assign(vertices, glm::vec4(0.0f));
   for (const GeometryRange& range : gpu.geometries) {
     const scene::Shape& shape = scene.shapes[size_t(range.shape)];
-    for (size_t v = 0; v < shape.vertexCount(); ++v) {
+    for (size_t v = 0; host && v < shape.vertexCount(); ++v) {
+      glm::vec2 uv0 = v < shape.texcoords0.size() ? shape.texcoords0[v] : glm::vec2(0.0f);
+      glm::vec2 uv1 = v < shape.texcoords1.size() ? shape.texcoords1[v] : glm::vec2(0.0f);
+      texcoords[range.firstVertex + v] = glm::vec4(uv0, uv1);
+    }
+    for (size_t v = 0; !host && v < shape.vertexCount(); ++v) {
       const glm::vec3& p = shape.positions[v];
       glm::vec3 n = v < shape.normals.size() ? shape.normals[v] : glm::vec3(0.0f);
       positions.insert(positions.end(), {p.x, p.y, p.z});
@@ -257,8 +290,13 @@ SceneGpu uploadScene(vk::Context& context, const scene::Scene& scene, const scen
   }
 
   const std::string& name = scene.source.empty() ? std::string("scene") : scene.source;
-  gpu.positions = uploaded(context, positions, name + " positions", gpu.bytes, true);
-  gpu.normals = uploaded(context, normals, name + " normals", gpu.bytes);
+  if (host) {
+    gpu.positions = vk::Buffer::borrow(context, host->positions, vertices * 12, name + " host positions");
+    gpu.normals = vk::Buffer::borrow(context, host->normals, vertices * 12, name + " host normals");
+  } else {
+    gpu.positions = uploaded(context, positions, name + " positions", gpu.bytes, true);
+    gpu.normals = uploaded(context, normals, name + " normals", gpu.bytes);
+  }
   gpu.texcoords = uploaded(context, texcoords, name + " texcoords", gpu.bytes);
   gpu.indices = uploaded(context, indices, name + " indices", gpu.bytes, true);
   gpu.materials = uploaded(context, materials, name + " materials", gpu.bytes);

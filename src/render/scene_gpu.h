@@ -51,9 +51,19 @@ struct SceneGpu {
 /// Level 0 of the textures goes to the GPU through one staging ring of at most this many bytes.
 inline constexpr uint64_t kTextureStagingRingBytes = 32ull << 20;
 
+/// A host application's vertex buffers, read in place (the embedding API):
+/// packed float triples, `vertexCapacity` vertices each, usable as storage
+/// buffers. Every shape of such a scene keeps its vertices here (Shape::host).
+struct HostBuffers {
+  VkBuffer positions = VK_NULL_HANDLE, normals = VK_NULL_HANDLE;
+  uint32_t vertexCapacity = 0;
+};
+
 /// Uploads the scene for the draw items of `layout` (which items exist does not
 /// change with time). Throws std::runtime_error naming the scene when it is
-/// larger than the device's buffers can hold.
-SceneGpu uploadScene(vk::Context& context, const scene::Scene& scene, const scene::Pose& layout);
+/// larger than the device's buffers can hold. With `host`, positions and
+/// normals are the host's buffers, and every shape must be a host shape.
+SceneGpu uploadScene(vk::Context& context, const scene::Scene& scene, const scene::Pose& layout,
+                     const HostBuffers* host = nullptr);
 
 }  // namespace snell::render

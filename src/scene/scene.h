@@ -87,6 +87,15 @@ struct MorphTarget {
   std::vector<glm::vec3> normals;
 };
 
+/// Where a host application keeps a shape's vertices (the embedding API):
+/// positions and normals in the host's own GPU buffers, from vertex `first` on.
+struct HostVertices {
+  uint32_t first = 0, count = 0;
+  /// A box the host promises the vertices stay in, in the shape's space; an
+  /// empty box (lo > hi) promises nothing and the shape is never culled.
+  glm::vec3 lo{INFINITY}, hi{-INFINITY};
+};
+
 /// One glTF triangle primitive: topology and rest pose. Normals are generated
 /// (area-weighted) when the file has none.
 struct Shape {
@@ -101,8 +110,10 @@ struct Shape {
   std::vector<glm::uvec4> joints;  ///< indices into the skin's joint list
   std::vector<glm::vec4> weights;  ///< the 4 strongest influences, summing to 1
   uint32_t maxJoint = 0;           ///< the largest joint index used, checked against the skin
+  /// Set for a host's shape: its vertices live on the GPU only (positions and normals stay empty).
+  std::optional<HostVertices> host;
 
-  size_t vertexCount() const { return positions.size(); }
+  size_t vertexCount() const { return host ? host->count : positions.size(); }
   size_t triangleCount() const { return indices.size() / 3; }
   bool morphed() const { return !targets.empty(); }
   bool skinned() const { return !joints.empty(); }

@@ -96,12 +96,30 @@ Buffer& Buffer::operator=(Buffer&& other) noexcept {
     domain_ = other.domain_;
     mapped_ = std::exchange(other.mapped_, nullptr);
     name_ = std::move(other.name_);
+    borrowed_ = std::exchange(other.borrowed_, false);
   }
   return *this;
 }
 
+Buffer Buffer::borrow(Context& context, VkBuffer buffer, VkDeviceSize size, std::string name) {
+  if (!buffer) throw VulkanError("borrowing buffer '" + name + "': the handle is null");
+  Buffer b;
+  b.context_ = &context;
+  b.buffer_ = buffer;
+  b.size_ = size;
+  b.name_ = std::move(name);
+  b.borrowed_ = true;
+  return b;
+}
+
 void Buffer::release() {
   if (!context_) return;
+  if (borrowed_) {  // the host frees its own buffer
+    buffer_ = VK_NULL_HANDLE;
+    context_ = nullptr;
+    borrowed_ = false;
+    return;
+  }
   VkDevice device = context_->device();
   VkBuffer buffer = std::exchange(buffer_, VK_NULL_HANDLE);
   VkDeviceMemory memory = std::exchange(memory_, VK_NULL_HANDLE);

@@ -42,6 +42,10 @@ class Buffer {
   Buffer(const Buffer&) = delete;
   Buffer& operator=(const Buffer&) = delete;
 
+  /// A host application's buffer that snell reads in place and never frees
+  /// (the embedding API's vertex buffers): no memory of its own, not mapped.
+  static Buffer borrow(Context& context, VkBuffer buffer, VkDeviceSize size, std::string name);
+
   VkBuffer handle() const { return buffer_; }
   VkDeviceSize size() const { return size_; }
   MemoryDomain domain() const { return domain_; }
@@ -60,6 +64,7 @@ class Buffer {
   MemoryDomain domain_ = MemoryDomain::Device;
   void* mapped_ = nullptr;
   std::string name_;
+  bool borrowed_ = false;
 };
 
 struct ImageDesc {

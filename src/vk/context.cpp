@@ -211,6 +211,11 @@ std::unique_ptr<Context> Context::create(const ContextDesc& desc) {
       if (!found) throw VulkanError(chosen.name + " lacks the device extension " + e);
       extensions.push_back(e.c_str());
     }
+    for (const std::string& e : desc.optionalDeviceExtensions) {
+      bool found = std::any_of(available.begin(), available.end(),
+                               [&](const VkExtensionProperties& a) { return e == a.extensionName; });
+      if (found) extensions.push_back(e.c_str()), c.optionalEnabled_.push_back(e);
+    }
   }
   VkPhysicalDevicePipelineExecutablePropertiesFeaturesKHR executableInfo{
       VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PIPELINE_EXECUTABLE_PROPERTIES_FEATURES_KHR};

@@ -12,6 +12,7 @@
 #include <memory>
 #include <set>
 #include <string>
+#include <algorithm>
 #include <vector>
 
 namespace snell::vk {
@@ -30,6 +31,8 @@ struct ContextDesc {
   /// Extra extensions a window needs (a surface on the instance, the swapchain
   /// on the device); creation fails naming any the system lacks.
   std::vector<std::string> instanceExtensions, deviceExtensions;
+  /// Device extensions enabled only where the device offers them (Context::enabled says).
+  std::vector<std::string> optionalDeviceExtensions;
   /// Turn on the driver's own acceleration structures (VK_KHR_acceleration_structure
   /// and buffer device addresses) where the device offers them, for the
   /// benchmarks' peer; DeviceCaps::driverAccelerationStructures says whether it is on.
@@ -114,6 +117,10 @@ class Context {
   const DeviceFacts& facts() const { return facts_; }
   const DeviceCaps& caps() const { return caps_; }
   bool ownsDevice() const { return owned_; }
+  /// Whether an optional device extension (ContextDesc::optionalDeviceExtensions) was enabled.
+  bool enabled(const std::string& extension) const {
+    return std::find(optionalEnabled_.begin(), optionalEnabled_.end(), extension) != optionalEnabled_.end();
+  }
 
   /// Validation warnings and errors seen so far (0 when validation is off).
   uint64_t validationMessageCount() const { return validationMessages_.load(); }
@@ -154,6 +161,7 @@ class Context {
   VkDevice device_ = VK_NULL_HANDLE;
   VkQueue queue_ = VK_NULL_HANDLE;
   uint32_t queueFamily_ = 0;
+  std::vector<std::string> optionalEnabled_;
   bool owned_ = false;
   bool validation_ = false;
   bool pipelineStatisticsRequested_ = false;

@@ -1,0 +1,356 @@
+// snell's public API: refraction through deforming meshes, traced by Vulkan
+// compute, for a host application (a DCC viewport plug-in, an engine, a tool)
+// that embeds it as a renderer backend. docs/embedding.md walks through it.
+//
+// Errors: every function reports failure by throwing snell::Error, whose
+// message says what failed (and which file, for files). snell never aborts
+// the host; after an Error the object that threw is still safe to destroy.
+//
+// Threads: a Device, and every Scene, Renderer and SharedImage made on it,
+// belong to one thread at a time: the host calls them from one thread, or
+// serialises the calls itself. Different Devices are independent. snell
+// submits to the Device's queue; a host that submits to the same queue from
+// another thread must lock around snell's calls that submit (Renderer::render,
+// Renderer::read), as Vulkan requires of any queue.
+#pragma once
+
+#include <vulkan/vulkan.h>
+
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <memory>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+// libsnell.so exports this header's names and hides everything else.
+#pragma GCC visibility push(default)
+
+namespace snell {
+
+/// The library's version, "major.minor.patch".
+const char* version();
+
+/// Every failure snell reports: bad input, a missing device feature, a Vulkan call that failed.
+class Error : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+/// Three floats: a point, a direction or a linear RGB colour.
+using Vec3 = std::array<float, 3>;
+/// A 4x4 matrix in column-major order (as OpenGL and GLM store them).
+using Mat4 = std::array<float, 16>;
+/// The identity matrix.
+inline constexpr Mat4 kIdentity{1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
+
+/// How snell creates a device of its own.
+struct DeviceOptions {
+  /// A device index or a substring of its name; empty: the SNELL_DEVICE
+  /// environment variable, else the first device that meets snell's needs.
+  std::string device;
+  /// Turn on the Khronos validation layer (it must be installed); messages are counted.
+  bool validation = false;
+  /// With validation: check synchronisation too.
+  bool synchronizationValidation = false;
+  /// Enable VK_KHR_external_memory_fd, so a SharedImage can hand its memory to
+  /// OpenGL (creation fails if the device lacks it), and VK_KHR_external_semaphore_fd
+  /// where the device has it (Device::exportsSemaphores).
+  bool interop = false;
+};
+
+/// A device a host application created, for snell to use and never destroy.
+/// The device must be Vulkan 1.3 with subgroupSizeControl, computeFullSubgroups
+/// and maintenance4 enabled (state them in `enabled13`), and `queue` must
+/// support compute and graphics. Host-owned buffers and images snell uses must
+/// be in `queueFamily` with exclusive sharing.
+struct HostDevice {
+  VkInstance instance = VK_NULL_HANDLE;
+  VkPhysicalDevice physicalDevice = VK_NULL_HANDLE;
+  VkDevice device = VK_NULL_HANDLE;
+  uint32_t queueFamily = 0;
+  VkQueue queue = VK_NULL_HANDLE;
+  /// What the host enabled of Vulkan 1.3 (its pNext is ignored).
+  VkPhysicalDeviceVulkan13Features enabled13{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_3_FEATURES};
+};
+
+/// The GPU snell runs on: its own, or the host's. Outlives every object made on it.
+class Device {
+ public:
+  /// Creates an instance and device; throws Error listing each device and why it was refused.
+  static Device create(const DeviceOptions& options = {});
+  /// Wraps the host's device; throws Error naming what it lacks.
+  static Device adopt(const HostDevice& host);
+  ~Device();
+  Device(Device&&) noexcept;
+  Device& operator=(Device&&) noexcept;
+
+  VkInstance instance() const;
+  VkPhysicalDevice physicalDevice() const;
+  VkDevice device() const;
+  VkQueue queue() const;
+  uint32_t queueFamily() const;
+  /// The device's name, as the driver gives it.
+  std::string name() const;
+  /// Validation messages seen so far (0 when validation is off or the device is adopted).
+  uint64_t validationMessages() const;
+  /// Whether a SharedSemaphore can be exported as a file descriptor (DeviceOptions::interop).
+  bool exportsSemaphores() const;
+  /// Waits until the device is idle.
+  void waitIdle();
+
+  struct Impl;
+  Impl& impl() const { return *impl_; }
+
+ private:
+  explicit Device(std::unique_ptr<Impl> impl);
+  std::unique_ptr<Impl> impl_;
+};
+
+/// A glTF metallic-roughness material with the transmission, IOR and volume extensions.
+struct Material {
+  std::string name;
+  std::array<float, 4> baseColor{1, 1, 1, 1};  ///< linear RGBA
+  int baseColorTexture = -1;                   ///< index into HostScene::textures; -1: none
+  float transmission = 0;                      ///< > 0: the faces refract
+  float ior = 1.5f;
+  float roughness = 1;    ///< the width of a glass face's highlights
+  float thickness = 0;    ///< 0: thin-walled
+  Vec3 attenuationColor{1, 1, 1};
+  float attenuationDistance = INFINITY;
+  bool doubleSided = false;
+};
+
+/// An 8-bit sRGB RGBA texture, row 0 at the top, repeating.
+struct Texture {
+  std::string name;
+  uint32_t width = 0, height = 0;
+  std::vector<uint8_t> rgba;  ///< width * height * 4 bytes
+};
+
+/// A triangle mesh whose vertices live in the host's buffers (HostScene::positions and normals).
+struct Mesh {
+  std::string name;
+  uint32_t firstVertex = 0;  ///< where its vertices start in the host's buffers
+  uint32_t vertexCount = 0;
+  std::vector<uint32_t> indices;  ///< 3 per triangle, counted from firstVertex
+  std::vector<float> texcoords;   ///< 2 per vertex (u, v), or empty
+  int material = -1;              ///< index into HostScene::materials; -1: a grey default
+  /// A box, in the mesh's space, the host promises its vertices stay in; the
+  /// default (empty) promises nothing, and the mesh is then never culled.
+  Vec3 boundsLo{INFINITY, INFINITY, INFINITY}, boundsHi{-INFINITY, -INFINITY, -INFINITY};
+};
+
+/// A mesh placed in the world. Renderer::setTransform moves it.
+struct Instance {
+  int mesh = 0;
+  Mat4 transform = kIdentity;  ///< mesh space to world
+};
+
+/// A punctual light (KHR_lights_punctual): candela for point and spot lights, lux for directional.
+struct Light {
+  enum class Type { Directional, Point, Spot } type = Type::Point;
+  Vec3 color{1, 1, 1};
+  float intensity = 1;
+  Vec3 position{0, 0, 0};
+  Vec3 direction{0, 0, -1};  ///< where the light points (directional, spot)
+  float innerConeAngle = 0, outerConeAngle = 0.7853982f;  ///< radians (spot)
+};
+
+/// A scene built from the host's own data. Positions and normals of every
+/// mesh are packed float triples (12 bytes a vertex) in two host VkBuffers
+/// made with VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, each mesh at its firstVertex:
+/// one buffer for all meshes, as an engine's skinning output usually is.
+/// snell reads them in place, never copies them, and never frees them.
+struct HostScene {
+  std::string name = "host scene";  ///< for messages
+  VkBuffer positions = VK_NULL_HANDLE, normals = VK_NULL_HANDLE;
+  uint32_t vertexCapacity = 0;  ///< vertices each buffer holds
+  std::vector<Mesh> meshes;
+  std::vector<Material> materials;
+  std::vector<Texture> textures;
+  std::vector<Instance> instances;
+  std::vector<Light> lights;
+};
+
+/// What is drawn: a glTF file, or the host's data.
+class Scene {
+ public:
+  /// Loads a glTF 2.0 file (.gltf or .glb); throws Error naming the file and the problem.
+  static Scene load(const std::string& path);
+  /// Wraps the host's data; the host's buffers must outlive every Renderer of this scene.
+  static Scene fromHost(const HostScene& host);
+  ~Scene();
+  Scene(Scene&&) noexcept;
+  Scene& operator=(Scene&&) noexcept;
+
+  std::string name() const;
+  /// Meshes: glTF primitives, or HostScene::meshes (the index markDirty takes).
+  size_t meshCount() const;
+  /// Cameras the file defines (View::sceneCamera).
+  size_t cameraCount() const;
+  /// The longest animation, in seconds (0: static).
+  double duration() const;
+
+  struct Impl;
+  Impl& impl() const { return *impl_; }
+
+ private:
+  explicit Scene(std::unique_ptr<Impl> impl);
+  std::unique_ptr<Impl> impl_;
+};
+
+/// A look-at camera with a vertical field of view.
+struct Camera {
+  Vec3 eye{0, 0, 3}, target{0, 0, 0}, up{0, 1, 0};
+  float yfov = 0.6981317f;  ///< radians (40 degrees)
+};
+
+/// One picture of the scene.
+struct View {
+  uint32_t width = 640, height = 480;
+  /// The scene's camera of this index; -1: `camera` below.
+  int sceneCamera = -1;
+  Camera camera;
+  enum class Output {
+    Viewport,  ///< rasterised, with only the refracting pixels traced: the talk's viewport
+    Trace,     ///< every pixel traced
+  } output = Output::Viewport;
+  Vec3 background{0.02f, 0.02f, 0.025f};  ///< linear RGB where nothing is drawn
+  /// Viewport only: alpha 0 (and black) where nothing is drawn, so the host
+  /// composites the image over its own with premultiplied alpha.
+  bool transparentBackground = false;
+};
+
+/// A host image snell writes a view into, on the Device's queue family. Its
+/// size must be the view's; it needs VK_IMAGE_USAGE_TRANSFER_DST_BIT and a
+/// format that can be a blit destination (RGBA8 UNORM or SRGB, BGRA8, RGBA16F,
+/// RGBA32F). snell moves it from `layoutBefore` (UNDEFINED: its contents are
+/// discarded) to TRANSFER_DST_OPTIMAL, writes it with a blit (an SRGB format
+/// gets sRGB-encoded values), and leaves it in `layoutAfter`.
+struct Target {
+  VkImage image = VK_NULL_HANDLE;
+  VkFormat format = VK_FORMAT_R8G8B8A8_SRGB;
+  uint32_t width = 0, height = 0;
+  VkImageLayout layoutBefore = VK_IMAGE_LAYOUT_UNDEFINED;
+  VkImageLayout layoutAfter = VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL;
+};
+
+/// How a frame's submission orders against the host's work. snell submits one
+/// command buffer per frame to the Device's queue; it starts with a full
+/// barrier, so work the host submitted to that queue before (its own writes
+/// to the vertex buffers or the target included) is finished and visible.
+struct Sync {
+  /// Binary semaphore snell's submission waits for (e.g. the host's skinning
+  /// on another queue, or a swapchain acquire); VK_NULL_HANDLE: none.
+  VkSemaphore wait = VK_NULL_HANDLE;
+  VkPipelineStageFlags waitStage = VK_PIPELINE_STAGE_ALL_COMMANDS_BIT;
+  /// Binary semaphore signalled once the target is written and in layoutAfter; VK_NULL_HANDLE: none.
+  VkSemaphore signal = VK_NULL_HANDLE;
+};
+
+/// How a Renderer works.
+struct RendererOptions {
+  /// Frames recorded ahead of the GPU; render() waits for the frame this many frames back.
+  uint32_t framesInFlight = 2;
+};
+
+/// What the last frame did (for the host's statistics overlay).
+struct FrameInfo {
+  uint64_t frame = 0;
+  uint32_t treesRefit = 0, treesBuilt = 0, treesSkipped = 0;
+  uint64_t pixelsTraced = 0;
+  bool skipped = false;  ///< nothing changed since the view was last drawn: the image was reused
+};
+
+/// Draws views of one scene, updating only what changed between frames.
+class Renderer {
+ public:
+  /// Uploads the scene (the host's buffers are used in place). The Device and
+  /// Scene must outlive the Renderer.
+  Renderer(Device& device, Scene& scene, const RendererOptions& options = {});
+  ~Renderer();
+  Renderer(Renderer&&) noexcept;
+  Renderer& operator=(Renderer&&) noexcept;
+
+  /// Poses a glTF scene at `seconds` (its animations, morphs and skins).
+  /// Transforms set with setTransform stay in force.
+  void setTime(double seconds);
+  /// Draw items: one per instance of a host scene, one per placed glTF primitive.
+  size_t instanceCount() const;
+  /// Moves instance `instance` (mesh space to world); the next frame refits the top-level tree only.
+  void setTransform(size_t instance, const Mat4& transform);
+  /// Says the host rewrote mesh `mesh`'s vertices in its buffers: the next
+  /// frame refits that mesh's tree and redraws. Write the buffers, then call
+  /// this, then render().
+  void markDirty(int mesh);
+
+  /// Renders `view` into `target`, submitted with `sync`; returns the frame's
+  /// number. The host may record its own use of the target once `sync.signal`
+  /// is waited for, or after wait(frame).
+  uint64_t render(const View& view, const Target& target, const Sync& sync = {});
+  /// Blocks until frame `frame` is complete on the GPU.
+  void wait(uint64_t frame);
+  /// Renders `view` and reads it back: linear RGBA floats, row 0 at the top (tests, thumbnails).
+  std::vector<float> read(const View& view);
+  /// What the last frame did.
+  FrameInfo lastFrame() const;
+
+  struct Impl;
+
+ private:
+  std::unique_ptr<Impl> impl_;
+};
+
+/// An image whose memory another API imports: OpenGL through
+/// GL_EXT_memory_object_fd (glImportMemoryFdEXT, then glTextureStorageMem2DEXT
+/// with the same size, a format of the same bytes and optimal tiling). Needs
+/// a Device made with DeviceOptions::interop.
+class SharedImage {
+ public:
+  /// An exportable image, usable as a Target (TRANSFER_DST and SAMPLED).
+  SharedImage(Device& device, uint32_t width, uint32_t height, VkFormat format = VK_FORMAT_R8G8B8A8_SRGB);
+  ~SharedImage();
+  SharedImage(SharedImage&&) noexcept;
+  SharedImage& operator=(SharedImage&&) noexcept;
+
+  /// A Target of this image, moved between the layouts given.
+  Target target(VkImageLayout before, VkImageLayout after) const;
+  /// A new file descriptor of the image's memory; the importer owns it
+  /// (glImportMemoryFdEXT takes it over).
+  int exportMemory() const;
+  /// The memory's size in bytes (glImportMemoryFdEXT's size).
+  uint64_t memorySize() const;
+  /// Whether the memory is a dedicated allocation (then set GL_DEDICATED_MEMORY_OBJECT_EXT).
+  bool dedicated() const;
+  VkImage image() const;
+
+  struct Impl;
+
+ private:
+  std::unique_ptr<Impl> impl_;
+};
+
+/// A binary semaphore another API imports (OpenGL through GL_EXT_semaphore_fd),
+/// where Device::exportsSemaphores() says the device can.
+class SharedSemaphore {
+ public:
+  explicit SharedSemaphore(Device& device);
+  ~SharedSemaphore();
+  SharedSemaphore(SharedSemaphore&&) noexcept;
+  SharedSemaphore& operator=(SharedSemaphore&&) noexcept;
+
+  VkSemaphore handle() const;
+  /// A new file descriptor of the semaphore; the importer owns it.
+  int exportFd() const;
+
+  struct Impl;
+
+ private:
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace snell
+
+#pragma GCC visibility pop

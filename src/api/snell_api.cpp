@@ -1,0 +1,563 @@
+// The public API (include/snell/snell.h) over the layers below: a Device is a
+// vk::Context, a Scene a scene::Scene (a host's data turned into one), a
+// Renderer a render::Renderer with the pose it draws. Every exception from
+// below leaves as snell::Error.
+#include "snell/snell.h"
+
+#include "render/method.h"
+#include "render/raster_pass.h"
+#include "render/renderer.h"
+#include "scene/evaluate.h"
+#include "scene/gltf_loader.h"
+#include "scene/view.h"
+#include "vk/commands.h"
+#include "vk/context.h"
+#include "vk/error.h"
+
+#include <glm/gtc/type_ptr.hpp>
+
+#include <map>
+#include <optional>
+#include <utility>
+
+namespace snell {
+
+namespace {
+
+// Runs `body`, turning whatever it throws into snell::Error.
+template <typename Body>
+auto guarded(Body&& body) -> decltype(body()) {
+  try {
+    return body();
+  } catch (const Error&) {
+    throw;
+  } catch (const std::exception& e) {
+    throw Error(e.what());
+  }
+}
+
+glm::dmat4 toMatrix(const Mat4& m) { return glm::dmat4(glm::make_mat4(m.data())); }
+glm::vec3 toVec(const Vec3& v) { return {v[0], v[1], v[2]}; }
+
+// A Vulkan entry point of the device's extensions; throws when the driver has none.
+template <typename Function>
+Function deviceFunction(VkDevice device, const char* name) {
+  auto f = reinterpret_cast<Function>(vkGetDeviceProcAddr(device, name));
+  if (!f) throw Error(std::string(name) + " is missing: make the Device with DeviceOptions::interop");
+  return f;
+}
+
+}  // namespace
+
+const char* version() { return SNELL_VERSION; }
+
+// ---------------------------------------------------------------- Device
+
+struct Device::Impl {
+  std::unique_ptr<vk::Context> context;
+  bool interop = false;
+};
+
+Device::Device(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
+Device::~Device() = default;
+Device::Device(Device&&) noexcept = default;
+Device& Device::operator=(Device&&) noexcept = default;
+
+Device Device::create(const DeviceOptions& options) {
+  return guarded([&] {
+    vk::ContextDesc desc;
+    desc.applicationName = "snell (embedded)";
+    desc.deviceOverride = options.device;
+    desc.validation = options.validation;
+    desc.synchronizationValidation = options.synchronizationValidation;
+    if (options.interop) {
+      desc.deviceExtensions = {VK_KHR_EXTERNAL_MEMORY_FD_EXTENSION_NAME};
+      desc.optionalDeviceExtensions = {VK_KHR_EXTERNAL_SEMAPHORE_FD_EXTENSION_NAME};  // lavapipe lacks it
+    }
+    auto impl = std::make_unique<Impl>();
+    impl->context = vk::Context::create(desc);
+    impl->interop = options.interop;
+    return Device(std::move(impl));
+  });
+}
+
+Device Device::adopt(const HostDevice& host) {
+  return guarded([&] {
+    vk::AdoptedDevice adopted;
+    adopted.instance = host.instance;
+    adopted.physicalDevice = host.physicalDevice;
+    adopted.device = host.device;
+    adopted.queueFamily = host.queueFamily;
+    adopted.queue = host.queue;
+    adopted.enabled13 = host.enabled13;
+    adopted.enabled13.pNext = nullptr;
+    auto impl = std::make_unique<Impl>();
+    impl->context = vk::Context::adopt(adopted);
+    return Device(std::move(impl));
+  });
+}
+
+VkInstance Device::instance() const { return impl_->context->instance(); }
+VkPhysicalDevice Device::physicalDevice() const { return impl_->context->physicalDevice(); }
+VkDevice Device::device() const { return impl_->context->device(); }
+VkQueue Device::queue() const { return impl_->context->queue(); }
+uint32_t Device::queueFamily() const { return impl_->context->queueFamily(); }
+std::string Device::name() const { return impl_->context->facts().name; }
+uint64_t Device::validationMessages() const { return impl_->context->validationMessageCount(); }
+
+bool Device::exportsSemaphores() const {
+  if (!impl_->interop || !impl_->context->enabled(VK_KHR_EXTERNAL_SEMAPHORE_FD_EXTENSION_NAME)) return false;
+  VkPhysicalDeviceExternalSemaphoreInfo info{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_EXTERNAL_SEMAPHORE_INFO};
+  info.handleType = VK_EXTERNAL_SEMAPHORE_HANDLE_TYPE_OPAQUE_FD_BIT;
+  VkExternalSemaphoreProperties properties{VK_STRUCTURE_TYPE_EXTERNAL_SEMAPHORE_PROPERTIES};
+  vkGetPhysicalDeviceExternalSemaphoreProperties(physicalDevice(), &info, &properties);
+  return (properties.externalSemaphoreFeatures & VK_EXTERNAL_SEMAPHORE_FEATURE_EXPORTABLE_BIT) != 0;
+}
+
+void Device::waitIdle() {
+  guarded([&] { VK_CHECK(vkDeviceWaitIdle(device())); });
+}
+
+// ---------------------------------------------------------------- Scene
+
+struct Scene::Impl {
+  scene::Scene scene;
+  render::HostBuffers host;  ///< null handles for a glTF scene
+};
+
+Scene::Scene(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
+Scene::~Scene() = default;
+Scene::Scene(Scene&&) noexcept = default;
+Scene& Scene::operator=(Scene&&) noexcept = default;
+
+Scene Scene::load(const std::string& path) {
+  return guarded([&] {
+    auto impl = std::make_unique<Impl>();
+    impl->scene = scene::loadGltf(path);
+    return Scene(std::move(impl));
+  });
+}
+
+namespace {
+
+scene::Material toMaterial(const Material& m, size_t textures, const std::string& where) {
+  if (m.baseColorTexture >= int(textures)) {
+    throw Error(where + ": baseColorTexture " + std::to_string(m.baseColorTexture) + " of " + std::to_string(textures) +
+                " textures");
+  }
+  if (!(m.ior >= 1.0f) || !(m.transmission >= 0.0f && m.transmission <= 1.0f)) {
+    throw Error(where + ": ior must be at least 1 and transmission within [0, 1]");
+  }
+  scene::Material out;
+  out.name = m.name;
+  out.baseColorFactor = glm::make_vec4(m.baseColor.data());
+  out.baseColorTexture.texture = m.baseColorTexture;
+  out.transmission = m.transmission;
+  out.ior = m.ior;
+  out.roughness = m.roughness;
+  out.thickness = m.thickness;
+  out.attenuationColor = toVec(m.attenuationColor);
+  out.attenuationDistance = m.attenuationDistance;
+  out.doubleSided = m.doubleSided;
+  return out;
+}
+
+scene::Shape toShape(const Mesh& m, int index, size_t materials, const std::string& where) {
+  if (m.indices.empty() || m.indices.size() % 3 != 0) {
+    throw Error(where + ": needs a whole number of triangles (" + std::to_string(m.indices.size()) + " indices)");
+  }
+  if (!m.texcoords.empty() && m.texcoords.size() != size_t(m.vertexCount) * 2) {
+    throw Error(where + ": " + std::to_string(m.texcoords.size()) + " texcoord floats for " +
+                std::to_string(m.vertexCount) + " vertices");
+  }
+  if (m.material >= int(materials)) {
+    throw Error(where + ": material " + std::to_string(m.material) + " of " + std::to_string(materials));
+  }
+  scene::Shape shape;
+  shape.name = m.name;
+  shape.mesh = index;
+  shape.material = m.material;
+  shape.indices = m.indices;
+  for (size_t v = 0; v + 1 < m.texcoords.size(); v += 2) shape.texcoords0.emplace_back(m.texcoords[v], m.texcoords[v + 1]);
+  shape.host = scene::HostVertices{m.firstVertex, m.vertexCount, toVec(m.boundsLo), toVec(m.boundsHi)};
+  return shape;
+}
+
+// A light's node: it shines down its -Z axis from `position`.
+glm::mat4 lightMatrix(const Light& light) {
+  glm::vec3 back = -glm::normalize(toVec(light.direction));
+  glm::vec3 helper = std::abs(back.y) < 0.9f ? glm::vec3(0, 1, 0) : glm::vec3(1, 0, 0);
+  glm::vec3 x = glm::normalize(glm::cross(helper, back));
+  glm::vec3 y = glm::cross(back, x);
+  return glm::mat4(glm::vec4(x, 0), glm::vec4(y, 0), glm::vec4(back, 0), glm::vec4(toVec(light.position), 1));
+}
+
+}  // namespace
+
+Scene Scene::fromHost(const HostScene& host) {
+  return guarded([&] {
+    auto impl = std::make_unique<Impl>();
+    scene::Scene& s = impl->scene;
+    s.source = host.name;
+    if (!host.positions || !host.normals) throw Error(host.name + ": the host's positions and normals buffers are needed");
+    for (size_t i = 0; i < host.textures.size(); ++i) {
+      const Texture& t = host.textures[i];
+      if (t.width == 0 || t.height == 0 || t.rgba.size() != size_t(t.width) * t.height * 4) {
+        throw Error(host.name + ": texture " + std::to_string(i) + " ('" + t.name + "') has " +
+                    std::to_string(t.rgba.size()) + " bytes for " + std::to_string(t.width) + "x" +
+                    std::to_string(t.height) + " RGBA8 pixels");
+      }
+      s.textures.push_back(scene::Texture{t.name, t.width, t.height, t.rgba});
+    }
+    for (size_t i = 0; i < host.materials.size(); ++i) {
+      s.materials.push_back(toMaterial(host.materials[i], s.textures.size(),
+                                       host.name + ": material " + std::to_string(i)));
+    }
+    for (size_t i = 0; i < host.meshes.size(); ++i) {
+      s.shapes.push_back(toShape(host.meshes[i], int(i), s.materials.size(), host.name + ": mesh " + std::to_string(i)));
+      s.meshes.push_back(scene::Mesh{host.meshes[i].name, {int(i)}, {}});
+    }
+    for (size_t i = 0; i < host.instances.size(); ++i) {
+      const Instance& instance = host.instances[i];
+      if (instance.mesh < 0 || size_t(instance.mesh) >= s.meshes.size()) {
+        throw Error(host.name + ": instance " + std::to_string(i) + " places mesh " + std::to_string(instance.mesh) +
+                    " of " + std::to_string(s.meshes.size()));
+      }
+      scene::Node node;
+      node.name = "instance " + std::to_string(i);
+      node.mesh = instance.mesh;
+      node.matrix = glm::make_mat4(instance.transform.data());
+      s.roots.push_back(int(s.nodes.size()));
+      s.nodes.push_back(node);
+    }
+    for (size_t i = 0; i < host.lights.size(); ++i) {
+      const Light& l = host.lights[i];
+      scene::Light light;
+      light.type = l.type == Light::Type::Directional ? scene::LightType::Directional
+                   : l.type == Light::Type::Point     ? scene::LightType::Point
+                                                      : scene::LightType::Spot;
+      light.color = toVec(l.color);
+      light.intensity = l.intensity;
+      light.innerConeAngle = l.innerConeAngle;
+      light.outerConeAngle = l.outerConeAngle;
+      scene::Node node;
+      node.name = "light " + std::to_string(i);
+      node.light = int(s.lights.size());
+      node.matrix = lightMatrix(l);
+      s.lights.push_back(light);
+      s.roots.push_back(int(s.nodes.size()));
+      s.nodes.push_back(node);
+    }
+    impl->host = {host.positions, host.normals, host.vertexCapacity};
+    return Scene(std::move(impl));
+  });
+}
+
+std::string Scene::name() const { return impl_->scene.source; }
+size_t Scene::meshCount() const { return impl_->scene.shapes.size(); }
+size_t Scene::cameraCount() const { return impl_->scene.cameras.size(); }
+double Scene::duration() const { return scene::animationDuration(impl_->scene); }
+
+// ---------------------------------------------------------------- Renderer
+
+struct Renderer::Impl {
+  vk::Context& context;
+  Scene::Impl& scene;
+  scene::Pose pose;
+  std::map<size_t, glm::dmat4> transforms;  ///< setTransform's, kept over setTime
+  std::unique_ptr<render::Renderer> renderer;
+  FrameInfo last;
+
+  Impl(Device& device, Scene& s, const RendererOptions& options)
+      : context(*device.impl().context), scene(s.impl()), pose(scene::evaluate(scene.scene, 0.0)) {
+    render::RendererOptions o;
+    o.framesInFlight = options.framesInFlight;
+    o.host = scene.host;
+    renderer = std::make_unique<render::Renderer>(context, scene.scene, pose, o);
+  }
+
+  // The renderer's request for a view of the current pose.
+  render::ViewRequest request(const View& view) const {
+    scene::ViewRequest which;
+    if (view.sceneCamera >= 0) {
+      which.camera = view.sceneCamera;
+    } else {
+      const Camera& c = view.camera;
+      which.lookAt = scene::LookAt{glm::dvec3(toVec(c.eye)), glm::dvec3(toVec(c.target)), glm::dvec3(toVec(c.up))};
+      which.yfov = c.yfov;
+    }
+    render::FrameSettings settings;
+    settings.width = view.width;
+    settings.height = view.height;
+    settings.view = scene::resolveView(scene.scene, pose, which);
+    settings.background = toVec(view.background);
+    render::RasterOptions raster;
+    bool viewport = view.output == View::Output::Viewport;
+    if (viewport && view.transparentBackground) settings.background = glm::vec3(0.0f), settings.backgroundAlpha = 0.0f;
+    if (viewport) fitDepth(settings.view, raster);
+    return render::methodView(viewport ? render::Method::Masked : render::Method::Trace, settings, raster);
+  }
+
+  // Near and far planes around the scene: a glTF scene's bounds at the pose, a
+  // host scene's promised boxes (its vertices are on the GPU only).
+  void fitDepth(const scene::View& view, render::RasterOptions& raster) const {
+    glm::dvec3 lo(INFINITY), hi(-INFINITY);
+    if (!scene.host.positions) {
+      scene::sceneBounds(scene.scene, pose, lo, hi);
+    } else {
+      for (const scene::DrawItem& item : pose.items) {
+        const scene::HostVertices& h = *scene.scene.shapes[size_t(item.shape)].host;
+        if (!(h.lo.x <= h.hi.x)) return;  // a mesh promised no box: keep the wide default planes
+        for (int corner = 0; corner < 8; ++corner) {
+          glm::dvec3 p(corner & 1 ? h.hi.x : h.lo.x, corner & 2 ? h.hi.y : h.lo.y, corner & 4 ? h.hi.z : h.lo.z);
+          p = glm::dvec3(item.world * glm::dvec4(p, 1.0));
+          lo = glm::min(lo, p), hi = glm::max(hi, p);
+        }
+      }
+    }
+    if (lo.x <= hi.x) render::fitDepthRange(view, lo, hi, raster);
+  }
+
+  void note(const render::FrameResult& result) {
+    const render::FrameStats& s = result.stats;
+    last = FrameInfo{s.frame, s.treesRefit, s.treesBuilt, s.treesSkipped, s.pixelsTraced, s.viewsSkipped > 0};
+  }
+};
+
+Renderer::Renderer(Device& device, Scene& scene, const RendererOptions& options)
+    : impl_(guarded([&] { return std::make_unique<Impl>(device, scene, options); })) {}
+Renderer::~Renderer() = default;
+Renderer::Renderer(Renderer&&) noexcept = default;
+Renderer& Renderer::operator=(Renderer&&) noexcept = default;
+
+void Renderer::setTime(double seconds) {
+  guarded([&] {
+    if (!std::isfinite(seconds)) throw Error("setTime: the time is not finite");
+    impl_->pose = scene::evaluate(impl_->scene.scene, seconds);
+    for (const auto& [instance, world] : impl_->transforms) impl_->pose.items[instance].world = world;
+  });
+}
+
+size_t Renderer::instanceCount() const { return impl_->pose.items.size(); }
+
+void Renderer::setTransform(size_t instance, const Mat4& transform) {
+  if (instance >= impl_->pose.items.size()) {
+    throw Error("setTransform: no instance " + std::to_string(instance) + " of " +
+                std::to_string(impl_->pose.items.size()));
+  }
+  for (float f : transform) {
+    if (!std::isfinite(f)) throw Error("setTransform: instance " + std::to_string(instance) + "'s matrix is not finite");
+  }
+  impl_->transforms[instance] = toMatrix(transform);
+  impl_->pose.items[instance].world = toMatrix(transform);
+}
+
+void Renderer::markDirty(int mesh) {
+  guarded([&] { impl_->renderer->markDirty(mesh); });
+}
+
+uint64_t Renderer::render(const View& view, const Target& target, const Sync& sync) {
+  return guarded([&] {
+    if (!target.image) throw Error("render: the target image is null");
+    if (target.width != view.width || target.height != view.height) {
+      throw Error("render: the target is " + std::to_string(target.width) + "x" + std::to_string(target.height) +
+                  ", the view " + std::to_string(view.width) + "x" + std::to_string(view.height));
+    }
+    render::FrameRequest frame;
+    frame.pose = &impl_->pose;
+    frame.views.push_back(impl_->request(view));
+    bool viewport = view.output == View::Output::Viewport;
+    render::Renderer& renderer = *impl_->renderer;
+    frame.record = [&](vk::Commands& commands) {
+      const render::ViewImages& images = renderer.viewImages(0);
+      const vk::Image& source = viewport ? images.composite : images.trace;
+      // The view's image lives in GENERAL; a blit reads best from TRANSFER_SRC_OPTIMAL.
+      commands.imageBarrier(source.handle(), VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_LAYOUT_GENERAL,
+                            VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT,
+                            VK_ACCESS_MEMORY_WRITE_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_READ_BIT);
+      commands.imageBarrier(target.image, VK_IMAGE_ASPECT_COLOR_BIT, target.layoutBefore,
+                            VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, 0,
+                            VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT);
+      VkImageBlit region{};
+      region.srcSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
+      region.dstSubresource = region.srcSubresource;
+      region.srcOffsets[1] = {int32_t(view.width), int32_t(view.height), 1};
+      region.dstOffsets[1] = region.srcOffsets[1];
+      vkCmdBlitImage(commands.handle(), source.handle(), VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, target.image,
+                     VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &region, VK_FILTER_NEAREST);
+      commands.imageBarrier(source.handle(), VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
+                            VK_IMAGE_LAYOUT_GENERAL, VK_PIPELINE_STAGE_TRANSFER_BIT, 0,
+                            VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, VK_ACCESS_MEMORY_READ_BIT | VK_ACCESS_MEMORY_WRITE_BIT);
+      commands.imageBarrier(target.image, VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
+                            target.layoutAfter, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT,
+                            VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, VK_ACCESS_MEMORY_READ_BIT | VK_ACCESS_MEMORY_WRITE_BIT);
+    };
+    frame.waitSemaphore = sync.wait;
+    frame.waitStage = sync.wait ? sync.waitStage : 0;
+    frame.signalSemaphore = sync.signal;
+    return renderer.submit(frame);
+  });
+}
+
+void Renderer::wait(uint64_t frame) {
+  guarded([&] { impl_->note(impl_->renderer->wait(frame)); });
+}
+
+std::vector<float> Renderer::read(const View& view) {
+  return guarded([&] {
+    render::FrameRequest frame;
+    frame.pose = &impl_->pose;
+    frame.views.push_back(impl_->request(view));
+    frame.views.back().readback = true;
+    const render::FrameResult& result = impl_->renderer->wait(impl_->renderer->submit(frame));
+    impl_->note(result);
+    const render::ViewPixels& pixels = result.views.at(0);
+    const std::vector<glm::vec4>& rgba = view.output == View::Output::Viewport ? pixels.composite : pixels.trace;
+    std::vector<float> out(rgba.size() * 4);
+    for (size_t i = 0; i < rgba.size(); ++i) {
+      for (int c = 0; c < 4; ++c) out[4 * i + size_t(c)] = rgba[i][c];
+    }
+    return out;
+  });
+}
+
+FrameInfo Renderer::lastFrame() const { return impl_->last; }
+
+// ---------------------------------------------------------------- SharedImage
+
+struct SharedImage::Impl {
+  vk::Context& context;
+  uint32_t width, height;
+  VkFormat format;
+  VkImage image = VK_NULL_HANDLE;
+  VkDeviceMemory memory = VK_NULL_HANDLE;
+  uint64_t size = 0;
+  bool dedicated = false;
+
+  Impl(vk::Context& c, uint32_t w, uint32_t h, VkFormat f) : context(c), width(w), height(h), format(f) {
+    VkExternalMemoryImageCreateInfo external{VK_STRUCTURE_TYPE_EXTERNAL_MEMORY_IMAGE_CREATE_INFO};
+    external.handleTypes = VK_EXTERNAL_MEMORY_HANDLE_TYPE_OPAQUE_FD_BIT;
+    VkImageCreateInfo info{VK_STRUCTURE_TYPE_IMAGE_CREATE_INFO, &external};
+    info.imageType = VK_IMAGE_TYPE_2D;
+    info.format = f;
+    info.extent = {w, h, 1};
+    info.mipLevels = info.arrayLayers = 1;
+    info.samples = VK_SAMPLE_COUNT_1_BIT;
+    info.tiling = VK_IMAGE_TILING_OPTIMAL;
+    info.usage = VK_IMAGE_USAGE_TRANSFER_DST_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT | VK_IMAGE_USAGE_SAMPLED_BIT;
+    info.initialLayout = VK_IMAGE_LAYOUT_UNDEFINED;
+    VK_CHECK(vkCreateImage(c.device(), &info, nullptr, &image));
+    try {
+      VkMemoryDedicatedRequirements dedicatedNeeds{VK_STRUCTURE_TYPE_MEMORY_DEDICATED_REQUIREMENTS};
+      VkMemoryRequirements2 needs{VK_STRUCTURE_TYPE_MEMORY_REQUIREMENTS_2, &dedicatedNeeds};
+      VkImageMemoryRequirementsInfo2 which{VK_STRUCTURE_TYPE_IMAGE_MEMORY_REQUIREMENTS_INFO_2};
+      which.image = image;
+      vkGetImageMemoryRequirements2(c.device(), &which, &needs);
+      dedicated = dedicatedNeeds.prefersDedicatedAllocation || dedicatedNeeds.requiresDedicatedAllocation;
+      VkMemoryDedicatedAllocateInfo dedicatedInfo{VK_STRUCTURE_TYPE_MEMORY_DEDICATED_ALLOCATE_INFO};
+      dedicatedInfo.image = image;
+      VkExportMemoryAllocateInfo exportInfo{VK_STRUCTURE_TYPE_EXPORT_MEMORY_ALLOCATE_INFO,
+                                            dedicated ? &dedicatedInfo : nullptr};
+      exportInfo.handleTypes = VK_EXTERNAL_MEMORY_HANDLE_TYPE_OPAQUE_FD_BIT;
+      VkMemoryAllocateInfo allocate{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO, &exportInfo};
+      allocate.allocationSize = size = needs.memoryRequirements.size;
+      allocate.memoryTypeIndex = c.findMemoryType(needs.memoryRequirements.memoryTypeBits,
+                                                  VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT, 0);
+      if (allocate.memoryTypeIndex == UINT32_MAX) throw Error("shared image: no device-local memory type fits it");
+      VK_CHECK(vkAllocateMemory(c.device(), &allocate, nullptr, &memory));
+      VK_CHECK(vkBindImageMemory(c.device(), image, memory, 0));
+    } catch (...) {
+      release();
+      throw;
+    }
+    c.setName(VK_OBJECT_TYPE_IMAGE, image, "shared image");
+  }
+  ~Impl() { release(); }
+
+  void release() {
+    VkDevice device = context.device();
+    VkImage i = std::exchange(image, VK_NULL_HANDLE);
+    VkDeviceMemory m = std::exchange(memory, VK_NULL_HANDLE);
+    context.retire([device, i, m] {
+      if (i) vkDestroyImage(device, i, nullptr);
+      if (m) vkFreeMemory(device, m, nullptr);
+    });
+  }
+};
+
+SharedImage::SharedImage(Device& device, uint32_t width, uint32_t height, VkFormat format)
+    : impl_(guarded([&] {
+        vk::Context& context = *device.impl().context;
+        if (width == 0 || height == 0) throw Error("shared image: its size is " + std::to_string(width) + "x" + std::to_string(height));
+        deviceFunction<PFN_vkGetMemoryFdKHR>(context.device(), "vkGetMemoryFdKHR");
+        return std::make_unique<Impl>(context, width, height, format);
+      })) {}
+SharedImage::~SharedImage() = default;
+SharedImage::SharedImage(SharedImage&&) noexcept = default;
+SharedImage& SharedImage::operator=(SharedImage&&) noexcept = default;
+
+Target SharedImage::target(VkImageLayout before, VkImageLayout after) const {
+  return Target{impl_->image, impl_->format, impl_->width, impl_->height, before, after};
+}
+
+int SharedImage::exportMemory() const {
+  return guarded([&] {
+    auto getFd = deviceFunction<PFN_vkGetMemoryFdKHR>(impl_->context.device(), "vkGetMemoryFdKHR");
+    VkMemoryGetFdInfoKHR info{VK_STRUCTURE_TYPE_MEMORY_GET_FD_INFO_KHR};
+    info.memory = impl_->memory;
+    info.handleType = VK_EXTERNAL_MEMORY_HANDLE_TYPE_OPAQUE_FD_BIT;
+    int fd = -1;
+    VK_CHECK(getFd(impl_->context.device(), &info, &fd));
+    return fd;
+  });
+}
+
+uint64_t SharedImage::memorySize() const { return impl_->size; }
+bool SharedImage::dedicated() const { return impl_->dedicated; }
+VkImage SharedImage::image() const { return impl_->image; }
+
+// ---------------------------------------------------------------- SharedSemaphore
+
+struct SharedSemaphore::Impl {
+  vk::Context& context;
+  VkSemaphore semaphore = VK_NULL_HANDLE;
+  explicit Impl(vk::Context& c) : context(c) {}
+  ~Impl() {
+    VkDevice device = context.device();
+    VkSemaphore s = semaphore;
+    if (s) context.retire([device, s] { vkDestroySemaphore(device, s, nullptr); });
+  }
+};
+
+SharedSemaphore::SharedSemaphore(Device& device)
+    : impl_(guarded([&] {
+        if (!device.exportsSemaphores()) {
+          throw Error("shared semaphore: " + device.name() +
+                      " cannot export semaphores as file descriptors (or the Device was made without interop)");
+        }
+        auto impl = std::make_unique<Impl>(*device.impl().context);
+        VkExportSemaphoreCreateInfo exportInfo{VK_STRUCTURE_TYPE_EXPORT_SEMAPHORE_CREATE_INFO};
+        exportInfo.handleTypes = VK_EXTERNAL_SEMAPHORE_HANDLE_TYPE_OPAQUE_FD_BIT;
+        VkSemaphoreCreateInfo info{VK_STRUCTURE_TYPE_SEMAPHORE_CREATE_INFO, &exportInfo};
+        VK_CHECK(vkCreateSemaphore(device.device(), &info, nullptr, &impl->semaphore));
+        return impl;
+      })) {}
+SharedSemaphore::~SharedSemaphore() = default;
+SharedSemaphore::SharedSemaphore(SharedSemaphore&&) noexcept = default;
+SharedSemaphore& SharedSemaphore::operator=(SharedSemaphore&&) noexcept = default;
+
+VkSemaphore SharedSemaphore::handle() const { return impl_->semaphore; }
+
+int SharedSemaphore::exportFd() const {
+  return guarded([&] {
+    auto getFd = deviceFunction<PFN_vkGetSemaphoreFdKHR>(impl_->context.device(), "vkGetSemaphoreFdKHR");
+    VkSemaphoreGetFdInfoKHR info{VK_STRUCTURE_TYPE_SEMAPHORE_GET_FD_INFO_KHR};
+    info.semaphore = impl_->semaphore;
+    info.handleType = VK_EXTERNAL_SEMAPHORE_HANDLE_TYPE_OPAQUE_FD_BIT;
+    int fd = -1;
+    VK_CHECK(getFd(impl_->context.device(), &info, &fd));
+    return fd;
+  });
+}
+
+}  // namespace snell

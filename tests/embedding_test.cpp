@@ -1,0 +1,353 @@
+// The public API as a host application uses it (include/snell/snell.h): a
+// scene from the host's own vertex buffers that follows the host's
+// deformation, and an adopted device rendering into the host's image.
+#include "hand_made_device.h"
+
+#include "scene/evaluate.h"
+#include "scene/gltf_writer.h"
+#include "scene/procedural_eye.h"
+#include "scene/view.h"
+
+#include <snell/snell.h>
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+namespace snell::test {
+namespace {
+
+// A host's buffer in mapped, coherent memory: the host writes its deformed
+// vertices into it with the CPU (an engine would run its skinning shader).
+struct HostBuffer {
+  VkDevice device = VK_NULL_HANDLE;
+  VkBuffer buffer = VK_NULL_HANDLE;
+  VkDeviceMemory memory = VK_NULL_HANDLE;
+  float* mapped = nullptr;
+
+  HostBuffer(const snell::Device& d, size_t floats, VkBufferUsageFlags usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT)
+      : device(d.device()) {
+    VkBufferCreateInfo info{VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO};
+    info.size = floats * sizeof(float);
+    info.usage = usage;
+    VK_CHECK(vkCreateBuffer(device, &info, nullptr, &buffer));
+    VkMemoryRequirements needs;
+    vkGetBufferMemoryRequirements(device, buffer, &needs);
+    VkPhysicalDeviceMemoryProperties memory_properties;
+    vkGetPhysicalDeviceMemoryProperties(d.physicalDevice(), &memory_properties);
+    const VkMemoryPropertyFlags wanted = VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT;
+    VkMemoryAllocateInfo allocate{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
+    allocate.allocationSize = needs.size;
+    for (uint32_t t = 0; t < memory_properties.memoryTypeCount; ++t) {
+      if ((needs.memoryTypeBits >> t & 1) && (memory_properties.memoryTypes[t].propertyFlags & wanted) == wanted) {
+        allocate.memoryTypeIndex = t;
+        break;
+      }
+    }
+    VK_CHECK(vkAllocateMemory(device, &allocate, nullptr, &memory));
+    VK_CHECK(vkBindBufferMemory(device, buffer, memory, 0));
+    void* p = nullptr;
+    VK_CHECK(vkMapMemory(device, memory, 0, VK_WHOLE_SIZE, 0, &p));
+    mapped = static_cast<float*>(p);
+  }
+  ~HostBuffer() {
+    vkDestroyBuffer(device, buffer, nullptr);
+    vkFreeMemory(device, memory, nullptr);
+  }
+};
+
+snell::Mat4 toMat4(const glm::dmat4& m) {
+  snell::Mat4 out;
+  for (int c = 0; c < 4; ++c) {
+    for (int r = 0; r < 4; ++r) out[size_t(4 * c + r)] = float(m[c][r]);
+  }
+  return out;
+}
+
+snell::Vec3 toVec3(const glm::dvec3& v) { return {float(v.x), float(v.y), float(v.z)}; }
+
+// The eye's camera as a look-at, so both scenes are seen from exactly the same place.
+snell::View eyeView(const scene::Scene& eye, snell::View::Output output) {
+  scene::View v = scene::resolveView(eye, scene::evaluate(eye, 0.0), {});
+  snell::View view;
+  view.width = 96;
+  view.height = 72;
+  view.output = output;
+  view.camera.eye = toVec3(v.eye);
+  view.camera.target = toVec3(v.eye + v.forward);
+  view.camera.up = toVec3(v.up);
+  view.camera.yfov = float(2.0 * std::atan(v.halfHeight));
+  return view;
+}
+
+// The procedural eye as a host would hand it over: every drawn item a mesh
+// of its own in the host's buffers, its materials, texture and lights.
+struct HostEye {
+  scene::Scene eye = scene::makeEye({.resolution = 24});
+  std::vector<uint32_t> first;  ///< per item: its first vertex in the host's buffers
+  uint32_t vertices = 0;
+  std::unique_ptr<HostBuffer> positions, normals;
+  snell::HostScene host;
+
+  explicit HostEye(const snell::Device& device) {
+    scene::Pose pose = scene::evaluate(eye, 0.0);
+    for (const scene::DrawItem& item : pose.items) {
+      first.push_back(vertices);
+      vertices += uint32_t(eye.shapes[size_t(item.shape)].vertexCount());
+    }
+    positions = std::make_unique<HostBuffer>(device, size_t(vertices) * 3);
+    normals = std::make_unique<HostBuffer>(device, size_t(vertices) * 3);
+    host.name = "host eye";
+    host.positions = positions->buffer;
+    host.normals = normals->buffer;
+    host.vertexCapacity = vertices;
+    for (const scene::Texture& t : eye.textures) host.textures.push_back({t.name, t.width, t.height, t.rgba});
+    for (const scene::Material& m : eye.materials) {
+      snell::Material out;
+      out.name = m.name;
+      out.baseColor = {m.baseColorFactor.r, m.baseColorFactor.g, m.baseColorFactor.b, m.baseColorFactor.a};
+      out.baseColorTexture = m.baseColorTexture.texture;
+      out.transmission = m.transmission;
+      out.ior = m.ior;
+      out.roughness = m.roughness;
+      out.doubleSided = m.doubleSided;
+      host.materials.push_back(out);
+    }
+    for (size_t i = 0; i < pose.items.size(); ++i) {
+      const scene::Shape& shape = eye.shapes[size_t(pose.items[i].shape)];
+      snell::Mesh mesh;
+      mesh.name = shape.name;
+      mesh.firstVertex = first[i];
+      mesh.vertexCount = uint32_t(shape.vertexCount());
+      mesh.indices = shape.indices;
+      for (const glm::vec2& uv : shape.texcoords0) mesh.texcoords.insert(mesh.texcoords.end(), {uv.x, uv.y});
+      mesh.material = shape.material;
+      host.meshes.push_back(mesh);
+      host.instances.push_back({int(i), toMat4(pose.items[i].world)});
+    }
+    for (size_t n = 0; n < eye.nodes.size(); ++n) {
+      if (eye.nodes[n].light < 0) continue;
+      const scene::Light& l = eye.lights[size_t(eye.nodes[n].light)];
+      snell::Light light;
+      light.type = l.type == scene::LightType::Directional ? snell::Light::Type::Directional
+                   : l.type == scene::LightType::Point     ? snell::Light::Type::Point
+                                                           : snell::Light::Type::Spot;
+      light.color = {l.color.r, l.color.g, l.color.b};
+      light.intensity = l.intensity;
+      light.position = toVec3(glm::dvec3(pose.world[n][3]));
+      light.direction = toVec3(-glm::dvec3(pose.world[n][2]));
+      light.innerConeAngle = l.innerConeAngle;
+      light.outerConeAngle = l.outerConeAngle;
+      host.lights.push_back(light);
+    }
+  }
+
+  // What the host does each frame: deform every item on its own and write the
+  // vertices into its buffers; then it tells the renderer what moved.
+  void deformTo(double time, snell::Renderer& renderer) {
+    scene::Pose pose = scene::evaluate(eye, time);
+    for (size_t i = 0; i < pose.items.size(); ++i) {
+      std::vector<glm::dvec3> p, n;
+      scene::deformOnCpu(pose.items[i], p, n);
+      for (size_t v = 0; v < p.size(); ++v) {
+        glm::dvec3 unit = glm::length(n[v]) > 0.0 ? glm::normalize(n[v]) : n[v];
+        for (int c = 0; c < 3; ++c) {
+          positions->mapped[3 * (first[i] + v) + size_t(c)] = float(p[v][c]);
+          normals->mapped[3 * (first[i] + v) + size_t(c)] = float(unit[c]);
+        }
+      }
+      renderer.setTransform(i, toMat4(pose.items[i].world));
+      renderer.markDirty(int(i));
+    }
+  }
+};
+
+struct ImageDifference {
+  float largest = 0;
+  size_t over = 0;  ///< pixels with a channel more than the tolerance apart
+};
+
+ImageDifference compare(const std::vector<float>& a, const std::vector<float>& b, float tolerance) {
+  ImageDifference d;
+  for (size_t p = 0; p + 3 < a.size() && p + 3 < b.size(); p += 4) {
+    float worst = 0;
+    for (int c = 0; c < 3; ++c) worst = std::max(worst, std::abs(a[p + size_t(c)] - b[p + size_t(c)]));
+    d.largest = std::max(d.largest, worst);
+    if (worst > tolerance) ++d.over;
+  }
+  return d;
+}
+
+TEST(Embedding, HostBufferMeshesFollowTheHostsDeformationLikeTheGltfMorphAndSkin) {
+  snell::Device device = snell::Device::create({.validation = true, .synchronizationValidation = true});
+  HostEye hostEye(device);
+  std::filesystem::path glb = std::filesystem::temp_directory_path() / "snell-embedding-eye.glb";
+  scene::saveGlb(hostEye.eye, glb.string());
+
+  snell::Scene fromFile = snell::Scene::load(glb.string());
+  snell::Scene fromHost = snell::Scene::fromHost(hostEye.host);
+  snell::Renderer fileRenderer(device, fromFile);
+  snell::Renderer hostRenderer(device, fromHost);
+  ASSERT_EQ(hostRenderer.instanceCount(), fileRenderer.instanceCount());
+  // The clip squashes (a morph) and turns the eye (a skin) over these times.
+  std::vector<float> first;
+  for (double time : {0.0, 0.9, 1.7}) {
+    for (snell::View::Output output : {snell::View::Output::Trace, snell::View::Output::Viewport}) {
+      snell::View view = eyeView(hostEye.eye, output);
+      fileRenderer.setTime(time);
+      std::vector<float> expected = fileRenderer.read(view);
+      if (first.empty()) first = expected;
+      if (time > 0 && output == snell::View::Output::Trace) {
+        EXPECT_GT(compare(first, expected, 2.0f / 255.0f).over, 50u) << "the eye hardly moved: the test would not see a host that stands still";
+      }
+      hostEye.deformTo(time, hostRenderer);
+      std::vector<float> got = hostRenderer.read(view);
+      if (output == snell::View::Output::Trace) {
+        EXPECT_GE(hostRenderer.lastFrame().treesRefit, time > 0 ? 1u : 0u);
+      }
+      // Float deformation on the host against the deform pass's: the same to
+      // rounding, so a few silhouette pixels at most may flip.
+      ImageDifference d = compare(expected, got, 2.0f / 255.0f);
+      EXPECT_LE(d.over, 3u) << "time " << time << (output == snell::View::Output::Trace ? " trace" : " viewport")
+                            << ": largest difference " << d.largest;
+      std::printf("time %.1f %s: %zu of %zu pixels over 2/255, largest %.5f\n", time,
+                  output == snell::View::Output::Trace ? "trace" : "viewport", d.over, expected.size() / 4,
+                  double(d.largest));
+    }
+  }
+  EXPECT_EQ(device.validationMessages(), 0u);
+  std::filesystem::remove(glb);
+}
+
+TEST(Embedding, HostSceneRefusesAMeshPastItsBuffers) {
+  snell::Device device = snell::Device::create({.validation = true});
+  HostBuffer buffer(device, 9);
+  snell::HostScene host;
+  host.positions = host.normals = buffer.buffer;
+  host.vertexCapacity = 3;
+  host.meshes.push_back({"past the end", 1, 3, {0, 1, 2}, {}, -1});
+  host.instances.push_back({0});
+  snell::Scene scene = snell::Scene::fromHost(host);
+  try {
+    snell::Renderer renderer(device, scene);
+    FAIL() << "a mesh past the host's buffers was accepted";
+  } catch (const snell::Error& e) {
+    EXPECT_NE(std::string(e.what()).find("past the host buffers' 3"), std::string::npos) << e.what();
+  }
+}
+
+TEST(Embedding, LoadingAMissingFileThrowsAnErrorNamingIt) {
+  try {
+    snell::Scene::load("/no/such/eye.glb");
+    FAIL() << "a missing file loaded";
+  } catch (const snell::Error& e) {
+    EXPECT_NE(std::string(e.what()).find("/no/such/eye.glb"), std::string::npos) << e.what();
+  }
+}
+
+// What a host's frame loop does: its own device (validation with
+// synchronisation on), snell renders into the host's image with a semaphore
+// the host's own command buffer waits for; that command buffer reads the image.
+TEST(Embedding, AdoptedDeviceRendersIntoTheHostsImageForAHundredFramesWithoutValidationMessages) {
+  HandMadeDevice host(true, true);
+  snell::HostDevice handles{host.instance, host.physical, host.device, host.family, host.queue, host.features13};
+  scene::Scene eye = scene::makeEye({.resolution = 16});
+  std::filesystem::path glb = std::filesystem::temp_directory_path() / "snell-embedding-frames.glb";
+  scene::saveGlb(eye, glb.string());
+  {
+    snell::Device device = snell::Device::adopt(handles);
+    snell::Scene scene = snell::Scene::load(glb.string());
+    snell::Renderer renderer(device, scene);
+    snell::View view = eyeView(eye, snell::View::Output::Viewport);
+    view.width = 48, view.height = 36;
+
+    // The host's image, its readback buffer, its command buffer, semaphore and fence.
+    VkImageCreateInfo imageInfo{VK_STRUCTURE_TYPE_IMAGE_CREATE_INFO};
+    imageInfo.imageType = VK_IMAGE_TYPE_2D;
+    imageInfo.format = VK_FORMAT_R8G8B8A8_SRGB;
+    imageInfo.extent = {view.width, view.height, 1};
+    imageInfo.mipLevels = imageInfo.arrayLayers = 1;
+    imageInfo.samples = VK_SAMPLE_COUNT_1_BIT;
+    imageInfo.usage = VK_IMAGE_USAGE_TRANSFER_DST_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT | VK_IMAGE_USAGE_SAMPLED_BIT;
+    VkImage image;
+    VK_CHECK(vkCreateImage(host.device, &imageInfo, nullptr, &image));
+    VkMemoryRequirements needs;
+    vkGetImageMemoryRequirements(host.device, image, &needs);
+    VkMemoryAllocateInfo allocate{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
+    allocate.allocationSize = needs.size;
+    while (!(needs.memoryTypeBits >> allocate.memoryTypeIndex & 1)) ++allocate.memoryTypeIndex;
+    VkDeviceMemory imageMemory;
+    VK_CHECK(vkAllocateMemory(host.device, &allocate, nullptr, &imageMemory));
+    VK_CHECK(vkBindImageMemory(host.device, image, imageMemory, 0));
+    HostBuffer readback(device, size_t(view.width) * view.height, VK_BUFFER_USAGE_TRANSFER_DST_BIT);
+    VkCommandPoolCreateInfo poolInfo{VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO};
+    poolInfo.flags = VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT;
+    poolInfo.queueFamilyIndex = host.family;
+    VkCommandPool pool;
+    VK_CHECK(vkCreateCommandPool(host.device, &poolInfo, nullptr, &pool));
+    VkCommandBufferAllocateInfo cbInfo{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
+    cbInfo.commandPool = pool;
+    cbInfo.commandBufferCount = 1;
+    VkCommandBuffer cb;
+    VK_CHECK(vkAllocateCommandBuffers(host.device, &cbInfo, &cb));
+    VkSemaphoreCreateInfo semaphoreInfo{VK_STRUCTURE_TYPE_SEMAPHORE_CREATE_INFO};
+    VkSemaphore rendered;
+    VK_CHECK(vkCreateSemaphore(host.device, &semaphoreInfo, nullptr, &rendered));
+    VkFenceCreateInfo fenceInfo{VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
+    VkFence fence;
+    VK_CHECK(vkCreateFence(host.device, &fenceInfo, nullptr, &fence));
+
+    size_t changedFrames = 0;
+    std::vector<uint8_t> previous;
+    for (int frame = 0; frame < 100; ++frame) {
+      renderer.setTime(0.04 * frame);
+      VkImageLayout before = frame == 0 ? VK_IMAGE_LAYOUT_UNDEFINED : VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL;
+      snell::Target target{image, imageInfo.format, view.width, view.height, before, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL};
+      renderer.render(view, target, {.signal = rendered});
+
+      VkCommandBufferBeginInfo begin{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
+      begin.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
+      VK_CHECK(vkBeginCommandBuffer(cb, &begin));
+      VkBufferImageCopy region{};
+      region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
+      region.imageExtent = {view.width, view.height, 1};
+      vkCmdCopyImageToBuffer(cb, image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, readback.buffer, 1, &region);
+      VkMemoryBarrier toHost{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
+      toHost.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
+      toHost.dstAccessMask = VK_ACCESS_HOST_READ_BIT;
+      vkCmdPipelineBarrier(cb, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_HOST_BIT, 0, 1, &toHost, 0, nullptr,
+                           0, nullptr);
+      VK_CHECK(vkEndCommandBuffer(cb));
+      VkPipelineStageFlags waitStage = VK_PIPELINE_STAGE_TRANSFER_BIT;
+      VkSubmitInfo submit{VK_STRUCTURE_TYPE_SUBMIT_INFO};
+      submit.waitSemaphoreCount = 1;
+      submit.pWaitSemaphores = &rendered;
+      submit.pWaitDstStageMask = &waitStage;
+      submit.commandBufferCount = 1;
+      submit.pCommandBuffers = &cb;
+      VK_CHECK(vkQueueSubmit(host.queue, 1, &submit, fence));
+      VK_CHECK(vkWaitForFences(host.device, 1, &fence, VK_TRUE, UINT64_MAX));
+      VK_CHECK(vkResetFences(host.device, 1, &fence));
+      const auto* bytes = reinterpret_cast<const uint8_t*>(readback.mapped);
+      std::vector<uint8_t> pixels(bytes, bytes + size_t(view.width) * view.height * 4);
+      if (!previous.empty() && pixels != previous) ++changedFrames;
+      previous = std::move(pixels);
+    }
+    device.waitIdle();
+    EXPECT_GT(changedFrames, 50u) << "the host's image should follow the animation";
+    vkDestroyFence(host.device, fence, nullptr);
+    vkDestroySemaphore(host.device, rendered, nullptr);
+    vkDestroyCommandPool(host.device, pool, nullptr);
+    vkDestroyImage(host.device, image, nullptr);
+    vkFreeMemory(host.device, imageMemory, nullptr);
+  }
+  EXPECT_EQ(host.validationMessages, 0);
+  std::filesystem::remove(glb);
+}
+
+}  // namespace
+}  // namespace snell::test
