@@ -37,13 +37,13 @@ struct HostBuffer {
     VK_CHECK(vkCreateBuffer(device, &info, nullptr, &buffer));
     VkMemoryRequirements needs;
     vkGetBufferMemoryRequirements(device, buffer, &needs);
-    VkPhysicalDeviceMemoryProperties memory_properties;
-    vkGetPhysicalDeviceMemoryProperties(d.physicalDevice(), &memory_properties);
+    VkPhysicalDeviceMemoryProperties memoryProperties;
+    vkGetPhysicalDeviceMemoryProperties(d.physicalDevice(), &memoryProperties);
     const VkMemoryPropertyFlags wanted = VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT;
     VkMemoryAllocateInfo allocate{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
     allocate.allocationSize = needs.size;
-    for (uint32_t t = 0; t < memory_properties.memoryTypeCount; ++t) {
-      if ((needs.memoryTypeBits >> t & 1) && (memory_properties.memoryTypes[t].propertyFlags & wanted) == wanted) {
+    for (uint32_t t = 0; t < memoryProperties.memoryTypeCount; ++t) {
+      if ((needs.memoryTypeBits >> t & 1) && (memoryProperties.memoryTypes[t].propertyFlags & wanted) == wanted) {
         allocate.memoryTypeIndex = t;
         break;
       }

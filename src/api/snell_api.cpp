@@ -55,7 +55,6 @@ const char* version() { return SNELL_VERSION; }
 
 struct Device::Impl {
   std::unique_ptr<vk::Context> context;
-  bool interop = false;
 };
 
 Device::Device(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
@@ -76,7 +75,6 @@ Device Device::create(const DeviceOptions& options) {
     }
     auto impl = std::make_unique<Impl>();
     impl->context = vk::Context::create(desc);
-    impl->interop = options.interop;
     return Device(std::move(impl));
   });
 }
@@ -106,7 +104,8 @@ std::string Device::name() const { return impl_->context->facts().name; }
 uint64_t Device::validationMessages() const { return impl_->context->validationMessageCount(); }
 
 bool Device::exportsSemaphores() const {
-  if (!impl_->interop || !impl_->context->enabled(VK_KHR_EXTERNAL_SEMAPHORE_FD_EXTENSION_NAME)) return false;
+  // Enabled only when DeviceOptions::interop asked for it and the device has it.
+  if (!impl_->context->enabled(VK_KHR_EXTERNAL_SEMAPHORE_FD_EXTENSION_NAME)) return false;
   VkPhysicalDeviceExternalSemaphoreInfo info{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_EXTERNAL_SEMAPHORE_INFO};
   info.handleType = VK_EXTERNAL_SEMAPHORE_HANDLE_TYPE_OPAQUE_FD_BIT;
   VkExternalSemaphoreProperties properties{VK_STRUCTURE_TYPE_EXTERNAL_SEMAPHORE_PROPERTIES};
@@ -298,12 +297,13 @@ struct Renderer::Impl {
     return render::methodView(viewport ? render::Method::Masked : render::Method::Trace, settings, raster);
   }
 
-  // Near and far planes around the scene: a glTF scene's bounds at the pose, a
+  // Near and far planes around the scene, every frame, so cheaply: a glTF
+  // scene's rest boxes as its pose moves them (not its deformed vertices), a
   // host scene's promised boxes (its vertices are on the GPU only).
   void fitDepth(const scene::View& view, render::RasterOptions& raster) const {
     glm::dvec3 lo(INFINITY), hi(-INFINITY);
     if (!scene.host.positions) {
-      scene::sceneBounds(scene.scene, pose, lo, hi);
+      scene::approximateBounds(scene.scene, pose, lo, hi);
     } else {
       for (const scene::DrawItem& item : pose.items) {
         const scene::HostVertices& h = *scene.scene.shapes[size_t(item.shape)].host;
@@ -488,7 +488,9 @@ struct SharedImage::Impl {
 SharedImage::SharedImage(Device& device, uint32_t width, uint32_t height, VkFormat format)
     : impl_(guarded([&] {
         vk::Context& context = *device.impl().context;
-        if (width == 0 || height == 0) throw Error("shared image: its size is " + std::to_string(width) + "x" + std::to_string(height));
+        if (width == 0 || height == 0) {
+          throw Error("shared image: its size is " + std::to_string(width) + "x" + std::to_string(height));
+        }
         deviceFunction<PFN_vkGetMemoryFdKHR>(context.device(), "vkGetMemoryFdKHR");
         return std::make_unique<Impl>(context, width, height, format);
       })) {}
