@@ -12,6 +12,9 @@
 
 #include <gtest/gtest.h>
 
+#include <fcntl.h>
+#include <unistd.h>
+
 #include <cmath>
 #include <cstring>
 #include <filesystem>
@@ -347,6 +350,43 @@ TEST(Embedding, AdoptedDeviceRendersIntoTheHostsImageForAHundredFramesWithoutVal
   }
   EXPECT_EQ(host.validationMessages, 0);
   std::filesystem::remove(glb);
+}
+
+// What an OpenGL host imports: the image's memory and, where the device can
+// export them, semaphores that chain frames without a host wait.
+TEST(Embedding, SharedImageAndSemaphoresExportFileDescriptorsAndChainFrames) {
+  scene::Scene eye = scene::makeEye({.resolution = 16});
+  std::filesystem::path glb = std::filesystem::temp_directory_path() / "snell-embedding-shared.glb";
+  scene::saveGlb(eye, glb.string());
+  snell::Device device = snell::Device::create({.interop = true});
+  snell::Scene scene = snell::Scene::load(glb.string());
+  std::filesystem::remove(glb);
+  snell::Renderer renderer(device, scene);
+  snell::View view = eyeView(eye, snell::View::Output::Viewport);
+  snell::SharedImage shared(device, view.width, view.height);
+  int memoryFd = shared.exportMemory();
+  EXPECT_GE(fcntl(memoryFd, F_GETFD), 0);
+  EXPECT_GE(shared.memorySize(), uint64_t(view.width) * view.height * 4);
+  close(memoryFd);
+  if (!device.exportsSemaphores()) {
+    renderer.wait(renderer.render(view, shared.target(VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_GENERAL)));
+    GTEST_SKIP() << device.name() << " cannot export semaphores (VK_KHR_external_semaphore_fd); the image was checked";
+  }
+  snell::SharedSemaphore chain(device);
+  int semaphoreFd = chain.exportFd();
+  EXPECT_GE(fcntl(semaphoreFd, F_GETFD), 0);
+  close(semaphoreFd);
+  // Each frame waits for the one before through the semaphore, then signals it.
+  uint64_t last = 0;
+  for (int frame = 0; frame < 10; ++frame) {
+    renderer.setTime(0.1 * frame);
+    VkImageLayout before = frame == 0 ? VK_IMAGE_LAYOUT_UNDEFINED : VK_IMAGE_LAYOUT_GENERAL;
+    snell::Sync sync{frame == 0 ? VK_NULL_HANDLE : chain.handle(), VK_PIPELINE_STAGE_TRANSFER_BIT,
+                     frame == 9 ? VK_NULL_HANDLE : chain.handle()};
+    last = renderer.render(view, shared.target(before, VK_IMAGE_LAYOUT_GENERAL), sync);
+  }
+  renderer.wait(last);
+  EXPECT_EQ(device.validationMessages(), 0u);
 }
 
 }  // namespace
