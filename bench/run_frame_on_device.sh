@@ -10,6 +10,8 @@
 #   bench/run_frame_on_device.sh optics  # each optics feature's cost (1920x1080) and error (320x240), stress grid's optics group
 #   bench/run_frame_on_device.sh textures # load times of the textured sample models (three runs each)
 #   bench/run_frame_on_device.sh maps    # refraction-map beside the trace and the raster methods (1920x1080), drift table
+#   bench/run_frame_on_device.sh robust  # the long runs: bench frame --soak (validation on) on the GPU while the
+#                                        # libFuzzer targets (carried in .fuzz/) run on the other cores
 # Results land in $OUT.
 set -uo pipefail
 for f in .gl/*.deb; do dpkg -x "$f" /; done
@@ -27,6 +29,30 @@ if [[ $step == all || $step == tests ]]; then
   SNELL_VALIDATION=1 .carry/snell_tests --gtest_brief=1 \
     --gtest_filter='-SnellCommand.*:SceneInfoCommand.*:RenderCommand.*:BenchMethods.*:BakeCommand.*:ExportWebCommand.*:Viewer.*:GlHost.*:ProceduralEye.PassesTheKhronos*' > "$OUT/tests.log" 2>&1
   echo "tests exit $?"; grep -E "FAILED|PASSED|tests ran" "$OUT/tests.log" | tail -12
+fi
+if [[ $step == robust ]]; then
+  echo "== soak: bench frame --viewport --soak ${SOAK_SECONDS:-570}, validation on, in the background"
+  ((${SOAK_SECONDS:-570} > 0)) && SNELL_VALIDATION=1 .carry/snell bench frame --viewport --soak "${SOAK_SECONDS:-570}" --json "$OUT/soak.json" \
+    >"$OUT/soak.log" 2>&1 &
+  soak=$!
+  logs=$(mktemp -d)
+  # The glTF targets (the CLI's links OpenImageIO, which is not carried: it runs on the Debian machine).
+  for t in gltf evaluate info; do
+    dict=.fuzz/gltf.dict
+    corpus=/tmp/corpus-$t
+    mkdir -p "$corpus"
+    cp -r ".fuzz/corpus/$t/." "$corpus/" 2>/dev/null
+    ASAN_OPTIONS=detect_leaks=1 ".fuzz/fuzz_$t" -fork="${FUZZ_JOBS:-13}" -ignore_crashes=1 -max_total_time="${FUZZ_SECONDS:-125}" \
+      -max_len=65536 -timeout=10 -rss_limit_mb=2048 -dict="$dict" -artifact_prefix="$OUT/crash-$t-" \
+      "$corpus" ".fuzz/seeds/$t" >"$logs/fuzz-$t.full" 2>&1
+    rc=$?
+    grep -E '^#[0-9]+|INFO: (fork|-fork|Seed|Loaded)|ERROR|SUMMARY|Deadly|crash' "$logs/fuzz-$t.full" | tail -200 >"$logs/fuzz-$t.log"
+    echo "fuzz $t exit $rc: $(grep -E '^#[0-9]+' "$logs/fuzz-$t.full" | tail -1)"
+  done
+  tar -C "$logs" -cf "$OUT/fuzz-logs.tar" $(cd "$logs" && ls *.log)
+  wait $soak
+  echo "soak exit $?"
+  tail -26 "$OUT/soak.log"
 fi
 if [[ $step == all || $step == bench ]]; then
   s=.carry/snell

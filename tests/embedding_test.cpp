@@ -19,6 +19,7 @@
 #include <cstring>
 #include <filesystem>
 #include <string>
+#include <thread>
 #include <vector>
 
 namespace snell::test {
@@ -386,6 +387,40 @@ TEST(Embedding, SharedImageAndSemaphoresExportFileDescriptorsAndChainFrames) {
     last = renderer.render(view, shared.target(before, VK_IMAGE_LAYOUT_GENERAL), sync);
   }
   renderer.wait(last);
+  EXPECT_EQ(device.validationMessages(), 0u);
+}
+
+// Two renderers on one device, each on its own thread, as two viewports of a
+// host might: the device's lock makes them take turns, and each thread's
+// images are those a lone renderer makes.
+TEST(Embedding, TwoRenderersOnOneDeviceRenderFromTwoThreads) {
+  scene::Scene eye = scene::makeEye({.resolution = 16});
+  std::filesystem::path glb = std::filesystem::temp_directory_path() / "snell-embedding-threads.glb";
+  scene::saveGlb(eye, glb.string());
+  snell::Device device = snell::Device::create();
+  snell::Scene scene = snell::Scene::load(glb.string());
+  std::filesystem::remove(glb);
+  snell::View view = eyeView(eye, snell::View::Output::Viewport);
+  view.width = 48, view.height = 36;
+  constexpr int kFrames = 12;
+  auto renderAll = [&](std::vector<std::vector<float>>& images) {
+    snell::Renderer renderer(device, scene);
+    for (int frame = 0; frame < kFrames; ++frame) {
+      renderer.setTime(0.1 * frame);
+      images.push_back(renderer.read(view));
+    }
+  };
+  std::vector<std::vector<float>> alone, first, second;
+  renderAll(alone);
+  std::thread a([&] { renderAll(first); }), b([&] { renderAll(second); });
+  a.join();
+  b.join();
+  ASSERT_EQ(first.size(), size_t(kFrames));
+  ASSERT_EQ(second.size(), size_t(kFrames));
+  for (int frame = 0; frame < kFrames; ++frame) {
+    EXPECT_EQ(first[frame], alone[frame]) << "frame " << frame;
+    EXPECT_EQ(second[frame], alone[frame]) << "frame " << frame;
+  }
   EXPECT_EQ(device.validationMessages(), 0u);
 }
 

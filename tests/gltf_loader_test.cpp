@@ -339,5 +339,32 @@ TEST(GltfLoader, ByteFlippedCopiesLoadOrFailCleanly) {
   }
 }
 
+// Found by the fuzzer (tests/fuzz/regressions): tinygltf passed the image on
+// without checking its view, and the loader read past the binary chunk.
+TEST(GltfLoader, GlbImageWhoseViewRunsPastItsBufferIsRefusedBeforeItIsRead) {
+  std::string json =
+      R"({"asset":{"version":"2.0"},"buffers":[{"byteLength":4}],)"
+      R"("bufferViews":[{"buffer":0,"byteOffset":0,"byteLength":100000}],)"
+      R"("images":[{"bufferView":0,"mimeType":"image/png"}]})";
+  while (json.size() % 4) json += ' ';
+  auto u32 = [](std::string& out, uint32_t v) { out.append(reinterpret_cast<const char*>(&v), 4); };
+  std::string glb = "glTF";
+  u32(glb, 2);
+  u32(glb, uint32_t(12 + 8 + json.size() + 8 + 4));
+  u32(glb, uint32_t(json.size()));
+  glb += "JSON" + json;
+  u32(glb, 4);
+  glb += std::string("BIN\0", 4) + std::string("\x89PNG", 4);
+  std::filesystem::path file = std::filesystem::temp_directory_path() / "snell_image_view_past_buffer.glb";
+  std::ofstream(file, std::ios::binary) << glb;
+  try {
+    loadGltf(file.string());
+    ADD_FAILURE() << "the file loaded";
+  } catch (const SceneError& e) {
+    EXPECT_NE(std::string(e.what()).find("bufferView lies outside its buffer"), std::string::npos) << e.what();
+  }
+  std::filesystem::remove(file);
+}
+
 }  // namespace
 }  // namespace snell::test

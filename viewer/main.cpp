@@ -2,6 +2,7 @@
 #include "viewer.h"
 
 #include "cli/cli.h"
+#include "cli/image_file.h"
 
 #include <cstdio>
 #include <exception>
@@ -88,11 +89,11 @@ snell::viewer::ViewerOptions parse(const std::vector<std::string>& args) {
     } else if (a == "--frames") {
       o.frames = snell::cli::parseCount(a, v);
     } else if (a == "--screenshot") {
-      o.screenshot = v;
+      snell::cli::checkWritable(o.screenshot = v);
     } else if (a == "--script") {
       o.script = v;
     } else if (a == "--json") {
-      o.json = v;
+      snell::cli::checkWritable(o.json = v);
     } else if (a == "--scene") {
       o.load.scene = v;
     } else if (a == "--ignore-extension") {

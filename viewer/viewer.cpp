@@ -27,9 +27,9 @@
 
 #include <algorithm>
 #include <chrono>
+#include <deque>
 #include <cmath>
 #include <cstdio>
-#include <fstream>
 #include <map>
 #include <memory>
 #include <optional>
@@ -76,6 +76,8 @@ class Viewer {
   int run();
 
  private:
+  int runFrames();
+  int reportGpuFailure(const vk::VulkanError& error);
   void openWindow();
   void useScene(std::unique_ptr<scene::Scene> scene, int camera);
   bool cameraResolves(int camera) const;
@@ -127,7 +129,17 @@ class Viewer {
   double lastX_ = 0, lastY_ = 0;
   int buttons_ = 0;  ///< bit per GLFW mouse button held
   int dragMods_ = 0;
-  std::vector<FrameRecord> records_;
+  // The latest frames' records (the JSON's medians): bounded, so a long run's
+  // memory stays flat.
+  static constexpr size_t kKeptRecords = 512;
+  std::deque<FrameRecord> records_;
+  uint64_t framesDrawn_ = 0;
+  struct MemorySample {
+    uint64_t frame, hostBytes, deviceBytes;
+    std::string scene;
+  };
+  std::vector<MemorySample> memorySamples_;  ///< before each scene switch, and at the end
+  void sampleMemory(uint64_t frame);
   std::vector<vk::PassTime> lastPasses_;
   render::FrameStats lastStats_;
   uint64_t pendingFrame_ = 0;  ///< the renderer's frame submitted last, not yet waited for
@@ -796,6 +808,17 @@ void Viewer::writeScreenshot() {
   std::printf("wrote %s: %ux%u\n", options_.screenshot.c_str(), image.width, image.height);
 }
 
+void Viewer::sampleMemory(uint64_t frame) {
+  // The frames before are finished, so what they retired is freed first.
+  if (pendingFrame_) noteFrame(renderer_->wait(pendingFrame_), pendingCpuMs_);
+  pendingFrame_ = 0;
+  context_->collectRetired();
+  MemorySample s{frame, cli::hostResidentBytes(), context_->memoryInUse(), scene_->source};
+  memorySamples_.push_back(s);
+  std::printf("memory at frame %llu (%s): host %.1f MiB resident, GPU %.1f MiB in use\n", (unsigned long long)frame,
+              s.scene.c_str(), double(s.hostBytes) / 1048576.0, double(s.deviceBytes) / 1048576.0);
+}
+
 void Viewer::writeJson(double seconds) const {
   std::vector<double> cpu;
   std::map<std::string, std::vector<double>> gpu;
@@ -835,7 +858,7 @@ void Viewer::writeJson(double seconds) const {
                      ",\n  \"viewports\": " + std::to_string(toggles_.split ? 2 : 1) +
                      ",\n  \"refraction\": " + (toggles_.refraction ? "true" : "false") +
                      ",\n  \"ui\": " + (toggles_.ui ? "true" : "false") +
-                     ",\n  \"frames\": " + std::to_string(records_.size()) +
+                     ",\n  \"frames\": " + std::to_string(framesDrawn_) +
                      ",\n  \"frames_in_medians\": " + std::to_string(cpu.size()) +
                      ",\n  \"wall_seconds\": " + std::to_string(seconds) +
                      ",\n  \"median_frame_ms\": " + std::to_string(median(cpu)) +
@@ -850,14 +873,15 @@ void Viewer::writeJson(double seconds) const {
     text += std::string(firstPass ? "\n" : ",\n") + "    \"" + name + "\": " + std::to_string(median(v));
     firstPass = false;
   }
-  text += "\n  }\n}\n";
-  std::string temp = options_.json + ".partial";
-  {
-    std::ofstream out(temp);
-    out << text;
-    if (!out) throw std::runtime_error(options_.json + ": cannot write");
+  text += "\n  },\n  \"memory_samples\": [";
+  for (size_t i = 0; i < memorySamples_.size(); ++i) {
+    const MemorySample& m = memorySamples_[i];
+    text += std::string(i ? "," : "") + "\n    {\"frame\": " + std::to_string(m.frame) + ", \"scene\": \"" +
+            cli::jsonEscape(m.scene) + "\", \"host_resident_bytes\": " + std::to_string(m.hostBytes) +
+            ", \"device_bytes\": " + std::to_string(m.deviceBytes) + "}";
   }
-  std::rename(temp.c_str(), options_.json.c_str());
+  text += "\n  ]\n}\n";
+  cli::writeTextFile(options_.json, text);
   std::printf("wrote %s\n", options_.json.c_str());
 }
 
@@ -868,10 +892,34 @@ void Viewer::noteFrame(const render::FrameResult& result, double cpuMs) {
   record.cpuMs = cpuMs;
   record.stats = result.stats;
   for (const vk::PassTime& p : lastPasses_) record.gpuMs[p.name] += p.milliseconds;
+  if (records_.size() == kKeptRecords) records_.pop_front();
   records_.push_back(record);
+  ++framesDrawn_;
 }
 
 int Viewer::run() {
+  try {
+    return runFrames();
+  } catch (const vk::VulkanError& e) {
+    return reportGpuFailure(e);
+  }
+}
+
+// A lost device or a failed submission ends the drawing, not the viewer: the
+// window stays up with the failure in its title until the user closes it,
+// and nothing half-drawn is written.
+int Viewer::reportGpuFailure(const vk::VulkanError& error) {
+  std::fprintf(stderr, "snell-view: error: the GPU failed, so nothing more is drawn: %s\n", error.what());
+  if (window_ && options_.frames == 0) {
+    std::string title = "snell-view: GPU failure (" + std::string(vk::resultName(error.result())) +
+                        "); see the terminal, close to quit";
+    glfwSetWindowTitle(window_, title.c_str());
+    while (!glfwWindowShouldClose(window_)) glfwWaitEventsTimeout(0.1);
+  }
+  return 1;
+}
+
+int Viewer::runFrames() {
   auto start = Clock::now(), last = start;
   double frameSeconds = 0.0;
   for (uint64_t frame = 0; !quit_ && (options_.frames == 0 || frame < options_.frames); ++frame) {
@@ -881,6 +929,7 @@ int Viewer::run() {
     }
     applyScript(frame);
     if (!pendingLoad_.empty()) {
+      sampleMemory(frame);
       std::string path = std::exchange(pendingLoad_, {});
       try {
         useScene(std::make_unique<scene::Scene>(scene::loadGltf(path, options_.load)), -1);
@@ -957,7 +1006,8 @@ int Viewer::run() {
   if (pendingFrame_) noteFrame(renderer_->wait(pendingFrame_), pendingCpuMs_);
   pendingFrame_ = 0;
   double seconds = std::chrono::duration<double>(Clock::now() - start).count();
-  std::printf("%zu frames in %.2f s on %s%s\n", records_.size(), seconds, context_->facts().name.c_str(),
+  sampleMemory(framesDrawn_);
+  std::printf("%llu frames in %.2f s on %s%s\n", (unsigned long long)framesDrawn_, seconds, context_->facts().name.c_str(),
               swapchain_ ? (", swapchain recreated " + std::to_string(swapchain_->recreations() - 1) + " time(s)").c_str()
                          : ", offscreen");
   writeJson(seconds);

@@ -6,9 +6,11 @@
 // message says what failed (and which file, for files). snell never aborts
 // the host; after an Error the object that threw is still safe to destroy.
 //
-// Threads: a Device, and every Scene, Renderer and SharedImage made on it,
-// belong to one thread at a time: the host calls them from one thread, or
-// serialises the calls itself. Different Devices are independent. snell
+// Threads: Renderers on one Device may be used from different threads at once:
+// their calls that use the GPU (construction, render, wait, read, destruction)
+// take turns on a lock the Device holds. A Scene is read-only once made and
+// may be shared by them. Each Renderer (and each SharedImage, SharedSemaphore)
+// belongs to one thread at a time. Different Devices are independent. snell
 // submits to the Device's queue; a host that submits to the same queue from
 // another thread must lock around snell's calls that submit (Renderer::render,
 // Renderer::read), as Vulkan requires of any queue.

@@ -17,6 +17,7 @@
 #include <glm/gtc/type_ptr.hpp>
 
 #include <map>
+#include <mutex>
 #include <optional>
 #include <utility>
 
@@ -55,6 +56,9 @@ const char* version() { return SNELL_VERSION; }
 
 struct Device::Impl {
   std::unique_ptr<vk::Context> context;
+  // Renderers on several threads share the context (its queue, its deferred
+  // destruction, its memory count): their GPU calls take turns here.
+  std::recursive_mutex mutex;
 };
 
 Device::Device(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
@@ -260,6 +264,7 @@ double Scene::duration() const { return scene::animationDuration(impl_->scene); 
 // ---------------------------------------------------------------- Renderer
 
 struct Renderer::Impl {
+  std::recursive_mutex& mutex;  ///< the Device's
   vk::Context& context;
   Scene::Impl& scene;
   scene::Pose pose;
@@ -268,7 +273,9 @@ struct Renderer::Impl {
   FrameInfo last;
 
   Impl(Device& device, Scene& s, const RendererOptions& options)
-      : context(*device.impl().context), scene(s.impl()), pose(scene::evaluate(scene.scene, 0.0)) {
+      : mutex(device.impl().mutex), context(*device.impl().context), scene(s.impl()),
+        pose(scene::evaluate(scene.scene, 0.0)) {
+    std::lock_guard lock(mutex);
     render::RendererOptions o;
     o.framesInFlight = options.framesInFlight;
     o.host = scene.host;
@@ -326,7 +333,11 @@ struct Renderer::Impl {
 
 Renderer::Renderer(Device& device, Scene& scene, const RendererOptions& options)
     : impl_(guarded([&] { return std::make_unique<Impl>(device, scene, options); })) {}
-Renderer::~Renderer() = default;
+Renderer::~Renderer() {
+  if (!impl_) return;  // moved from
+  std::lock_guard lock(impl_->mutex);
+  impl_->renderer.reset();
+}
 Renderer::Renderer(Renderer&&) noexcept = default;
 Renderer& Renderer::operator=(Renderer&&) noexcept = default;
 
@@ -358,6 +369,7 @@ void Renderer::markDirty(int mesh) {
 
 uint64_t Renderer::render(const View& view, const Target& target, const Sync& sync) {
   return guarded([&] {
+    std::lock_guard lock(impl_->mutex);
     if (!target.image) throw Error("render: the target image is null");
     if (target.width != view.width || target.height != view.height) {
       throw Error("render: the target is " + std::to_string(target.width) + "x" + std::to_string(target.height) +
@@ -400,11 +412,15 @@ uint64_t Renderer::render(const View& view, const Target& target, const Sync& sy
 }
 
 void Renderer::wait(uint64_t frame) {
-  guarded([&] { impl_->note(impl_->renderer->wait(frame)); });
+  guarded([&] {
+    std::lock_guard lock(impl_->mutex);
+    impl_->note(impl_->renderer->wait(frame));
+  });
 }
 
 std::vector<float> Renderer::read(const View& view) {
   return guarded([&] {
+    std::lock_guard lock(impl_->mutex);
     render::FrameRequest frame;
     frame.pose = &impl_->pose;
     frame.views.push_back(impl_->request(view));

@@ -113,6 +113,8 @@ Options parse(const Args& args) {
 
 }  // namespace
 
+void parseBakeOptions(const Args& args) { (void)parse(args); }
+
 int runBake(const Args& args) {
   for (const std::string& a : args) {
     if (a == "--help" || a == "-h") {
@@ -121,6 +123,7 @@ int runBake(const Args& args) {
     }
   }
   Options o = parse(args);
+  checkWritable(o.output);
   scene::Scene scene = o.shot.loadScene();
   std::optional<uint32_t> material;
   if (!o.material.empty()) material = findTexturedMaterial("bake", scene, o.material);

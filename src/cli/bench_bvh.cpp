@@ -1,6 +1,7 @@
 // `snell bench bvh`: how good the GPU's trees are, as SAH cost against a CPU
 // binned-SAH build of the very same triangles (src/ref), per mesh.
 #include "cli/cli.h"
+#include "cli/image_file.h"
 
 #include "ref/sah_bvh.h"
 #include "render/renderer.h"
@@ -10,6 +11,7 @@
 #include "scene/view.h"
 #include "vk/commands.h"
 
+#include <sstream>
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
@@ -120,7 +122,7 @@ int runBenchBvh(const Args& args) {
     }
     if (a == "--json" || a == "--eye-resolution") {
       if (i + 1 >= args.size()) throw UsageError{"bench bvh: " + a + " needs a value"};
-      if (a == "--json") json = args[++i];
+      if (a == "--json") checkWritable(json = args[++i]);
       else eyeResolution = uint32_t(parseCount(a, args[++i]));
     } else if (!a.empty() && a[0] == '-') {
       throw UsageError{"bench bvh: unknown option " + a};
@@ -150,7 +152,7 @@ int runBenchBvh(const Args& args) {
   }
   std::printf("worst ratio %.3f\n", worst);
   if (!json.empty()) {
-    std::ofstream out(json);
+    std::ostringstream out;  // written whole or not at all
     out << "{\n  \"device\": \"" << context->facts().name << "\",\n  \"meshes\": [\n";
     for (size_t i = 0; i < rows.size(); ++i) {
       const Row& r = rows[i];
@@ -162,7 +164,7 @@ int runBenchBvh(const Args& args) {
           << "}" << (i + 1 < rows.size() ? "," : "") << "\n";
     }
     out << "  ],\n  \"worst_ratio\": " << worst << "\n}\n";
-    if (!out) throw std::runtime_error(json + ": could not write");
+    writeTextFile(json, out.str());
   }
   return 0;
 }

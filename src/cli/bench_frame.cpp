@@ -2,6 +2,7 @@
 // build or refit, top level, raster, trace) while the scene animates, medians
 // over many frames, and what each frame did and skipped.
 #include "cli/cli.h"
+#include "cli/image_file.h"
 
 #include "render/method.h"
 #include "render/renderer.h"
@@ -11,6 +12,7 @@
 #include "scene/scene_summary.h"
 #include "scene/view.h"
 
+#include <sstream>
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -43,11 +45,82 @@ options:
   --no-mask           with --viewport: trace every pixel
   --no-refraction     with --viewport: glass left out, nothing traced
   --json FILE         write the results as JSON too
+  --soak SECONDS      render for SECONDS instead, and every twentieth of it
+                      report the frame time, host memory (resident), GPU memory
+                      and validation messages; fails if GPU memory grows
 )";
 
 // The refraction work these tables quote: the refraction passes, and the
 // deform that trees and trace both wait for.
 bool refractionPass(const std::string& name) { return name == "deform" || render::isRefractionPass(name); }
+
+// A long run: is anything growing? Each sample covers a twentieth of the run;
+// only the samples are kept, so the benchmark's own memory stays flat.
+template <typename RenderFrame>
+int soakFrames(const vk::Context& context, const render::Renderer& renderer, RenderFrame&& renderFrame,
+               uint32_t warmup, double seconds, const std::string& json, const std::string& label,
+               const std::string& mode) {
+  struct Sample {
+    double atSeconds = 0;
+    uint64_t frames = 0;
+    double frameMs = 0, wallMs = 0;
+    uint64_t hostBytes = 0, deviceBytes = 0, validation = 0;
+  };
+  std::vector<Sample> samples;
+  double wall = 0;
+  uint64_t f = 0;
+  for (; f < warmup; ++f) renderFrame(f, wall);
+  using Clock = std::chrono::steady_clock;
+  auto start = Clock::now();
+  double interval = seconds / 20.0;
+  std::vector<double> frameMs, wallMs;
+  std::printf("%9s %10s %12s %12s %14s %14s %11s\n", "seconds", "frames", "frame ms", "wall ms", "host MiB",
+              "GPU MiB", "validation");
+  for (;;) {
+    const render::FrameResult& result = renderFrame(f++, wall);
+    double total = 0;
+    for (const vk::PassTime& p : result.passes) total += p.milliseconds;
+    frameMs.push_back(total);
+    wallMs.push_back(wall);
+    double now = std::chrono::duration<double>(Clock::now() - start).count();
+    if (now < interval * double(samples.size() + 1)) continue;
+    Sample s{now, f - warmup, median(frameMs), median(wallMs), hostResidentBytes(), context.memoryInUse(),
+             context.validationMessageCount()};
+    samples.push_back(s);
+    frameMs.clear();
+    wallMs.clear();
+    std::printf("%9.1f %10llu %12.4f %12.4f %14.2f %14.2f %11llu\n", s.atSeconds, (unsigned long long)s.frames, s.frameMs,
+                s.wallMs, double(s.hostBytes) / 1048576.0, double(s.deviceBytes) / 1048576.0,
+                (unsigned long long)s.validation);
+    std::fflush(stdout);
+    if (samples.size() == 20) break;
+  }
+  const Sample &first = samples.front(), &last = samples.back();
+  bool deviceFlat = last.deviceBytes == first.deviceBytes;
+  double hostGrowth = double(last.hostBytes) - double(first.hostBytes);
+  std::printf("%llu frames in %.0f s: GPU memory %s (%.2f MiB to %.2f MiB), host memory %+.2f MiB from the first "
+              "sample, %llu validation message(s); GPU memory by the renderer's own count: %.2f MiB\n",
+              (unsigned long long)last.frames, last.atSeconds, deviceFlat ? "flat" : "GREW",
+              double(first.deviceBytes) / 1048576.0, double(last.deviceBytes) / 1048576.0, hostGrowth / 1048576.0,
+              (unsigned long long)last.validation, double(renderer.memoryBytes()) / 1048576.0);
+  if (!json.empty()) {
+    std::ostringstream out;
+    out << "{\n  \"device\": \"" << jsonEscape(context.facts().name) << "\",\n  \"scene\": \"" << jsonEscape(label)
+        << "\",\n  \"mode\": \"" << mode << "\",\n  \"soak_seconds\": " << seconds << ",\n  \"frames\": " << last.frames
+        << ",\n  \"device_memory_flat\": " << (deviceFlat ? "true" : "false")
+        << ",\n  \"host_growth_bytes\": " << int64_t(hostGrowth) << ",\n  \"samples\": [\n";
+    for (size_t i = 0; i < samples.size(); ++i) {
+      const Sample& s = samples[i];
+      out << "    {\"seconds\": " << s.atSeconds << ", \"frames\": " << s.frames << ", \"frame_median_ms\": " << s.frameMs
+          << ", \"wall_median_ms\": " << s.wallMs << ", \"host_resident_bytes\": " << s.hostBytes
+          << ", \"device_bytes\": " << s.deviceBytes << ", \"validation_messages\": " << s.validation << "}"
+          << (i + 1 < samples.size() ? "," : "") << "\n";
+    }
+    out << "  ]\n}\n";
+    writeTextFile(json, out.str());
+  }
+  return deviceFlat && last.validation == 0 ? 0 : 1;
+}
 
 }  // namespace
 
@@ -56,6 +129,7 @@ int runBenchFrame(const Args& args) {
   scene::EyeOptions eye;
   bool viewport = false, masked = true, refraction = true;
   std::string json, file;
+  double soak = 0;
   for (size_t i = 0; i < args.size(); ++i) {
     const std::string& a = args[i];
     if (a == "--help" || a == "-h") {
@@ -85,7 +159,10 @@ int runBenchFrame(const Args& args) {
     } else if (a == "--crowd") {
       eye.crowd = uint32_t(parseCount(a, v));
     } else if (a == "--json") {
-      json = v;
+      checkWritable(json = v);
+    } else if (a == "--soak") {
+      soak = parseNumbers(a, v, 1)[0];
+      if (!(soak > 0)) throw UsageError{"bench frame: --soak takes seconds above 0, got " + v};
     } else {
       throw UsageError{"bench frame: unknown option " + a};
     }
@@ -118,7 +195,8 @@ int runBenchFrame(const Args& args) {
   std::map<std::string, std::vector<double>> counters;
   std::vector<std::string> counterOrder = {"items deformed", "trees refit", "trees rebuilt", "triangles refit",
                                            "pixels traced", "dispatches", "draws"};
-  for (uint32_t f = 0; f < warmup + frames; ++f) {
+  // One animated frame, rendered and waited for; its wall time in `wall`.
+  auto renderFrame = [&](uint64_t f, double& wall) -> const render::FrameResult& {
     double t = std::fmod(double(f) / 24.0, duration);
     scene::Pose pose = scene::evaluate(scene, t);
     render::ViewRequest view;
@@ -137,7 +215,13 @@ int runBenchFrame(const Args& args) {
     request.views.push_back(view);
     auto start = std::chrono::steady_clock::now();
     const render::FrameResult& result = renderer.wait(renderer.submit(request));
-    double wall = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+    wall = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+    return result;
+  };
+  if (soak > 0) return soakFrames(*context, renderer, renderFrame, warmup, soak, json, label, mode);
+  for (uint32_t f = 0; f < warmup + frames; ++f) {
+    double wall = 0;
+    const render::FrameResult& result = renderFrame(f, wall);
     // The first build happens once, on the first frame: report it even though it is warm-up.
     bool measured = f >= warmup;
     double total = 0, refractionTotal = 0;
@@ -180,7 +264,7 @@ int runBenchFrame(const Args& args) {
   std::printf("\nGPU memory (geometry, deformation, trees, per-frame tables): %.2f MiB, trees %.1f bytes per triangle\n",
               double(renderer.memoryBytes()) / 1048576.0, renderer.treeBytesPerTriangle());
   if (!json.empty()) {
-    std::ofstream out(json);
+    std::ostringstream out;  // written whole or not at all
     out << "{\n  \"device\": \"" << jsonEscape(context->facts().name) << "\",\n  \"scene\": \"" << jsonEscape(label)
         << "\",\n  \"mode\": \"" << mode << "\",\n  \"triangles\": " << summary.triangles << ",\n  \"width\": " << width
         << ",\n  \"height\": " << height << ",\n  \"memory_bytes\": " << renderer.memoryBytes()
@@ -198,7 +282,7 @@ int runBenchFrame(const Args& args) {
       out << (i ? ", " : "") << "\"" << counterOrder[i] << "\": " << median(counters[counterOrder[i]]);
     }
     out << "}\n}\n";
-    if (!out) throw std::runtime_error(json + ": could not write");
+    writeTextFile(json, out.str());
   }
   return 0;
 }

@@ -411,11 +411,12 @@ int runBenchMethods(const Args& args) {
     } else if (a == "--crowd") {
       eye.crowd = uint32_t(parseCount(a, v));
     } else if (a == "--json") {
-      json = v;
+      checkWritable(json = v);
     } else if (a == "--svg") {
-      svg = v;
+      checkWritable(svg = v);
     } else if (a == "--images") {
       images = v;
+      checkWritable(images + "/trace.png");  // the folder exists and takes files
     } else {
       throw UsageError{"bench methods: unknown option " + a};
     }

@@ -5,6 +5,7 @@
 // structures built and updated over the same triangles in the same run.
 // With characters, on crowds of the procedural eye: the viewport frame's passes.
 #include "cli/cli.h"
+#include "cli/image_file.h"
 
 #include "peer/driver_bvh.h"
 #include "ref/sah_bvh.h"
@@ -194,7 +195,7 @@ int runBenchScale(const Args& args) {
     else if (a == "--refit-workgroup") tuning.refitWorkgroup = uint32_t(parseCount(a, v));
     else if (a == "--size") parseSize(a, v, width, height);
     else if (a == "--frames") frames = std::max<uint32_t>(1, uint32_t(parseCount(a, v)));
-    else if (a == "--json") json = v;
+    else if (a == "--json") checkWritable(json = v);
     else throw UsageError{"bench scale: unknown option " + a};
   }
   vk::ContextDesc desc = contextDescFromEnvironment();
@@ -317,7 +318,7 @@ int runBenchScale(const Args& args) {
     crowdRows.push_back(std::move(r));
   }
   if (!json.empty()) {
-    std::ofstream out(json);
+    std::ostringstream out;  // written whole or not at all
     out << "{\n  \"device\": \"" << context->facts().name << "\",\n  \"driver_acceleration_structures\": "
         << (driver ? "true" : "false") << ",\n  \"restructure_rounds\": " << restructure << ",\n  \"runs\": " << runs
         << ",\n  \"spheres\": [\n";
@@ -348,7 +349,7 @@ int runBenchScale(const Args& args) {
       out << "}}" << (i + 1 < crowdRows.size() ? "," : "") << "\n";
     }
     out << "  ]\n}\n";
-    if (!out) throw std::runtime_error(json + ": could not write");
+    writeTextFile(json, out.str());
   }
   return 0;
 }

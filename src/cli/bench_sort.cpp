@@ -2,12 +2,14 @@
 // timestamps, median of many runs after warm-up; every size is also checked
 // against std::sort so a fast wrong sort never makes the table.
 #include "cli/cli.h"
+#include "cli/image_file.h"
 
 #include "render/radix_sort.h"
 #include "vk/buffer.h"
 #include "vk/commands.h"
 #include "vk/context.h"
 
+#include <sstream>
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -79,7 +81,7 @@ Options parse(const Args& args) {
     else if (a == "--max-log") o.maxLog = static_cast<unsigned>(parseCount(a, v));
     else if (a == "--runs") o.runs = static_cast<unsigned>(parseCount(a, v));
     else if (a == "--warmup") o.warmup = static_cast<unsigned>(parseCount(a, v));
-    else if (a == "--json") o.json = v;
+    else if (a == "--json") checkWritable(o.json = v);
     else if (a == "--workgroup") o.tuning.workgroupSize = static_cast<uint32_t>(parseCount(a, v));
     else if (a == "--keys-per-thread") o.tuning.keysPerThread = static_cast<uint32_t>(parseCount(a, v));
     else if (a == "--keys") {
@@ -197,6 +199,7 @@ Row measure(vk::Context& context, render::RadixSort& sort, uint64_t count, const
 
 int runBenchSort(const Args& args) {
   Options o = parse(args);
+  if (!o.json.empty()) checkWritable(o.json);
   vk::ContextDesc desc = contextDescFromEnvironment();
   desc.pipelineStatistics = o.pipelineStats;
   auto context = vk::Context::create(desc);
@@ -232,10 +235,8 @@ int runBenchSort(const Args& args) {
   }
 
   if (!o.json.empty()) {
-    std::string temporary = o.json + ".partial";
     {
-      std::ofstream out(temporary);
-      if (!out) throw std::runtime_error("cannot write " + temporary);
+      std::ostringstream out;
       out << "{\n  \"benchmark\": \"sort\",\n  \"device\": \"" << device.name << "\",\n  \"driver\": \"" << device.driverName
           << " " << device.driverInfo << "\",\n  \"vulkan\": \"" << vk::versionString(device.apiVersion)
           << "\",\n  \"runs\": " << o.runs << ",\n  \"warmup\": " << o.warmup << ",\n  \"results\": [\n";
@@ -248,8 +249,8 @@ int runBenchSort(const Args& args) {
             << "}" << (i + 1 < rows.size() ? "," : "") << "\n";
       }
       out << "  ]\n}\n";
+      writeTextFile(o.json, out.str());
     }
-    if (std::rename(temporary.c_str(), o.json.c_str()) != 0) throw std::runtime_error("cannot write " + o.json);
     std::printf("wrote %s\n", o.json.c_str());
   }
   if (!allCorrect) {

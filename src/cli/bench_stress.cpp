@@ -1,8 +1,10 @@
 // `snell bench stress`: the numerical stability grid (src/stress), GPU against
 // the CPU double-precision reference, as a table and as JSON.
 #include "cli/cli.h"
+#include "cli/image_file.h"
 #include "stress/stress.h"
 
+#include <sstream>
 #include <cstdio>
 #include <fstream>
 
@@ -67,7 +69,7 @@ int runBenchStress(const Args& args) {
     if (a != "--json" && a != "--size" && a != "--rays" && a != "--only") throw UsageError{"bench stress: unknown option " + a};
     if (i + 1 >= args.size()) throw UsageError{"bench stress: " + a + " needs a value"};
     const std::string& value = args[++i];
-    if (a == "--json") json = value;
+    if (a == "--json") checkWritable(json = value);
     else if (a == "--only") only = value;
     else if (a == "--rays") options.aimedRaysSide = uint32_t(parseCount(a, value));
     else parseSize(a, value, options.imageWidth, options.imageHeight);
@@ -95,9 +97,8 @@ int runBenchStress(const Args& args) {
     results.push_back(r);
   }
   if (!json.empty()) {
-    std::string tmp = json + ".tmp";
     {
-      std::ofstream out(tmp);
+      std::ostringstream out;
       out << "[\n";
       for (size_t i = 0; i < results.size(); ++i) {
         const stress::Result& r = results[i];
@@ -111,9 +112,8 @@ int runBenchStress(const Args& args) {
             << (i + 1 < results.size() ? "," : "") << "\n";
       }
       out << "]\n";
-      if (!out) throw std::runtime_error(json + ": could not write");
+      writeTextFile(json, out.str());
     }
-    std::rename(tmp.c_str(), json.c_str());
   }
   return bad ? 1 : 0;
 }

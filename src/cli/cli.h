@@ -19,6 +19,10 @@ namespace snell::cli {
 /// The words after the subcommand's name.
 using Args = std::vector<std::string>;
 
+/// This process's resident host memory in bytes (/proc/self/statm), for the
+/// long runs' reports.
+uint64_t hostResidentBytes();
+
 /// Thrown for a bad command line; main prints it with the usage hint, exit 2.
 struct UsageError {
   std::string message;
@@ -35,6 +39,11 @@ int runBenchScale(const Args& args);
 int runBenchMethods(const Args& args);
 int runBake(const Args& args);
 int runExportWeb(const Args& args);
+/// Parse a subcommand's options as its run does, without running it: a bad
+/// command line throws UsageError (the CLI fuzz target, tests/fuzz).
+void parseRenderOptions(const Args& args);
+void parseBakeOptions(const Args& args);
+void parseExportWebOptions(const Args& args);
 
 /// A context on the device snell picks; SNELL_VALIDATION=1 turns on the
 /// validation layer, synchronization checks included.

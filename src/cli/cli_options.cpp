@@ -11,6 +11,8 @@
 #include <charconv>
 #include <cstdlib>
 
+#include <unistd.h>
+
 namespace snell::cli {
 
 vk::ContextDesc contextDescFromEnvironment() {
@@ -19,6 +21,15 @@ vk::ContextDesc contextDescFromEnvironment() {
   desc.validation = validation && std::string(validation) == "1";
   desc.synchronizationValidation = desc.validation;  // as the tests' own context has it
   return desc;
+}
+
+uint64_t hostResidentBytes() {
+  std::FILE* statm = std::fopen("/proc/self/statm", "r");
+  if (!statm) return 0;
+  unsigned long long size = 0, resident = 0;
+  int read = std::fscanf(statm, "%llu %llu", &size, &resident);
+  std::fclose(statm);
+  return read == 2 ? uint64_t(resident) * uint64_t(::sysconf(_SC_PAGESIZE)) : 0;
 }
 
 unsigned long long parseCount(const std::string& option, const std::string& value) {

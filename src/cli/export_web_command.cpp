@@ -19,6 +19,8 @@
 #include <optional>
 #include <stdexcept>
 
+#include <unistd.h>
+
 namespace snell::cli {
 
 namespace {
@@ -258,6 +260,8 @@ Options parse(const Args& args) {
 
 }  // namespace
 
+void parseExportWebOptions(const Args& args) { (void)parse(args); }
+
 int runExportWeb(const Args& args) {
   for (const std::string& a : args) {
     if (a == "--help" || a == "-h") {
@@ -267,9 +271,8 @@ int runExportWeb(const Args& args) {
   }
   Options o = parse(args);
   namespace fs = std::filesystem;
-  std::error_code made;
-  fs::create_directories(o.output, made);
-  if (!fs::is_directory(o.output)) throw std::runtime_error(o.output + ": cannot make the folder (" + made.message() + ")");
+  // Nothing is made until the page is ready; a folder that cannot be made or written fails now.
+  checkWritable(fs::is_directory(o.output) ? (fs::path(o.output) / "index.html").string() : o.output);
   scene::Scene scene = o.shot.loadScene();
   std::optional<uint32_t> material;
   if (!o.material.empty()) material = findTexturedMaterial("export-web", scene, o.material);
@@ -359,11 +362,24 @@ int runExportWeb(const Args& args) {
                                   ", " + view.description);
   std::string html = replaced(replaced(replaced(kHtml, "%TITLE%", title), "%WIDTH%", std::to_string(o.shot.width)),
                               "%HEIGHT%", std::to_string(o.shot.height));
+  // A new folder appears whole (written beside it, then renamed); into an
+  // existing one each file is replaced whole, the page last, so it exists
+  // only once all it loads does.
   fs::path dir(o.output);
-  for (const Layer& l : layers) writeTextFile((dir / l.file).string(), std::string(l.png.begin(), l.png.end()));
-  writeTextFile((dir / "images.js").string(), images);
-  writeTextFile((dir / "snell-web.js").string(), kScript);
-  writeTextFile((dir / "index.html").string(), html);  // last: the page exists only once all it loads does
+  bool fresh = !fs::exists(dir);
+  fs::path writing = fresh ? fs::path(dir.string() + ".partial-" + std::to_string(::getpid())) : dir;
+  try {
+    if (fresh) fs::create_directory(writing);
+    for (const Layer& l : layers) writeTextFile((writing / l.file).string(), std::string(l.png.begin(), l.png.end()));
+    writeTextFile((writing / "images.js").string(), images);
+    writeTextFile((writing / "snell-web.js").string(), kScript);
+    writeTextFile((writing / "index.html").string(), html);
+    if (fresh) fs::rename(writing, dir);
+  } catch (...) {
+    std::error_code ignored;
+    if (fresh) fs::remove_all(writing, ignored);
+    throw;
+  }
 
   uintmax_t pageBytes = fs::file_size(dir / "index.html") + fs::file_size(dir / "snell-web.js") + fs::file_size(dir / "images.js");
   double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

@@ -1,5 +1,6 @@
 // `snell eye -o eye.glb`: writes the procedural eye (or a crowd of eye pairs).
 #include "cli/cli.h"
+#include "cli/image_file.h"
 
 #include "scene/gltf_writer.h"
 #include "scene/procedural_eye.h"
@@ -68,6 +69,7 @@ int runEye(const Args& args) {
     else throw UsageError{"eye: unknown option " + a};
   }
   if (output.empty()) throw UsageError{"eye: give the output file with -o FILE.glb"};
+  checkWritable(output);
   try {
     scene::checkEyeOptions(options);
   } catch (const std::invalid_argument& e) {

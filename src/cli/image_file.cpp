@@ -16,10 +16,12 @@
 #include <iterator>
 
 #include <algorithm>
+#include <cerrno>
 #include <cstring>
 #include <cmath>
 #include <filesystem>
 #include <stdexcept>
+#include <fcntl.h>
 #include <unistd.h>
 
 namespace snell::cli {
@@ -285,6 +287,21 @@ bake::MapPixels readMapFile(const std::string& path, bake::Encoding& encoding) {
     std::memcpy(pixels.rg16.data(), decoded.image.data(), decoded.image.size());  // stb gives native-endian samples
   }
   return pixels;
+}
+
+void checkWritable(const std::string& path) {
+  fs::path target(path);
+  fs::path dir = target.has_parent_path() ? target.parent_path() : fs::path(".");
+  if (!fs::is_directory(dir)) throw std::runtime_error(path + ": the folder " + dir.string() + " does not exist");
+  if (fs::is_directory(target)) throw std::runtime_error(path + ": is a folder, not a file");
+  // The only sure test is to make a file there, as the final write will.
+  fs::path probe = dir / (".snell-write-check-" + std::to_string(::getpid()));
+  int fd = ::open(probe.c_str(), O_WRONLY | O_CREAT | O_EXCL, 0600);
+  if (fd < 0) {
+    throw std::runtime_error(path + ": cannot write in the folder " + dir.string() + " (" + std::strerror(errno) + ")");
+  }
+  ::close(fd);
+  ::unlink(probe.c_str());
 }
 
 void writeTextFile(const std::string& path, const std::string& text) {

@@ -39,6 +39,11 @@ void writePngRgba8(const std::string& path, uint32_t width, uint32_t height, con
 /// Writes `text` to `path` the same way: complete, or not at all.
 void writeTextFile(const std::string& path, const std::string& text);
 
+/// Fails now, before any work is done, where `path` could not be written at the
+/// end: its folder is missing or not writable, or the path is a folder. Throws
+/// std::runtime_error naming the path and the problem.
+void checkWritable(const std::string& path);
+
 /// Reads an 8-bit-per-channel image (a golden PNG) as RGB bytes.
 struct Rgb8Image {
   uint32_t width = 0, height = 0;

@@ -224,6 +224,8 @@ void printStats(long frameNumber, const render::FrameStats& s, const std::vector
 
 }  // namespace
 
+void parseRenderOptions(const Args& args) { (void)parse(args); }
+
 int runRender(const Args& args) {
   for (const std::string& a : args) {
     if (a == "--help" || a == "-h") {
@@ -232,6 +234,7 @@ int runRender(const Args& args) {
     }
   }
   Options o = parse(args);
+  checkWritable(o.frames ? framePath(o.output, o.firstFrame) : o.output);
   if (!o.environment.empty()) o.optics.environment = std::make_shared<scene::Environment>(readEnvironment(o.environment));
   scene::Scene scene = o.shot.loadScene();
 

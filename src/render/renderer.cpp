@@ -714,6 +714,12 @@ uint64_t Renderer::submit(const FrameRequest& request) {
     uint32_t w = r.settings.width, h = r.settings.height;
     std::string name = "view " + std::to_string(i);
     uint64_t pixels = uint64_t(w) * h;
+    // Refused whole, before any of it is allocated, where the device cannot hold it.
+    uint64_t needed = (im.trace.handle() ? 0 : pixels * 8) +
+                      (composite && !im.composite.handle() ? pixels * (8 + 4 + 4 + 4) : 0) +
+                      (r.aov && !im.aov.handle() ? pixels * sizeof(gpu::TraceAov) : 0) +
+                      (!r.settings.rays.empty() && !v.rays.handle() ? pixels * sizeof(gpu::GpuRay) : 0);
+    context_.checkFits(needed, name + " at " + std::to_string(w) + "x" + std::to_string(h));
     im.width = w;
     im.height = h;
     if (!im.trace.handle()) {

@@ -1,6 +1,8 @@
 // Packing a scene into the buffers the passes read (shaders/shared/trace.h).
 #include "render/scene_gpu.h"
 
+#include "scene/scene_summary.h"
+
 #include "scene/texture_mips.h"
 
 #include "shared/trace.h"
@@ -213,6 +215,11 @@ static void checkHostShapes(const scene::Scene& scene, const HostBuffers& host) 
 SceneGpu uploadScene(vk::Context& context, const scene::Scene& scene, const scene::Pose& layout,
                      const HostBuffers* host) {
   if (host) checkHostShapes(scene, *host);
+  // Refused before anything is allocated where the device cannot hold it (the
+  // estimate `snell info` prints; allocations are checked one by one as well).
+  scene::SceneSummary estimate = scene::summarize(scene, 0, 0);
+  context.checkFits(estimate.totalBytes(), (scene.source.empty() ? std::string("the scene") : scene.source) + " (" +
+                                               std::to_string(estimate.triangles) + " triangles)");
   SceneGpu gpu;
   std::vector<int> shapeGeometry(scene.shapes.size(), -1);
   uint64_t vertices = 0, triangles = 0;

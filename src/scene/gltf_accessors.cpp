@@ -138,7 +138,13 @@ std::vector<float> readScalars(const Reader& r, int index, const std::string& wh
 
 std::vector<uint32_t> readIndices(const Reader& r, int index, const std::string& what) {
   const tinygltf::Accessor& a = r.at(r.model.accessors, index, what, "accessor");
-  if (a.componentType == TINYGLTF_COMPONENT_TYPE_FLOAT || a.normalized) r.fail(what + " must hold unsigned integers");
+  // Signed types are refused too (found by fuzzing: a negative index cannot become a uint32_t).
+  bool unsignedType = a.componentType == TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE ||
+                      a.componentType == TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT ||
+                      a.componentType == TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT;
+  if (!unsignedType || a.normalized) {
+    r.fail(what + " must hold unsigned integers (UNSIGNED_BYTE, UNSIGNED_SHORT or UNSIGNED_INT)");
+  }
   AccessorData data = readAccessor(r, index, what);
   return std::vector<uint32_t>(data.values.begin(), data.values.end());
 }

@@ -26,6 +26,11 @@
 
 namespace snell::scene {
 
+namespace {
+// The largest image side snell decodes: the renderer's own cap on any image (render::checkImageSize).
+constexpr int kMaxImageSide = 16384;
+}  // namespace
+
 using gltf::AccessorData;
 using gltf::Reader;
 using gltf::kMaxElements;
@@ -132,6 +137,9 @@ void loadTextures(const Reader& r) {
             texture.rgba[p * 4 + size_t(c)] = value;
           }
         }
+      } else if (image.width > kMaxImageSide || image.height > kMaxImageSide) {
+        r.fail(what + ": image '" + image.uri + "' is " + std::to_string(image.width) + "x" + std::to_string(image.height) +
+               ", beyond snell's limit of " + std::to_string(kMaxImageSide) + " pixels a side");
       } else {
         r.warn(what + ": image '" + image.uri + "' could not be read; materials fall back to their factors");
       }
@@ -735,14 +743,48 @@ std::vector<unsigned char> readHead(const std::string& path, size_t bytes) {
 struct EncodedImages {
   std::mutex mutex;
   std::map<int, std::vector<unsigned char>> bytes;  // by image index
+  const tinygltf::Model* model = nullptr;           // being parsed: its buffers come before its images
 };
 
-bool keepEncoded(tinygltf::Image*, const int index, std::string*, std::string*, int, int, const unsigned char* bytes,
-                 int size, void* user) {
+// Debian's tinygltf (2.8) hands over an image in a bufferView without checking
+// that the view lies inside its buffer (found by fuzzing, tests/fuzz): the
+// view is checked here before a byte is read.
+bool imageViewInBounds(const tinygltf::Model& model, const tinygltf::Image& image) {
+  if (image.bufferView < 0) return true;
+  if (size_t(image.bufferView) >= model.bufferViews.size()) return false;
+  const tinygltf::BufferView& view = model.bufferViews[size_t(image.bufferView)];
+  if (view.buffer < 0 || size_t(view.buffer) >= model.buffers.size()) return false;
+  size_t bufferSize = model.buffers[size_t(view.buffer)].data.size();
+  return view.byteOffset <= bufferSize && view.byteLength <= bufferSize - view.byteOffset;
+}
+
+bool keepEncoded(tinygltf::Image* image, const int index, std::string* error, std::string*, int, int,
+                 const unsigned char* bytes, int size, void* user) {
   auto* encoded = static_cast<EncodedImages*>(user);
+  if (image && encoded->model && !imageViewInBounds(*encoded->model, *image)) {
+    if (error) *error += "image " + std::to_string(index) + ": its bufferView lies outside its buffer";
+    return false;
+  }
+  if (size < 0) return false;
   std::lock_guard<std::mutex> lock(encoded->mutex);
   encoded->bytes[index].assign(bytes, bytes + size);
   return true;
+}
+
+// Whether a PNG's chunks lie inside its bytes. stb allocates what a chunk's
+// length field claims before reading it (found by fuzzing: a 60 KB file asked
+// for 2 GB), so a PNG whose chunks overrun its bytes is not handed to stb.
+bool pngChunksFit(const std::vector<unsigned char>& bytes) {
+  static const unsigned char kSignature[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
+  if (bytes.size() < 8 || std::memcmp(bytes.data(), kSignature, 8) != 0) return true;  // not a PNG: stb checks the rest
+  size_t at = 8;
+  while (at + 12 <= bytes.size()) {
+    uint64_t length = uint64_t(bytes[at]) << 24 | uint64_t(bytes[at + 1]) << 16 | uint64_t(bytes[at + 2]) << 8 | bytes[at + 3];
+    if (length > bytes.size() - at - 12) return false;
+    if (std::memcmp(&bytes[at + 4], "IEND", 4) == 0) return true;
+    at += 12 + size_t(length);
+  }
+  return false;  // no IEND before the end
 }
 
 // What tinygltf's own loader does with stb_image (RGBA, 16 bits where the
@@ -750,6 +792,15 @@ bool keepEncoded(tinygltf::Image*, const int index, std::string*, std::string*, 
 void decodeImage(tinygltf::Image& image, const std::vector<unsigned char>& bytes) {
   const int size = static_cast<int>(bytes.size());
   int w = 0, h = 0, comp = 0, bits = 8;
+  // An image's header may claim any size: one beyond snell's limit is not
+  // decoded (found by fuzzing: stb would allocate what the header says), and
+  // the texture that uses it is refused with the size it claims.
+  if (stbi_info_from_memory(bytes.data(), size, &w, &h, &comp) && (w > kMaxImageSide || h > kMaxImageSide)) {
+    image.width = w;
+    image.height = h;
+    return;
+  }
+  if (!pngChunksFit(bytes)) return;
   unsigned char* data = nullptr;
   if (stbi_is_16_bit_from_memory(bytes.data(), size)) {
     data = reinterpret_cast<unsigned char*>(stbi_load_16_from_memory(bytes.data(), size, &w, &h, &comp, 4));
@@ -807,8 +858,9 @@ Scene loadGltf(const std::string& path, const LoadOptions& options) {
   const Clock::time_point start = Clock::now();
   tinygltf::TinyGLTF parser;
   EncodedImages encoded;
-  parser.SetImageLoader(keepEncoded, &encoded);
   tinygltf::Model model;
+  encoded.model = &model;
+  parser.SetImageLoader(keepEncoded, &encoded);
   std::string error, warning;
   bool ok = binary ? parser.LoadBinaryFromFile(&model, &error, &warning, path)
                    : parser.LoadASCIIFromFile(&model, &error, &warning, path);

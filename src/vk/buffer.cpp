@@ -41,13 +41,7 @@ VkDeviceMemory allocate(Context& context, const VkMemoryRequirements& needs, Mem
   info.pNext = deviceAddress ? &flags : nullptr;
   info.allocationSize = needs.size;
   info.memoryTypeIndex = type;
-  VkDeviceMemory memory = VK_NULL_HANDLE;
-  VkResult result = vkAllocateMemory(context.device(), &info, nullptr, &memory);
-  if (result != VK_SUCCESS) {
-    throw VulkanError("allocating " + std::to_string(needs.size) + " bytes for '" + name + "' failed with " +
-                          std::string(resultName(result)),
-                      result);
-  }
+  VkDeviceMemory memory = context.allocateMemory(info, name);
   context.setName(VK_OBJECT_TYPE_DEVICE_MEMORY, memory, name);
   return memory;
 }
@@ -124,9 +118,10 @@ void Buffer::release() {
   VkBuffer buffer = std::exchange(buffer_, VK_NULL_HANDLE);
   VkDeviceMemory memory = std::exchange(memory_, VK_NULL_HANDLE);
   mapped_ = nullptr;
-  context_->retire([device, buffer, memory] {
+  Context* context = context_;
+  context_->retire([context, device, buffer, memory] {
     if (buffer) vkDestroyBuffer(device, buffer, nullptr);
-    if (memory) vkFreeMemory(device, memory, nullptr);  // unmaps implicitly
+    context->freeMemory(memory);  // unmaps implicitly
   });
   context_ = nullptr;
 }
@@ -208,10 +203,11 @@ void Image::release() {
   VkImage image = std::exchange(image_, VK_NULL_HANDLE);
   VkImageView view = std::exchange(view_, VK_NULL_HANDLE);
   VkDeviceMemory memory = std::exchange(memory_, VK_NULL_HANDLE);
-  context_->retire([device, image, view, memory] {
+  Context* context = context_;
+  context_->retire([context, device, image, view, memory] {
     if (view) vkDestroyImageView(device, view, nullptr);
     if (image) vkDestroyImage(device, image, nullptr);
-    if (memory) vkFreeMemory(device, memory, nullptr);
+    context->freeMemory(memory);
   });
   context_ = nullptr;
 }

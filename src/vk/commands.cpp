@@ -101,7 +101,7 @@ void Commands::wait() {
   if (!serial_) return;
   // Bounded: a GPU that stops answering for a minute is reported, not waited on forever.
   constexpr uint64_t kTimeoutNs = 60ull * 1000 * 1000 * 1000;
-  VkResult result = vkWaitForFences(context_->device(), 1, &fence_, VK_TRUE, kTimeoutNs);
+  VkResult result = callUnlessFaulted("vkWaitForFences", [&] { return vkWaitForFences(context_->device(), 1, &fence_, VK_TRUE, kTimeoutNs); });
   if (result == VK_TIMEOUT) throw VulkanError("Commands '" + name_ + "': the GPU did not finish within 60 s", result);
   VK_CHECK(result);
   context_->noteCompleted(serial_);

@@ -4,6 +4,7 @@
 
 #include "vk/error.h"
 
+#include <cerrno>
 #include <algorithm>
 #include <cstdio>
 #include <cstdlib>
@@ -357,6 +358,18 @@ void Context::initialise(VkPhysicalDevice physicalDevice, const DeviceFacts& fac
   caps_.timestampValidBits = families[queueFamily_].timestampValidBits;
 
   vkGetPhysicalDeviceMemoryProperties(physicalDevice, &memory_);
+  for (uint32_t h = 0; h < memory_.memoryHeapCount; ++h) {
+    if (memory_.memoryHeaps[h].flags & VK_MEMORY_HEAP_DEVICE_LOCAL_BIT) memoryLimit_ += memory_.memoryHeaps[h].size;
+  }
+  if (const char* limit = std::getenv("SNELL_DEVICE_MEMORY_LIMIT"); limit && *limit) {
+    char* end = nullptr;
+    errno = 0;
+    unsigned long long bytes = std::strtoull(limit, &end, 10);
+    if (*end != '\0' || errno || bytes == 0 || limit[0] == '-') {
+      throw VulkanError(std::string("SNELL_DEVICE_MEMORY_LIMIT=") + limit + ": expected a number of bytes above 0");
+    }
+    memoryLimit_ = std::min<uint64_t>(memoryLimit_ ? memoryLimit_ : bytes, bytes);
+  }
   setName(VK_OBJECT_TYPE_DEVICE, device_, "snell device");
   setName(VK_OBJECT_TYPE_QUEUE, queue_, "snell queue");
 }
@@ -419,6 +432,55 @@ void Context::collectRetired() {
   std::vector<Retired> ready(std::make_move_iterator(done), std::make_move_iterator(retired_.end()));
   retired_.erase(done, retired_.end());
   for (Retired& r : ready) r.destroy();
+}
+
+namespace {
+
+std::string mib(uint64_t bytes) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.1f MiB", double(bytes) / 1048576.0);
+  return text;
+}
+
+}  // namespace
+
+void Context::checkFits(uint64_t bytes, const std::string& what) const {
+  if (bytes <= memoryAvailable()) return;
+  throw VulkanError(what + " needs " + mib(bytes) + " of device memory; " + mib(memoryAvailable()) + " of the " +
+                        mib(memoryLimit_) + " limit is free (" + facts_.name +
+                        (std::getenv("SNELL_DEVICE_MEMORY_LIMIT") ? ", SNELL_DEVICE_MEMORY_LIMIT" : "") + ")",
+                    VK_ERROR_OUT_OF_DEVICE_MEMORY);
+}
+
+VkDeviceMemory Context::allocateMemory(const VkMemoryAllocateInfo& info, const std::string& what) {
+  uint32_t heap = memory_.memoryTypes[info.memoryTypeIndex].heapIndex;
+  bool counted = memory_.memoryHeaps[heap].flags & VK_MEMORY_HEAP_DEVICE_LOCAL_BIT;
+  std::lock_guard lock(memoryMutex_);
+  if (counted) checkFits(info.allocationSize, "'" + what + "'");
+  VkDeviceMemory memory = VK_NULL_HANDLE;
+  VkResult result = callUnlessFaulted("vkAllocateMemory", [&] { return vkAllocateMemory(device_, &info, nullptr, &memory); });
+  if (result != VK_SUCCESS) {
+    throw VulkanError("allocating " + mib(info.allocationSize) + " for '" + what + "' failed with " +
+                          std::string(resultName(result)) + " (" + mib(memoryInUse()) + " in use, of " +
+                          mib(memoryLimit_) + ")",
+                      result);
+  }
+  if (counted) {
+    counted_[memory] = info.allocationSize;
+    uint64_t now = memoryInUse_.fetch_add(info.allocationSize) + info.allocationSize;
+    if (now > memoryPeak_.load()) memoryPeak_.store(now);
+  }
+  return memory;
+}
+
+void Context::freeMemory(VkDeviceMemory memory) {
+  if (!memory) return;
+  vkFreeMemory(device_, memory, nullptr);
+  std::lock_guard lock(memoryMutex_);
+  if (auto it = counted_.find(memory); it != counted_.end()) {
+    memoryInUse_.fetch_sub(it->second);
+    counted_.erase(it);
+  }
 }
 
 uint32_t Context::findMemoryType(uint32_t typeBits, VkMemoryPropertyFlags required, VkMemoryPropertyFlags preferred) const {

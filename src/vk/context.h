@@ -10,6 +10,8 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <mutex>
+#include <unordered_map>
 #include <set>
 #include <string>
 #include <algorithm>
@@ -147,6 +149,23 @@ class Context {
   /// UINT32_MAX when none has them.
   uint32_t findMemoryType(uint32_t typeBits, VkMemoryPropertyFlags required, VkMemoryPropertyFlags preferred) const;
 
+  /// vkAllocateMemory with snell's accounting: memory in the device-local heaps
+  /// counts against memoryLimit(), and an allocation past it, or one the driver
+  /// refuses, throws VulkanError naming `what` with the numbers.
+  VkDeviceMemory allocateMemory(const VkMemoryAllocateInfo& info, const std::string& what);
+  /// vkFreeMemory, and the accounting.
+  void freeMemory(VkDeviceMemory memory);
+  /// Device-local memory snell holds now, at most so far, and may hold: the
+  /// device-local heaps' size, or SNELL_DEVICE_MEMORY_LIMIT (bytes) where smaller.
+  uint64_t memoryInUse() const { return memoryInUse_.load(); }
+  uint64_t memoryPeak() const { return memoryPeak_.load(); }
+  uint64_t memoryLimit() const { return memoryLimit_; }
+  uint64_t memoryAvailable() const { return memoryLimit_ > memoryInUse() ? memoryLimit_ - memoryInUse() : 0; }
+  /// Refuses work needing `bytes` more device memory than is available, before
+  /// anything is allocated: throws VulkanError (VK_ERROR_OUT_OF_DEVICE_MEMORY)
+  /// naming `what` with the bytes needed and available.
+  void checkFits(uint64_t bytes, const std::string& what) const;
+
  private:
   Context() = default;
   void initialise(VkPhysicalDevice physicalDevice, const DeviceFacts& facts, bool dynamicRendering,
@@ -178,6 +197,11 @@ class Context {
     std::function<void()> destroy;
   };
   std::vector<Retired> retired_;
+
+  uint64_t memoryLimit_ = 0;
+  std::atomic<uint64_t> memoryInUse_{0}, memoryPeak_{0};
+  std::mutex memoryMutex_;
+  std::unordered_map<VkDeviceMemory, uint64_t> counted_;  ///< device-local allocations and their sizes
 };
 
 }  // namespace snell::vk

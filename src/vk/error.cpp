@@ -1,7 +1,11 @@
 // Names of VkResult codes; Debian 12's headers lack vk_enum_string_helper.h.
 #include "vk/error.h"
 
+#include <atomic>
+#include <cstdlib>
+#include <mutex>
 #include <sstream>
+#include <string>
 
 namespace snell::vk {
 
@@ -53,6 +57,67 @@ void check(VkResult result, const char* expression, const char* file, int line) 
   message << expression << " failed with " << resultName(result) << " (" << static_cast<int>(result)
           << ") at " << file << ":" << line;
   throw VulkanError(message.str(), result);
+}
+
+namespace {
+
+struct FaultSwitch {
+  bool armed = false;
+  std::string call;
+  VkResult result = VK_SUCCESS;
+  unsigned long long from = 1;
+  std::atomic<unsigned long long> calls{0};
+};
+
+VkResult resultFromName(const std::string& name) {
+  for (int code = 0; code >= -1000; --code) {  // the core error codes
+    if (resultName(VkResult(code)) == name) return VkResult(code);
+  }
+  for (VkResult r : {VK_ERROR_OUT_OF_POOL_MEMORY, VK_ERROR_INVALID_EXTERNAL_HANDLE, VK_ERROR_FRAGMENTATION,
+                     VK_ERROR_SURFACE_LOST_KHR, VK_ERROR_OUT_OF_DATE_KHR, VK_ERROR_VALIDATION_FAILED_EXT}) {
+    if (resultName(r) == name) return r;
+  }
+  return VK_SUCCESS;
+}
+
+// Read once: the setting belongs to the process, as SNELL_DEVICE does.
+FaultSwitch& faultSwitch() {
+  static FaultSwitch* instance = [] {
+    auto* f = new FaultSwitch;  // never freed: calls may come from static destructors
+    const char* setting = std::getenv("SNELL_FAULT");
+    if (!setting || !*setting) return f;
+    std::string text(setting);
+    size_t first = text.find(':');
+    size_t second = first == std::string::npos ? first : text.find(':', first + 1);
+    std::string call = text.substr(0, first);
+    std::string result = first == std::string::npos ? "" : text.substr(first + 1, second - first - 1);
+    f->result = resultFromName(result);
+    if (call.rfind("vk", 0) != 0 || f->result >= 0) {
+      throw VulkanError("SNELL_FAULT=" + text + ": expected vkCALL:VK_ERROR_...[:N], e.g. vkQueueSubmit:VK_ERROR_DEVICE_LOST");
+    }
+    if (second != std::string::npos) {
+      char* end = nullptr;
+      f->from = std::strtoull(text.c_str() + second + 1, &end, 10);
+      if (*end != '\0' || f->from == 0) throw VulkanError("SNELL_FAULT=" + text + ": N must be a whole number from 1");
+    }
+    f->call = call;
+    f->armed = true;
+    return f;
+  }();
+  return *instance;
+}
+
+}  // namespace
+
+VkResult injectedFault(const char* expression) {
+  FaultSwitch& f = faultSwitch();
+  if (!f.armed) return VK_SUCCESS;
+  // The call is the expression's first word: "vkQueueSubmit(queue, ...)".
+  std::string_view text(expression);
+  if (text.substr(0, f.call.size()) != f.call || (text.size() > f.call.size() && text[f.call.size()] != '(')) {
+    return VK_SUCCESS;
+  }
+  return f.calls.fetch_add(1) + 1 >= f.from ? f.result : VK_SUCCESS;
 }
 
 }  // namespace snell::vk

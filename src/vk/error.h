@@ -29,7 +29,26 @@ class VulkanError : public std::runtime_error {
 /// `result` is VK_SUCCESS (or another non-error status code).
 void check(VkResult result, const char* expression, const char* file, int line);
 
+/// The fault switch, for tests of what a failing GPU does to snell:
+///   SNELL_FAULT=CALL:RESULT[:N]
+/// makes the Nth call (default the first) of the Vulkan function CALL, and
+/// every later one, fail with RESULT without being made, e.g.
+/// SNELL_FAULT=vkQueueSubmit:VK_ERROR_DEVICE_LOST or
+/// SNELL_FAULT=vkAllocateMemory:VK_ERROR_OUT_OF_DEVICE_MEMORY:5. Returns the
+/// result to fail with, or VK_SUCCESS to make the call. A malformed setting
+/// throws VulkanError saying what is wrong with it.
+VkResult injectedFault(const char* call);
+
+/// `call()`, unless the fault switch fails it; `expression` is the call's text.
+template <typename Call>
+VkResult callUnlessFaulted(const char* expression, Call&& call) {
+  VkResult fault = injectedFault(expression);
+  return fault != VK_SUCCESS ? fault : call();
+}
+
 }  // namespace snell::vk
 
 /// Always-on check of a Vulkan call; never compiled out in release builds.
-#define VK_CHECK(expression) ::snell::vk::check((expression), #expression, __FILE__, __LINE__)
+#define VK_CHECK(expression)                                                                                 \
+  ::snell::vk::check(::snell::vk::callUnlessFaulted(#expression, [&]() -> VkResult { return (expression); }), \
+                     #expression, __FILE__, __LINE__)

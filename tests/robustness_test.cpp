@@ -1,0 +1,184 @@
+// What a failing GPU, a full device and an unwritable path do to snell's
+// commands: a clear error naming the problem, a non-zero exit, and no file
+// (or half a file) left behind. The GPU's failures come from the fault switch
+// (SNELL_FAULT, src/vk/error.h), the full device from SNELL_DEVICE_MEMORY_LIMIT.
+// The test command runs these under AddressSanitizer as well.
+#include "command_run.h"
+#include "gpu_test.h"
+
+#include "render/renderer.h"
+#include "scene/evaluate.h"
+#include "scene/procedural_eye.h"
+#include "vk/context.h"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <string>
+
+namespace snell::test {
+namespace {
+
+namespace fs = std::filesystem;
+
+// A private folder per test: whatever a failed run leaves in it is visible.
+class Robustness : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() /
+           ("snell-robustness-" + std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+
+  // In the sanitized build the command checks for leaks at exit (a leak
+  // changes its exit code); elsewhere the variable does nothing.
+  CommandRun snell(const std::string& environment, const std::string& arguments) const {
+    return runCommand("cd " + shellQuoted(dir_.string()) + " && ASAN_OPTIONS=detect_leaks=1 " + environment + " " +
+                      SNELL_BINARY + " " + arguments);
+  }
+  size_t filesLeft() const { return size_t(std::distance(fs::directory_iterator(dir_), fs::directory_iterator())); }
+
+  fs::path dir_;
+};
+
+TEST_F(Robustness, DeviceLostAtSubmitEndsRenderWithAnErrorAndNoImage) {
+  CommandRun run = snell("SNELL_FAULT=vkQueueSubmit:VK_ERROR_DEVICE_LOST", "render --eye --size 64x48 -o eye.png");
+  EXPECT_EQ(run.exitCode, 1) << run.output;
+  EXPECT_NE(run.output.find("vkQueueSubmit"), std::string::npos) << run.output;
+  EXPECT_NE(run.output.find("VK_ERROR_DEVICE_LOST"), std::string::npos) << run.output;
+  EXPECT_EQ(filesLeft(), 0u) << run.output;
+}
+
+TEST_F(Robustness, DeviceLostWhileWaitingEndsAnAnimationWithTheFramesBeforeItWhole) {
+  // The first frames are written whole; the failing one leaves nothing.
+  CommandRun run = snell("SNELL_FAULT=vkWaitForFences:VK_ERROR_DEVICE_LOST:6",
+                         "render --eye --size 48x36 --frames 1:8 -o 'eye_####.png'");
+  EXPECT_EQ(run.exitCode, 1) << run.output;
+  EXPECT_NE(run.output.find("VK_ERROR_DEVICE_LOST"), std::string::npos) << run.output;
+  for (const auto& entry : fs::directory_iterator(dir_)) {
+    EXPECT_EQ(entry.path().filename().string().rfind("eye_", 0), 0u) << "a temporary file was left: " << entry.path();
+    EXPECT_GT(fs::file_size(entry.path()), 100u) << entry.path();
+  }
+  EXPECT_LT(filesLeft(), 8u) << run.output;
+}
+
+TEST_F(Robustness, AFailedAllocationNamesWhatWasBeingAllocated) {
+  CommandRun run = snell("SNELL_FAULT=vkAllocateMemory:VK_ERROR_OUT_OF_DEVICE_MEMORY:12",
+                         "render --eye --viewport --size 64x48 -o eye.png");
+  EXPECT_EQ(run.exitCode, 1) << run.output;
+  EXPECT_NE(run.output.find("allocating"), std::string::npos) << run.output;
+  EXPECT_NE(run.output.find("for '"), std::string::npos) << "names the buffer or image: " << run.output;
+  EXPECT_NE(run.output.find("VK_ERROR_OUT_OF_DEVICE_MEMORY"), std::string::npos) << run.output;
+  EXPECT_EQ(filesLeft(), 0u) << run.output;
+}
+
+TEST_F(Robustness, ASceneTooBigForTheDeviceIsRefusedWithTheNumbersBeforeAnythingIsAllocated) {
+  CommandRun run = snell("SNELL_DEVICE_MEMORY_LIMIT=65536", "render --eye --size 64x48 -o eye.png");
+  EXPECT_EQ(run.exitCode, 1) << run.output;
+  EXPECT_NE(run.output.find("procedural eye"), std::string::npos) << "names the scene: " << run.output;
+  EXPECT_NE(run.output.find("needs"), std::string::npos) << run.output;
+  EXPECT_NE(run.output.find("of the 0.1 MiB limit is free"), std::string::npos) << run.output;
+  EXPECT_NE(run.output.find("SNELL_DEVICE_MEMORY_LIMIT"), std::string::npos) << run.output;
+  EXPECT_EQ(filesLeft(), 0u);
+}
+
+TEST_F(Robustness, AnImageTooBigForTheDeviceIsRefusedNamingTheView) {
+  // 64 MiB holds the eye, not a 4000x4000 view's images (16 million pixels).
+  CommandRun run = snell("SNELL_DEVICE_MEMORY_LIMIT=67108864", "render --eye --size 4000x4000 -o eye.png");
+  EXPECT_EQ(run.exitCode, 1) << run.output;
+  EXPECT_NE(run.output.find("view 0 at 4000x4000 needs"), std::string::npos) << run.output;
+  EXPECT_EQ(filesLeft(), 0u);
+}
+
+TEST_F(Robustness, AMalformedFaultSettingIsAnErrorSayingWhatIsExpected) {
+  CommandRun run = snell("SNELL_FAULT=vkQueueSubmit:DEVICE_LOST", "render --eye --size 16x16 -o eye.png");
+  EXPECT_EQ(run.exitCode, 1) << run.output;
+  EXPECT_NE(run.output.find("expected vkCALL:VK_ERROR_"), std::string::npos) << run.output;
+}
+
+TEST_F(Robustness, AMalformedMemoryLimitIsAnErrorNamingTheVariable) {
+  CommandRun run = snell("SNELL_DEVICE_MEMORY_LIMIT=lots", "render --eye --size 16x16 -o eye.png");
+  EXPECT_EQ(run.exitCode, 1) << run.output;
+  EXPECT_NE(run.output.find("SNELL_DEVICE_MEMORY_LIMIT=lots"), std::string::npos) << run.output;
+}
+
+TEST_F(Robustness, AnOutputInAMissingFolderFailsBeforeRendering) {
+  CommandRun run = snell("", "render --eye --size 64x48 --stats -o missing/eye.png");
+  EXPECT_EQ(run.exitCode, 1) << run.output;
+  EXPECT_NE(run.output.find("missing/eye.png: the folder missing does not exist"), std::string::npos) << run.output;
+  EXPECT_EQ(run.output.find("GPU ms"), std::string::npos) << "nothing was rendered: " << run.output;
+}
+
+TEST_F(Robustness, AnOutputThatIsAFolderFailsBeforeRendering) {
+  fs::create_directory(dir_ / "eye.png");
+  CommandRun run = snell("", "bake --eye --size 32x32 -o eye.png");
+  EXPECT_EQ(run.exitCode, 1) << run.output;
+  EXPECT_NE(run.output.find("eye.png: is a folder"), std::string::npos) << run.output;
+}
+
+TEST_F(Robustness, AReadOnlyFolderFailsBeforeRendering) {
+  if (::geteuid() == 0) GTEST_SKIP() << "root writes into read-only folders";
+  fs::create_directory(dir_ / "locked");
+  fs::permissions(dir_ / "locked", fs::perms::owner_read | fs::perms::owner_exec);
+  CommandRun run = snell("", "render --eye --size 16x16 -o locked/eye.png");
+  fs::permissions(dir_ / "locked", fs::perms::owner_all);
+  EXPECT_EQ(run.exitCode, 1) << run.output;
+  EXPECT_NE(run.output.find("cannot write in the folder"), std::string::npos) << run.output;
+}
+
+TEST_F(Robustness, DeviceLostDuringBakeLeavesNoMap) {
+  CommandRun run = snell("SNELL_FAULT=vkQueueSubmit:VK_ERROR_DEVICE_LOST:2", "bake --eye --size 32x32 -o map.png");
+  EXPECT_EQ(run.exitCode, 1) << run.output;
+  EXPECT_NE(run.output.find("VK_ERROR_DEVICE_LOST"), std::string::npos) << run.output;
+  EXPECT_EQ(filesLeft(), 0u) << run.output;
+}
+
+TEST_F(Robustness, DeviceLostDuringExportWebLeavesNoFolder) {
+  CommandRun run = snell("SNELL_FAULT=vkQueueSubmit:VK_ERROR_DEVICE_LOST:3", "export-web --eye --size 32x32 -o page");
+  EXPECT_EQ(run.exitCode, 1) << run.output;
+  EXPECT_EQ(filesLeft(), 0u) << run.output;
+}
+
+TEST_F(Robustness, DeviceLostDuringABenchmarkLeavesNoJson) {
+  CommandRun run = snell("SNELL_FAULT=vkQueueSubmit:VK_ERROR_DEVICE_LOST:4",
+                         "bench frame --eye-resolution 16 --frames 4 --json frame.json");
+  EXPECT_EQ(run.exitCode, 1) << run.output;
+  EXPECT_NE(run.output.find("VK_ERROR_DEVICE_LOST"), std::string::npos) << run.output;
+  EXPECT_EQ(filesLeft(), 0u) << run.output;
+}
+
+#ifdef SNELL_VIEWER_BINARY
+TEST_F(Robustness, DeviceLostEndsTheViewersDrawingWithAnErrorAndNoScreenshot) {
+  CommandRun run = runCommand("cd " + shellQuoted(dir_.string()) + " && SNELL_FAULT=vkQueueSubmit:VK_ERROR_DEVICE_LOST:16 " +
+                              SNELL_VIEWER_BINARY + " --offscreen --size 48x36 --frames 30 --screenshot shot.png");
+  EXPECT_EQ(run.exitCode, 1) << run.output;
+  EXPECT_NE(run.output.find("the GPU failed, so nothing more is drawn"), std::string::npos) << run.output;
+  EXPECT_NE(run.output.find("VK_ERROR_DEVICE_LOST"), std::string::npos) << run.output;
+  EXPECT_EQ(filesLeft(), 0u) << run.output;
+}
+#endif
+
+// The accounting behind the limit: what a renderer allocates it gives back.
+TEST(DeviceMemory, EveryByteARendererAllocatedIsCountedAndReturned) {
+  vk::Context& context = gpuContext();
+  context.collectRetired();
+  uint64_t before = context.memoryInUse();
+  scene::Scene eye = scene::makeEye({.resolution = 16});
+  scene::Pose pose = scene::evaluate(eye, 0.0);
+  uint64_t estimate = 0;
+  {
+    render::Renderer renderer(context, eye, pose);
+    EXPECT_GT(context.memoryInUse(), before);
+    estimate = context.memoryInUse() - before;
+    EXPECT_LE(context.memoryInUse(), context.memoryLimit());
+    EXPECT_GE(context.memoryPeak(), context.memoryInUse());
+  }
+  vkDeviceWaitIdle(context.device());
+  context.collectRetired();
+  EXPECT_EQ(context.memoryInUse(), before) << estimate << " bytes were allocated";
+}
+
+}  // namespace
+}  // namespace snell::test
