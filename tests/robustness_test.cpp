@@ -151,7 +151,8 @@ TEST_F(Robustness, DeviceLostDuringABenchmarkLeavesNoJson) {
 
 #ifdef SNELL_VIEWER_BINARY
 TEST_F(Robustness, DeviceLostEndsTheViewersDrawingWithAnErrorAndNoScreenshot) {
-  CommandRun run = runCommand("cd " + shellQuoted(dir_.string()) + " && SNELL_FAULT=vkQueueSubmit:VK_ERROR_DEVICE_LOST:16 " +
+  CommandRun run = runCommand("cd " + shellQuoted(dir_.string()) +
+                              " && ASAN_OPTIONS=detect_leaks=1 SNELL_FAULT=vkQueueSubmit:VK_ERROR_DEVICE_LOST:16 " +
                               SNELL_VIEWER_BINARY + " --offscreen --size 48x36 --frames 30 --screenshot shot.png");
   EXPECT_EQ(run.exitCode, 1) << run.output;
   EXPECT_NE(run.output.find("the GPU failed, so nothing more is drawn"), std::string::npos) << run.output;
