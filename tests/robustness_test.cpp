@@ -168,17 +168,17 @@ TEST(DeviceMemory, EveryByteARendererAllocatedIsCountedAndReturned) {
   uint64_t before = context.memoryInUse();
   scene::Scene eye = scene::makeEye({.resolution = 16});
   scene::Pose pose = scene::evaluate(eye, 0.0);
-  uint64_t estimate = 0;
+  uint64_t allocated = 0;
   {
     render::Renderer renderer(context, eye, pose);
     EXPECT_GT(context.memoryInUse(), before);
-    estimate = context.memoryInUse() - before;
+    allocated = context.memoryInUse() - before;
     EXPECT_LE(context.memoryInUse(), context.memoryLimit());
     EXPECT_GE(context.memoryPeak(), context.memoryInUse());
   }
   vkDeviceWaitIdle(context.device());
   context.collectRetired();
-  EXPECT_EQ(context.memoryInUse(), before) << estimate << " bytes were allocated";
+  EXPECT_EQ(context.memoryInUse(), before) << allocated << " bytes were allocated";
 }
 
 }  // namespace

@@ -50,12 +50,19 @@ std::string lowerExtension(const std::string& path) {
   return ext;
 }
 
+// The folder `path` goes in; throws naming the path when it does not exist.
+fs::path existingFolder(const std::string& path) {
+  fs::path target(path);
+  fs::path dir = target.has_parent_path() ? target.parent_path() : fs::path(".");
+  if (!fs::is_directory(dir)) throw std::runtime_error(path + ": the folder " + dir.string() + " does not exist");
+  return dir;
+}
+
 // Writes through a temporary file in the same folder, so the rename is atomic.
 template <typename WriteFn>
 void writeAtomically(const std::string& path, WriteFn write) {
   fs::path target(path);
-  fs::path dir = target.has_parent_path() ? target.parent_path() : fs::path(".");
-  if (!fs::is_directory(dir)) throw std::runtime_error(path + ": the folder " + dir.string() + " does not exist");
+  fs::path dir = existingFolder(path);
   fs::path temp = dir / ("." + target.stem().string() + ".partial-" + std::to_string(::getpid()) + target.extension().string());
   try {
     write(temp.string());
@@ -290,10 +297,8 @@ bake::MapPixels readMapFile(const std::string& path, bake::Encoding& encoding) {
 }
 
 void checkWritable(const std::string& path) {
-  fs::path target(path);
-  fs::path dir = target.has_parent_path() ? target.parent_path() : fs::path(".");
-  if (!fs::is_directory(dir)) throw std::runtime_error(path + ": the folder " + dir.string() + " does not exist");
-  if (fs::is_directory(target)) throw std::runtime_error(path + ": is a folder, not a file");
+  fs::path dir = existingFolder(path);
+  if (fs::is_directory(path)) throw std::runtime_error(path + ": is a folder, not a file");
   // The only sure test is to make a file there, as the final write will.
   fs::path probe = dir / (".snell-write-check-" + std::to_string(::getpid()));
   int fd = ::open(probe.c_str(), O_WRONLY | O_CREAT | O_EXCL, 0600);

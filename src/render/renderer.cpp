@@ -719,7 +719,7 @@ uint64_t Renderer::submit(const FrameRequest& request) {
                       (composite && !im.composite.handle() ? pixels * (8 + 4 + 4 + 4) : 0) +
                       (r.aov && !im.aov.handle() ? pixels * sizeof(gpu::TraceAov) : 0) +
                       (!r.settings.rays.empty() && !v.rays.handle() ? pixels * sizeof(gpu::GpuRay) : 0);
-    context_.checkFits(needed, name + " at " + std::to_string(w) + "x" + std::to_string(h));
+    if (needed) context_.checkFits(needed, name + " at " + std::to_string(w) + "x" + std::to_string(h));
     im.width = w;
     im.height = h;
     if (!im.trace.handle()) {
