@@ -31,7 +31,7 @@ def main():
     lines = [
         "# Radix sort: snell (Vulkan compute) vs CUB, one run, one GPU",
         "",
-        f"- GPU: {snell['device']}; Vulkan driver: {snell['driver']} (Vulkan {snell['vulkan']})",
+        f"- GPU: {snell['device']['name']}; Vulkan driver: {snell['device']['driver']} {snell['device']['driver_info']} (Vulkan {snell['device']['vulkan']})",
         f"- CUB: {cub['implementation']}, CUDA driver {cub['cuda_driver']}",
         f"- median of {snell['runs']} runs after {snell['warmup']} warm-up; GPU timestamps (snell), CUDA events (CUB)",
         "- 32-bit values; random keys; every row checked against std::sort",
@@ -46,7 +46,7 @@ def main():
         lines.append(f"| 2^{r['pairs'].bit_length() - 1} | {r['key_bits']} | {r['shape']} | {r['snell_median_ms']:.4f} | "
                      f"{r['snell_gpairs_per_s']:.2f} | {cub_ms} | {cub_rate} | {ratio} |")
     open(sys.argv[3], "w").write("\n".join(lines) + "\n")
-    json.dump({"device": snell["device"], "driver": snell["driver"], "cub": cub["implementation"],
+    json.dump({"device": snell["device"]["name"], "driver": snell["device"]["driver"], "cub": cub["implementation"],
                "rows": rows}, open(sys.argv[4], "w"), indent=2)
     print("\n".join(lines))
 

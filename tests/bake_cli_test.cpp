@@ -3,7 +3,7 @@
 #include "command_run.h"
 
 #include "bake/refraction_bake.h"
-#include "cli/image_file.h"
+#include "io/image_file.h"
 
 #include <gtest/gtest.h>
 
@@ -87,12 +87,12 @@ std::string chromiumCommand(const fs::path& page, const std::string& action) {
          shellQuoted("file://" + page.string());
 }
 
-cli::Rgb8Image screenshot(const fs::path& page, uint32_t width, uint32_t height) {
+io::Rgb8Image screenshot(const fs::path& page, uint32_t width, uint32_t height) {
   fs::path shot = page.parent_path() / "screenshot.png";
   CommandRun run = runCommand(chromiumCommand(page, "--screenshot=" + shellQuoted(shot.string()) + " --window-size=" +
                                                         std::to_string(width) + "," + std::to_string(height)));
   if (!fs::exists(shot)) throw std::runtime_error("chromium wrote no screenshot:\n" + run.output);
-  return cli::readRgb8(shot.string());
+  return io::readRgb8(shot.string());
 }
 
 struct PageMatch {
@@ -100,7 +100,7 @@ struct PageMatch {
 };
 
 // The page against the render, pixel by pixel: within `tolerance` of 255.
-PageMatch match(const cli::Rgb8Image& page, const cli::Rgb8Image& render, const bake::DecodedMap& map, int tolerance) {
+PageMatch match(const io::Rgb8Image& page, const io::Rgb8Image& render, const bake::DecodedMap& map, int tolerance) {
   PageMatch m;
   for (size_t i = 0; i < map.coverage.size(); ++i) {
     int d = 0;
@@ -133,13 +133,13 @@ TEST(ExportWebCommand, ThePageInChromiumDrawsWhatTheRefractionMapMethodRenders) 
   CommandRun rendered = snell("render --eye --size 160x120 --method refraction-map -o " +
                               shellQuoted((dir / "render.png").string()));
   ASSERT_EQ(rendered.exitCode, 0) << rendered.output;
-  cli::Rgb8Image render = cli::readRgb8((dir / "render.png").string());
+  io::Rgb8Image render = io::readRgb8((dir / "render.png").string());
   bake::Encoding encoding = bake::Encoding::Exr;
-  bake::MapPixels mapPixels = cli::readMapFile((site / "map.png").string(), encoding);
+  bake::MapPixels mapPixels = io::readMapFile((site / "map.png").string(), encoding);
   bake::DecodedMap map = bake::decodeMap(mapPixels, encoding);
   ASSERT_EQ(encoding, bake::Encoding::Sky8);
 
-  cli::Rgb8Image page = screenshot(site / "index.html", width, height);
+  io::Rgb8Image page = screenshot(site / "index.html", width, height);
   ASSERT_EQ(page.width, width);
   ASSERT_EQ(page.height, height);
   // The same layers and mips, read by the browser's sampler in 8-bit sRGB: within 1/255.

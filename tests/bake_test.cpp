@@ -5,7 +5,7 @@
 #include "golden_support.h"
 
 #include "bake/refraction_bake.h"
-#include "cli/image_file.h"
+#include "io/image_file.h"
 #include "render/method.h"
 #include "render/renderer.h"
 #include "scene/evaluate.h"
@@ -42,7 +42,7 @@ Baked bakeEye(vk::Context& context, double time = 0.0) {
 }
 
 // refraction-map's picture of `s` at `pose` from `settings`' view, with `map`.
-cli::Rgb8Image drawWithMap(vk::Context& context, const scene::Scene& s, const scene::Pose& pose,
+io::Rgb8Image drawWithMap(vk::Context& context, const scene::Scene& s, const scene::Pose& pose,
                            const render::FrameSettings& settings, const render::RefractionMapBuffer& map) {
   render::Renderer renderer(context, s, pose);
   render::RasterOptions raster;
@@ -55,14 +55,14 @@ cli::Rgb8Image drawWithMap(vk::Context& context, const scene::Scene& s, const sc
   request.views.push_back(render::methodView(render::Method::RefractionMap, settings, raster));
   request.views.back().readback = true;
   const render::FrameResult& result = renderer.wait(renderer.submit(request));
-  return cli::toSrgb8({settings.width, settings.height, result.views.at(0).composite});
+  return io::toSrgb8({settings.width, settings.height, result.views.at(0).composite});
 }
 
-cli::Rgb8Image traceOf(vk::Context& context, const scene::Scene& s, const scene::Pose& pose,
+io::Rgb8Image traceOf(vk::Context& context, const scene::Scene& s, const scene::Pose& pose,
                        const render::FrameSettings& settings) {
   render::Renderer renderer(context, s, pose);
   render::RenderedFrame frame = render::renderFrame(context, renderer, pose, settings);
-  return cli::toSrgb8({settings.width, settings.height, frame.rgba});
+  return io::toSrgb8({settings.width, settings.height, frame.rgba});
 }
 
 struct GlassError {
@@ -70,7 +70,7 @@ struct GlassError {
   int worst = 0;
 };
 
-GlassError glassError(const cli::Rgb8Image& got, const cli::Rgb8Image& want, const bake::RefractionBake& bake) {
+GlassError glassError(const io::Rgb8Image& got, const io::Rgb8Image& want, const bake::RefractionBake& bake) {
   GlassError e;
   for (size_t i = 0; i < bake.texels.size(); ++i) {
     if (bake.coverage(i) == bake::Coverage::Empty) continue;
@@ -109,8 +109,8 @@ TEST_F(GpuTest, TheBakedEyeMarksItsGlassAndWhereItLandsOnTheIris) {
 TEST_F(GpuTest, TheMapRedrawsTheTraceAtTheBakedPoseAndView) {
   Baked b = bakeEye(context());
   render::RefractionMapBuffer map = bake::uploadRefractionMap(context(), b.bake);
-  cli::Rgb8Image drawn = drawWithMap(context(), b.scene, b.pose, b.settings, map);
-  cli::Rgb8Image traced = traceOf(context(), b.scene, b.pose, b.settings);
+  io::Rgb8Image drawn = drawWithMap(context(), b.scene, b.pose, b.settings, map);
+  io::Rgb8Image traced = traceOf(context(), b.scene, b.pose, b.settings);
   GlassError e = glassError(drawn, traced, b.bake);
   std::printf("glass pixels: %zu, within 1/255 of the trace: %zu, worst %d/255\n", e.pixels, e.withinOne, e.worst);
   ASSERT_GT(e.pixels, 1000u);
@@ -187,14 +187,14 @@ TEST_F(GpuTest, EachMapFileRoundTripsTheBakedUvsWithinItsStep) {
                         Case{bake::Encoding::Sky8, "map8.png", 8.0 / 65025 + 1e-9}}) {
     std::string path = (dir / c.file).string();
     try {
-      cli::writeMapFile(path, bake::encodeMap(want, c.encoding), c.encoding);
+      io::writeMapFile(path, bake::encodeMap(want, c.encoding), c.encoding);
     } catch (const std::runtime_error& e) {
       if (std::string(e.what()).find("no OpenImageIO") == std::string::npos) throw;
       std::printf("%s: skipped, %s\n", c.file, e.what());  // the GPU machine's build carries no OpenImageIO
       continue;
     }
     bake::Encoding read = bake::Encoding::Exr;
-    bake::MapPixels pixels = cli::readMapFile(path, read);
+    bake::MapPixels pixels = io::readMapFile(path, read);
     bake::DecodedMap got = bake::decodeMap(pixels, read);
     EXPECT_EQ(read, c.encoding) << c.file;
     ASSERT_EQ(got.coverage.size(), want.coverage.size());

@@ -190,7 +190,7 @@ TEST(Embedding, HostBufferMeshesFollowTheHostsDeformationLikeTheGltfMorphAndSkin
   snell::Device device = snell::Device::create({.validation = true, .synchronizationValidation = true});
   HostEye hostEye(device);
   std::filesystem::path glb = std::filesystem::temp_directory_path() / "snell-embedding-eye.glb";
-  scene::saveGlb(hostEye.eye, glb.string());
+  scene::saveGltf(hostEye.eye, glb.string());
 
   snell::Scene fromFile = snell::Scene::load(glb.string());
   snell::Scene fromHost = snell::Scene::fromHost(hostEye.host);
@@ -261,7 +261,7 @@ TEST(Embedding, AdoptedDeviceRendersIntoTheHostsImageForAHundredFramesWithoutVal
   snell::HostDevice handles{host.instance, host.physical, host.device, host.family, host.queue, host.features13};
   scene::Scene eye = scene::makeEye({.resolution = 16});
   std::filesystem::path glb = std::filesystem::temp_directory_path() / "snell-embedding-frames.glb";
-  scene::saveGlb(eye, glb.string());
+  scene::saveGltf(eye, glb.string());
   {
     snell::Device device = snell::Device::adopt(handles);
     snell::Scene scene = snell::Scene::load(glb.string());
@@ -358,7 +358,7 @@ TEST(Embedding, AdoptedDeviceRendersIntoTheHostsImageForAHundredFramesWithoutVal
 TEST(Embedding, SharedImageAndSemaphoresExportFileDescriptorsAndChainFrames) {
   scene::Scene eye = scene::makeEye({.resolution = 16});
   std::filesystem::path glb = std::filesystem::temp_directory_path() / "snell-embedding-shared.glb";
-  scene::saveGlb(eye, glb.string());
+  scene::saveGltf(eye, glb.string());
   snell::Device device = snell::Device::create({.interop = true});
   snell::Scene scene = snell::Scene::load(glb.string());
   std::filesystem::remove(glb);
@@ -396,7 +396,7 @@ TEST(Embedding, SharedImageAndSemaphoresExportFileDescriptorsAndChainFrames) {
 TEST(Embedding, TwoRenderersOnOneDeviceRenderFromTwoThreads) {
   scene::Scene eye = scene::makeEye({.resolution = 16});
   std::filesystem::path glb = std::filesystem::temp_directory_path() / "snell-embedding-threads.glb";
-  scene::saveGlb(eye, glb.string());
+  scene::saveGltf(eye, glb.string());
   snell::Device device = snell::Device::create();
   snell::Scene scene = snell::Scene::load(glb.string());
   std::filesystem::remove(glb);

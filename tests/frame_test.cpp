@@ -207,7 +207,7 @@ TEST_F(GpuTest, TheMaskedCompositeMatchesTheFullTraceComposite) {
     return frame(renderer, pose, {v}).views.at(0).composite;
   };
   std::vector<glm::vec4> masked = composite(true), full = composite(false);
-  Comparison result = compare(cli::toSrgb8({192, 144, masked}), cli::toSrgb8({192, 144, full}));
+  Comparison result = compare(io::toSrgb8({192, 144, masked}), io::toSrgb8({192, 144, full}));
   std::printf("    masked against full trace: %zu of %zu pixels within 1/255, max %d/255\n", result.withinOne,
               result.pixels, result.maxDifference);
   EXPECT_GE(double(result.withinOne) / double(result.pixels), 0.999) << result.firstMismatches;

@@ -2,7 +2,7 @@
 // image, imported into OpenGL through shared memory, composited over the
 // host's own backdrop.
 #include "assets.h"
-#include "cli/image_file.h"
+#include "io/image_file.h"
 #include "command_run.h"
 
 #include <gtest/gtest.h>
@@ -42,7 +42,7 @@ TEST(GlHost, ItsScreenshotIsTheViewportRenderOverItsOwnBackdrop) {
                                     " --viewport --time 0.5 --size 160x120 -o " + shellQuoted(render));
   ASSERT_EQ(reference.exitCode, 0) << reference.output;
 
-  cli::Rgb8Image got = cli::readRgb8(shot), expected = cli::readRgb8(render);
+  io::Rgb8Image got = io::readRgb8(shot), expected = io::readRgb8(render);
   ASSERT_EQ(got.width, expected.width);
   ASSERT_EQ(got.height, expected.height);
   // Where snell drew nothing (its background), the host's backdrop shows;

@@ -16,16 +16,16 @@
 
 namespace snell::test {
 
-cli::Rgb8Image referenceImage(const scene::Scene& s, const scene::Pose& pose, const scene::View& view, uint32_t width,
+io::Rgb8Image referenceImage(const scene::Scene& s, const scene::Pose& pose, const scene::View& view, uint32_t width,
                               uint32_t height) {
   ref::ReferenceSettings settings;
   settings.width = width;
   settings.height = height;
   settings.view = view;
   ref::ReferenceImage r = ref::renderReference(s, pose, settings);
-  cli::LinearImage linear{width, height, {}};
+  io::LinearImage linear{width, height, {}};
   for (const glm::dvec3& colour : r.color) linear.rgba.emplace_back(glm::vec3(colour), 1.0f);
-  return cli::toSrgb8(linear);
+  return io::toSrgb8(linear);
 }
 
 // SNELL_GOLDEN_DIR in the environment wins: the GPU machine has the checkout elsewhere.
@@ -34,7 +34,7 @@ std::filesystem::path goldenDir() {
   return override ? std::filesystem::path(override) : std::filesystem::path(SNELL_SOURCE_DIR) / "golden";
 }
 
-Comparison compare(const cli::Rgb8Image& got, const cli::Rgb8Image& want) {
+Comparison compare(const io::Rgb8Image& got, const io::Rgb8Image& want) {
   Comparison c;
   c.pixels = size_t(want.width) * want.height;
   c.diff = {want.width, want.height, std::vector<uint8_t>(c.pixels * 3, 0)};

@@ -2,7 +2,7 @@
 // compared, the reference's picture of a view, and the test scenes.
 #pragma once
 
-#include "cli/image_file.h"
+#include "io/image_file.h"
 #include "render/renderer.h"
 #include "scene/evaluate.h"
 #include "scene/scene.h"
@@ -25,17 +25,17 @@ struct Tolerance {
 std::filesystem::path goldenDir();
 
 /// The CPU double-precision reference's picture, as 8-bit sRGB.
-cli::Rgb8Image referenceImage(const scene::Scene& s, const scene::Pose& pose, const scene::View& view, uint32_t width,
+io::Rgb8Image referenceImage(const scene::Scene& s, const scene::Pose& pose, const scene::View& view, uint32_t width,
                               uint32_t height);
 
 struct Comparison {
   size_t pixels = 0, withinOne = 0;
   int maxDifference = 0;
   std::string firstMismatches;  ///< the first five pixels over 1/255, one per line
-  cli::Rgb8Image diff;          ///< mismatches in red over a dim copy of `want`
+  io::Rgb8Image diff;          ///< mismatches in red over a dim copy of `want`
 };
 
-Comparison compare(const cli::Rgb8Image& got, const cli::Rgb8Image& want);
+Comparison compare(const io::Rgb8Image& got, const io::Rgb8Image& want);
 
 /// The viewport composite (and its whole trace) of `renderer`'s scene `s` at
 /// `pose` from `view`, the raster depth range fitted to the scene's bounds.

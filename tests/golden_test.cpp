@@ -8,7 +8,7 @@
 #include "golden_support.h"
 #include "gpu_test.h"
 
-#include "cli/image_file.h"
+#include "io/image_file.h"
 #include "ref/reference_tracer.h"
 #include "render/renderer.h"
 #include "scene/evaluate.h"
@@ -99,16 +99,16 @@ TEST_P(Golden, GpuTraceMatchesTheReferenceGolden) {
   const scene::View& view = shot.view;
   fs::path goldenPath = goldenDir() / (c.name + ".png");
   const char* update = std::getenv("SNELL_UPDATE_GOLDEN");
-  if (update && std::string(update) == "1") cli::writeRgb8(goldenPath.string(), referenceImage(s, pose, view, c.width, c.height));
+  if (update && std::string(update) == "1") io::writeRgb8(goldenPath.string(), referenceImage(s, pose, view, c.width, c.height));
   ASSERT_TRUE(fs::exists(goldenPath)) << goldenPath << " is missing (SNELL_UPDATE_GOLDEN=1 makes it from the reference)";
-  cli::Rgb8Image golden = cli::readRgb8(goldenPath.string());
+  io::Rgb8Image golden = io::readRgb8(goldenPath.string());
   ASSERT_EQ(golden.width, c.width);
   ASSERT_EQ(golden.height, c.height);
 
   render::Renderer renderer(context(), s, pose);
   render::FrameSettings settings{c.width, c.height, view, {0.02f, 0.02f, 0.025f}, gpu::kDefaultMaxInterfaces};
   render::RenderedFrame frame = render::renderFrame(context(), renderer, pose, settings);
-  cli::Rgb8Image gpu = cli::toSrgb8({c.width, c.height, frame.rgba});
+  io::Rgb8Image gpu = io::toSrgb8({c.width, c.height, frame.rgba});
   Comparison result = compare(gpu, golden);
   double share = double(result.withinOne) / double(result.pixels);
   RecordProperty("within_one", std::to_string(share));
@@ -118,8 +118,8 @@ TEST_P(Golden, GpuTraceMatchesTheReferenceGolden) {
   bool pass = share >= c.tolerance.withinOne && result.maxDifference <= c.tolerance.maxDifference;
   if (!pass) {
     fs::path out = scratchDir("golden-" + c.name);
-    cli::writeRgb8((out / "gpu.png").string(), gpu);
-    cli::writeRgb8((out / "diff.png").string(), result.diff);
+    io::writeRgb8((out / "gpu.png").string(), gpu);
+    io::writeRgb8((out / "diff.png").string(), result.diff);
     ADD_FAILURE() << c.name << ": " << 100.0 * share << "% of pixels within 1/255 (need "
                   << 100.0 * c.tolerance.withinOne << "%), max difference " << result.maxDifference << " (allowed "
                   << c.tolerance.maxDifference << ")\nfirst mismatches:\n"
@@ -135,7 +135,7 @@ TEST_P(Golden, GoldenIsWhatTheReferenceRendersToday) {
   const scene::View& view = shot.view;
   fs::path goldenPath = goldenDir() / (c.name + ".png");
   ASSERT_TRUE(fs::exists(goldenPath)) << goldenPath << " is missing";
-  Comparison result = compare(referenceImage(s, pose, view, c.width, c.height), cli::readRgb8(goldenPath.string()));
+  Comparison result = compare(referenceImage(s, pose, view, c.width, c.height), io::readRgb8(goldenPath.string()));
   // Compilers may round the last bit differently; anything more means the golden is stale.
   EXPECT_LE(result.maxDifference, 1) << c.name << ": the committed golden is not what src/ref renders\n"
                                       << result.firstMismatches;
@@ -151,7 +151,7 @@ TEST_F(GpuTest, EyeWithIorOneEqualsTheEyeWithoutItsTransmissiveFaces) {
     scene::View view = scene::resolveView(s, pose, {});
     render::Renderer renderer(context(), s, pose);
     render::RenderedFrame frame = render::renderFrame(context(), renderer, pose, {192, 144, view, {0.02f, 0.02f, 0.025f}, 8});
-    return cli::toSrgb8({192, 144, frame.rgba});
+    return io::toSrgb8({192, 144, frame.rgba});
   };
   Comparison result = compare(render(eyeWith(1.0f)), render(eyeWithoutCorneaTip()));
   double share = double(result.withinOne) / double(result.pixels);

@@ -21,7 +21,7 @@ using scene::EyeOptions;
 
 scene::Scene writeAndRead(const EyeOptions& options, const std::string& name) {
   std::string path = (scratchDir("eye-" + name) / (name + ".glb")).string();
-  scene::saveGlb(scene::makeEye(options), path);
+  scene::saveGltf(scene::makeEye(options), path);
   return scene::loadGltf(path);
 }
 
@@ -130,7 +130,7 @@ TEST(ProceduralEye, OutOfRangeOptionsAreRefusedByName) {
 
 TEST(ProceduralEye, FailedWriteLeavesNoFile) {
   std::string path = "/nonexistent-snell-dir/eye.glb";
-  EXPECT_THROW(scene::saveGlb(scene::makeEye(), path), scene::SceneError);
+  EXPECT_THROW(scene::saveGltf(scene::makeEye(), path), scene::SceneError);
   EXPECT_FALSE(std::filesystem::exists(path));
   EXPECT_FALSE(std::filesystem::exists(path + ".partial"));
 }
@@ -162,7 +162,7 @@ TEST(ProceduralEye, PassesTheKhronosValidatorWithNoErrorOrWarning) {
   cases.push_back({"aqueous", aqueous});
   for (const auto& [name, options] : cases) {
     std::string path = (dir / (name + ".glb")).string();
-    scene::saveGlb(scene::makeEye(options), path);
+    scene::saveGltf(scene::makeEye(options), path);
     std::string output;
     EXPECT_EQ(validate(path, output), 0) << output;
     EXPECT_NE(output.find("0 errors, 0 warnings"), std::string::npos) << output;

@@ -6,7 +6,7 @@
 #include "golden_support.h"
 #include "gpu_test.h"
 
-#include "cli/image_file.h"
+#include "io/image_file.h"
 #include "ref/reference_tracer.h"
 #include "render/renderer.h"
 #include "render/scene_gpu.h"
@@ -81,7 +81,7 @@ TEST_F(GpuTest, TexturesLargerTogetherThanOneStorageBufferRenderAsTheReferenceDo
   const uint32_t width = 256, height = 32;
   render::Renderer renderer(context(), s, pose);
   render::RenderedFrame frame = render::renderFrame(context(), renderer, pose, {width, height, view, {0.02f, 0.02f, 0.025f}, 8});
-  Comparison result = compare(cli::toSrgb8({width, height, frame.rgba}), referenceImage(s, pose, view, width, height));
+  Comparison result = compare(io::toSrgb8({width, height, frame.rgba}), referenceImage(s, pose, view, width, height));
   std::printf("%u textures, %.0f MiB: %zu of %zu pixels within 1/255, max difference %d/255\n", count,
               double(bytes) / 1048576.0, result.withinOne, result.pixels, result.maxDifference);
   EXPECT_EQ(result.withinOne, result.pixels) << result.firstMismatches;
@@ -215,7 +215,7 @@ constexpr uint32_t kFloorWidth = 160, kFloorHeight = 120;
 // neighbouring pixels (grey, 0-255) over rows 38 to 57, just below the
 // horizon (and the floor's far edge), where the floor lies 13 to 400 units
 // away and a cell is a pixel or less along the depth.
-double farFloorEnergy(const cli::Rgb8Image& image) {
+double farFloorEnergy(const io::Rgb8Image& image) {
   double sum = 0.0;
   size_t count = 0;
   auto grey = [&](uint32_t x, uint32_t y) {
@@ -252,9 +252,9 @@ TEST_F(GpuTest, ACheckerboardFloorBehindGlassDoesNotShimmer) {
   std::vector<glm::vec4> levelZeroRgba;
   for (const glm::dvec3& c : levelZero.color) levelZeroRgba.emplace_back(glm::vec3(c), 1.0f);
 
-  double trace = farFloorEnergy(cli::toSrgb8({kFloorWidth, kFloorHeight, traced.rgba}));
-  double mipmapped = farFloorEnergy(cli::toSrgb8({kFloorWidth, kFloorHeight, drawn.rgba}));
-  double aliased = farFloorEnergy(cli::toSrgb8({kFloorWidth, kFloorHeight, levelZeroRgba}));
+  double trace = farFloorEnergy(io::toSrgb8({kFloorWidth, kFloorHeight, traced.rgba}));
+  double mipmapped = farFloorEnergy(io::toSrgb8({kFloorWidth, kFloorHeight, drawn.rgba}));
+  double aliased = farFloorEnergy(io::toSrgb8({kFloorWidth, kFloorHeight, levelZeroRgba}));
   std::printf("far floor energy: traced behind glass %.1f, raster mipmapped %.1f, level 0 %.1f\n", trace, mipmapped,
               aliased);
   // The test can fail: read at level 0, the far floor is noise (a cell is
@@ -298,9 +298,9 @@ TEST_F(GpuTest, TextureTransformsAndTheSecondUvSetReadAsTheReferenceReadsThem) {
     const uint32_t width = 96, height = 72;
     render::Renderer renderer(context(), s, pose);
     render::CompositeFrame frame = compositeOf(context(), renderer, s, pose, view, width, height);
-    cli::Rgb8Image want = referenceImage(s, pose, view, width, height);
+    io::Rgb8Image want = referenceImage(s, pose, view, width, height);
     // The raster pass draws the open quad; the trace, the quad behind glass.
-    Comparison composite = compare(cli::toSrgb8({width, height, frame.rgba}), want);
+    Comparison composite = compare(io::toSrgb8({width, height, frame.rgba}), want);
     std::printf("%s: %zu of %zu pixels within 1/255, max difference %d/255\n", throughGlass ? "through glass" : "open",
                 composite.withinOne, composite.pixels, composite.maxDifference);
     EXPECT_GE(double(composite.withinOne), 0.999 * double(composite.pixels)) << composite.firstMismatches;
@@ -331,7 +331,7 @@ TEST_F(GpuTest, EverySampleModelRendersItsTexturesAsTheReferenceDoes) {
       const uint32_t width = 80, height = 60;
       render::Renderer renderer(context(), s, pose);
       render::CompositeFrame frame = compositeOf(context(), renderer, s, pose, view, width, height);
-      Comparison result = compare(cli::toSrgb8({width, height, frame.rgba}), referenceImage(s, pose, view, width, height));
+      Comparison result = compare(io::toSrgb8({width, height, frame.rgba}), referenceImage(s, pose, view, width, height));
       std::printf("%s: %zu of %zu pixels within 1/255, max difference %d/255\n", entry.path().filename().c_str(),
                   result.withinOne, result.pixels, result.maxDifference);
       // Silhouettes may differ by a pixel where raster coverage and the

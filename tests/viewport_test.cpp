@@ -7,7 +7,7 @@
 #include "golden_support.h"
 #include "gpu_test.h"
 
-#include "cli/image_file.h"
+#include "io/image_file.h"
 #include "render/raster_pass.h"
 #include "render/renderer.h"
 #include "scene/evaluate.h"
@@ -103,10 +103,10 @@ TEST_P(ViewportComposite, OpaquePixelsMatchTheReferenceGolden) {
   Composite shot(context(), c);
   fs::path goldenPath = goldenDir() / (c.golden + ".png");
   ASSERT_TRUE(fs::exists(goldenPath)) << goldenPath;
-  cli::Rgb8Image golden = cli::readRgb8(goldenPath.string());
+  io::Rgb8Image golden = io::readRgb8(goldenPath.string());
   ASSERT_EQ(golden.width, c.width);
   ASSERT_EQ(golden.height, c.height);
-  cli::Rgb8Image composite = cli::toSrgb8({c.width, c.height, shot.frame.rgba});
+  io::Rgb8Image composite = io::toSrgb8({c.width, c.height, shot.frame.rgba});
   // Transmissive pixels are judged by the test above; here they are taken
   // from the golden so only the rasterized pixels count.
   size_t opaque = 0;
@@ -125,8 +125,8 @@ TEST_P(ViewportComposite, OpaquePixelsMatchTheReferenceGolden) {
   bool pass = share >= c.opaque.withinOne && result.maxDifference <= c.opaque.maxDifference;
   if (!pass) {
     fs::path out = scratchDir("viewport-" + c.name);
-    cli::writeRgb8((out / "composite.png").string(), composite);
-    cli::writeRgb8((out / "diff.png").string(), result.diff);
+    io::writeRgb8((out / "composite.png").string(), composite);
+    io::writeRgb8((out / "diff.png").string(), result.diff);
     ADD_FAILURE() << c.name << ": " << 100.0 * share << "% within 1/255 (need " << 100.0 * c.opaque.withinOne
                   << "%)\n" << result.firstMismatches << "composite and diff written to " << out;
   }
@@ -144,7 +144,7 @@ TEST_F(GpuTest, ViewportWithoutRefractionSeesStraightThroughTheCornea) {
   Composite shot(context(), c, options);
   scene::Scene bare = eyeWithoutCorneaTip();
   scene::Pose pose = scene::evaluate(bare, 0.0);
-  Comparison result = compare(cli::toSrgb8({c.width, c.height, shot.frame.rgba}),
+  Comparison result = compare(io::toSrgb8({c.width, c.height, shot.frame.rgba}),
                               referenceImage(bare, pose, shot.view, c.width, c.height));
   double share = double(result.withinOne) / double(result.pixels);
   std::printf("refraction off vs the reference without the cornea tip: %.3f%% within 1/255, max %d\n", 100.0 * share,
@@ -198,9 +198,9 @@ TEST_F(GpuTest, FilmBackPanAndZoomMoveTraceAndRasterTogether) {
   const uint32_t w = 192, h = 144;
   render::Renderer renderer(context(), s, pose);
   render::CompositeFrame frame = compositeOf(context(), renderer, s, pose, view, w, h);
-  cli::Rgb8Image reference = referenceImage(s, pose, view, w, h);
-  Comparison composite = compare(cli::toSrgb8({w, h, frame.rgba}), reference);
-  Comparison trace = compare(cli::toSrgb8({w, h, frame.trace.rgba}), reference);
+  io::Rgb8Image reference = referenceImage(s, pose, view, w, h);
+  Comparison composite = compare(io::toSrgb8({w, h, frame.rgba}), reference);
+  Comparison trace = compare(io::toSrgb8({w, h, frame.trace.rgba}), reference);
   double compositeShare = double(composite.withinOne) / double(composite.pixels);
   double traceShare = double(trace.withinOne) / double(trace.pixels);
   std::printf("panned and zoomed film back: composite %.3f%%, trace %.3f%% within 1/255 of the reference\n",

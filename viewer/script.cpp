@@ -27,7 +27,7 @@ const std::map<std::string, std::vector<Arg>>& grammar() {
       {"gate", {Arg::Switch}},                {"split", {Arg::Switch}},
       {"ui", {Arg::Switch}},                  {"minimise", {}},
       {"restore", {}},                        {"load", {Arg::Text}},
-      {"method", {Arg::Text}},
+      {"method", {Arg::Text}},                {"screenshot", {}},
       {"quit", {}}};
   return actions;
 }

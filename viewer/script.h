@@ -7,7 +7,10 @@
 //   camera N|orbit    play | pause      scrub SECONDS    loop on|off
 //   refraction on|off wireframe on|off  heatmap on|off   gate on|off
 //   split on|off      ui on|off         minimise         restore
-//   load PATH         quit
+//   load PATH         method NAME       screenshot       quit
+//
+// screenshot does what the screenshot key (F12) does: the frame as shown, to
+// snell-view-YYYYMMDD-HHMMSS.png in the current folder.
 #pragma once
 
 #include <cstdint>

@@ -1,5 +1,6 @@
 // ImGui's Vulkan backend of 1.86 draws through a render pass; this owns it,
-// the framebuffers of the window images and the font upload.
+// the framebuffers of the window images, the font upload and the scaling
+// for HiDPI displays.
 #include "ui_overlay.h"
 
 #include "vk/error.h"
@@ -7,7 +8,11 @@
 #include <imgui.h>
 #include <backends/imgui_impl_glfw.h>
 #include <backends/imgui_impl_vulkan.h>
+#define GLFW_INCLUDE_NONE
+#include <GLFW/glfw3.h>
 
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <string>
@@ -23,15 +28,34 @@ void checkImguiResult(VkResult result) {
   std::exit(1);
 }
 
+// The window's content scale: 1 on a 96 dpi display, 2 on most HiDPI ones
+// (X11 reads it from Xft.dpi); 1 offscreen.
+float contentScale(GLFWwindow* window) {
+  if (!window) return 1.0f;
+  float x = 1.0f, y = 1.0f;
+  glfwGetWindowContentScale(window, &x, &y);
+  float scale = std::max(x, y);
+  return std::isfinite(scale) && scale > 0.0f ? std::clamp(scale, 0.5f, 4.0f) : 1.0f;
+}
+
 }  // namespace
 
-UiOverlay::UiOverlay(vk::Context& context, GLFWwindow* window) : context_(context) {
+UiOverlay::UiOverlay(vk::Context& context, GLFWwindow* window) : context_(context), window_(window) {
   IMGUI_CHECKVERSION();
   ImGui::CreateContext();
   ImGuiIO& io = ImGui::GetIO();
   io.IniFilename = nullptr;  // no imgui.ini left in the user's working directory
   ImGui::StyleColorsDark();
   ImGui::GetStyle().WindowRounding = 4.0f;
+  baseStyle_ = ImGui::GetStyle();
+  // The font drawn at the pixel size the display needs, so text stays sharp:
+  // ImGui's default font is 13 pixels at scale 1.
+  atlasScale_ = contentScale(window);
+  ImFontConfig font;
+  font.OversampleH = font.OversampleV = 1;  // as AddFontDefault() without a config: a pixel font
+  font.PixelSnapH = true;
+  font.SizePixels = std::round(13.0f * atlasScale_);
+  io.Fonts->AddFontDefault(&font);
   if (window) glfw_ = ImGui_ImplGlfw_InitForVulkan(window, true);
 
   VkDescriptorPoolSize sizes[] = {{VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 4}};
@@ -102,7 +126,27 @@ void UiOverlay::newFrame(uint32_t width, uint32_t height, double seconds) {
     io.DisplaySize = ImVec2(float(width), float(height));
     io.DeltaTime = float(seconds > 0.0 ? seconds : 1.0 / 60.0);
   }
+  applyScale();
   ImGui::NewFrame();
+}
+
+// ImGui lays out in window units and the GLFW backend magnifies by the
+// framebuffer scale (pixels per unit: 2 on Wayland or macOS HiDPI, 1 on X11).
+// What is left of the content scale, ours: the style's sizes and the font,
+// whose atlas was drawn at the scale the window opened with. Polled each
+// frame, which also follows the window to a monitor of another scale.
+void UiOverlay::applyScale() {
+  ImGuiIO& io = ImGui::GetIO();
+  float content = contentScale(window_);
+  float perUnit = glfw_ && io.DisplayFramebufferScale.x > 0.0f ? io.DisplayFramebufferScale.x : 1.0f;
+  float scale = content / perUnit;
+  float fontScale = content / atlasScale_ / perUnit;
+  if (scale == scale_ && fontScale == io.FontGlobalScale) return;
+  scale_ = scale;
+  ImGuiStyle& style = ImGui::GetStyle();
+  style = baseStyle_;
+  style.ScaleAllSizes(scale);
+  io.FontGlobalScale = fontScale;
 }
 
 VkFramebuffer UiOverlay::framebufferFor(const vk::Image& target) {

@@ -1,11 +1,14 @@
 // ImGui (Debian's libimgui-dev) drawn over the window image: GLFW input when
 // there is a window, a fixed display size when the viewer runs offscreen.
+// Sized for the display: fonts and spacing follow the window's content scale
+// (HiDPI), read when it opens and again each frame.
 #pragma once
 
 #include "vk/buffer.h"
 #include "vk/commands.h"
 #include "vk/context.h"
 
+#include <imgui.h>
 #include <vulkan/vulkan.h>
 
 #include <map>
@@ -26,7 +29,8 @@ class UiOverlay {
   UiOverlay(const UiOverlay&) = delete;
   UiOverlay& operator=(const UiOverlay&) = delete;
 
-  /// Starts an ImGui frame for a display of width x height.
+  /// Starts an ImGui frame for a display of width x height (and follows a
+  /// change of the window's content scale, e.g. moved to another monitor).
   void newFrame(uint32_t width, uint32_t height, double seconds);
   /// Ends the frame and records its drawing onto `target` (kWindowImageFormat, GENERAL).
   void render(vk::Commands& commands, const vk::Image& target);
@@ -39,8 +43,14 @@ class UiOverlay {
 
  private:
   VkFramebuffer framebufferFor(const vk::Image& target);
+  void applyScale();
   vk::Context& context_;
+  GLFWwindow* window_ = nullptr;
   bool glfw_ = false;
+  /// The font atlas's scale (built once, at the content scale the window
+  /// opened with) and the scale the sizes follow now.
+  float atlasScale_ = 1.0f, scale_ = 0.0f;
+  ImGuiStyle baseStyle_;
   VkDescriptorPool pool_ = VK_NULL_HANDLE;
   VkRenderPass renderPass_ = VK_NULL_HANDLE;
   std::map<VkImageView, VkFramebuffer> framebuffers_;

@@ -31,7 +31,12 @@ struct ViewerOptions {
 };
 
 /// Runs the viewer; returns the process exit code (non-zero when the
-/// validation layer reported anything).
+/// validation layer reported anything). A --camera the scene lacks throws
+/// cli::UsageError; a scene that fails to load, std::runtime_error.
 int runViewer(const ViewerOptions& options);
+
+/// The mouse, trackpad and key bindings, as --help and the overlay list them
+/// (input.cpp, beside the code that binds them).
+extern const char* const kControlsHelp;
 
 }  // namespace snell::viewer

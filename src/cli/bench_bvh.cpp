@@ -1,7 +1,8 @@
 // `snell bench bvh`: how good the GPU's trees are, as SAH cost against a CPU
 // binned-SAH build of the very same triangles (src/ref), per mesh.
-#include "cli/cli.h"
-#include "cli/image_file.h"
+#include "cli/commands.h"
+#include "io/image_file.h"
+#include "io/json.h"
 
 #include "ref/sah_bvh.h"
 #include "render/renderer.h"
@@ -11,27 +12,19 @@
 #include "scene/view.h"
 #include "vk/commands.h"
 
-#include <sstream>
-#include <chrono>
+#include <algorithm>
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
 
 namespace snell::cli {
 
 namespace {
 
-constexpr const char* kHelp = R"(usage: snell bench bvh [SCENE.glb ...] [--json FILE] [--eye-resolution N]
-
-Builds every bottom-level tree of each scene on the GPU (the procedural eye
-first, then the files given) and prices it with the surface area heuristic
-(Ct = 1 per internal node, Ci = 1 per triangle, one triangle per leaf), next
-to a CPU binned-SAH tree (32 bins) over the same triangles. ratio = GPU / CPU: 1.0 is as good
-as binned SAH, higher is worse. "GPU SAH" prices the tree the renderer builds
-(H-PLOC) with exact boxes; "stored" prices its boxes as the nodes store them,
-quantised to 8 bits within each node (what a ray tests); "+restructure" is
-the same build followed by three rounds of treelet restructuring.
-)";
+struct Options {
+  std::vector<std::string> files;
+  std::string json;
+  uint32_t eyeResolution = 64;
+};
 
 struct Row {
   std::string scene, mesh;
@@ -108,35 +101,15 @@ void measure(vk::Context& context, const scene::Scene& scene, const std::string&
   }
 }
 
-}  // namespace
-
-int runBenchBvh(const Args& args) {
-  std::vector<std::string> files;
-  std::string json;
-  uint32_t eyeResolution = 64;
-  for (size_t i = 0; i < args.size(); ++i) {
-    const std::string& a = args[i];
-    if (a == "--help" || a == "-h") {
-      std::fputs(kHelp, stdout);
-      return 0;
-    }
-    if (a == "--json" || a == "--eye-resolution") {
-      if (i + 1 >= args.size()) throw UsageError{"bench bvh: " + a + " needs a value"};
-      if (a == "--json") checkWritable(json = args[++i]);
-      else eyeResolution = uint32_t(parseCount(a, args[++i]));
-    } else if (!a.empty() && a[0] == '-') {
-      throw UsageError{"bench bvh: unknown option " + a};
-    } else {
-      files.push_back(a);
-    }
-  }
-  auto context = vk::Context::create(contextDescFromEnvironment());
+int runBvh(const Options& o) {
+  if (!o.json.empty()) io::checkWritable(o.json);
+  auto context = vk::Context::create(io::contextDescFromEnvironment());
   std::printf("device: %s\n", context->facts().name.c_str());
   std::vector<Row> rows;
   scene::EyeOptions eye;
-  eye.resolution = eyeResolution;
-  measure(*context, scene::makeEye(eye), "eye (resolution " + std::to_string(eyeResolution) + ")", rows);
-  for (const std::string& f : files) {
+  eye.resolution = o.eyeResolution;
+  measure(*context, scene::makeEye(eye), "eye (resolution " + std::to_string(o.eyeResolution) + ")", rows);
+  for (const std::string& f : o.files) {
     scene::LoadOptions load;
     load.ignoredExtensions = {"KHR_materials_iridescence"};
     measure(*context, scene::loadGltf(f, load), std::filesystem::path(f).stem().string(), rows);
@@ -151,22 +124,49 @@ int runBenchBvh(const Args& args) {
     worst = std::max(worst, r.ratio());
   }
   std::printf("worst ratio %.3f\n", worst);
-  if (!json.empty()) {
-    std::ostringstream out;  // written whole or not at all
-    out << "{\n  \"device\": \"" << context->facts().name << "\",\n  \"meshes\": [\n";
-    for (size_t i = 0; i < rows.size(); ++i) {
-      const Row& r = rows[i];
-      out << "    {\"scene\": \"" << r.scene << "\", \"mesh\": \"" << r.mesh << "\", \"triangles\": " << r.triangles
-          << ", \"gpu_sah\": " << r.gpuCost << ", \"restructured_sah\": " << r.restructuredCost
-          << ", \"cpu_binned_sah\": " << r.cpuCost << ", \"ratio\": " << r.ratio()
-          << ", \"stored_quantised_ratio\": " << r.storedRatio()
-          << ", \"restructured_ratio\": " << r.restructuredRatio()
-          << "}" << (i + 1 < rows.size() ? "," : "") << "\n";
+  if (!o.json.empty()) {
+    io::Json j = io::reportHead("bench-bvh", &context->facts());
+    io::Json meshes = io::Json::array();
+    for (const Row& r : rows) {
+      meshes.push_back(io::Json{{"scene", r.scene},
+                                {"mesh", r.mesh},
+                                {"triangles", r.triangles},
+                                {"gpu_sah", r.gpuCost},
+                                {"restructured_sah", r.restructuredCost},
+                                {"cpu_binned_sah", r.cpuCost},
+                                {"ratio", r.ratio()},
+                                {"stored_quantised_ratio", r.storedRatio()},
+                                {"restructured_ratio", r.restructuredRatio()}});
     }
-    out << "  ],\n  \"worst_ratio\": " << worst << "\n}\n";
-    writeTextFile(json, out.str());
+    j["meshes"] = std::move(meshes);
+    j["worst_ratio"] = worst;
+    io::writeJson(o.json, j);
   }
-  return 0;
+  return validationExitCode(*context);
+}
+
+}  // namespace
+
+void addBenchBvh(CLI::App& bench, Runner& run) {
+  auto o = std::make_shared<Options>();
+  CLI::App* sub = bench.add_subcommand("bvh", "SAH cost of the GPU's trees against a CPU binned-SAH tree, per mesh");
+  describe(*sub,
+      "Builds every bottom-level tree of each scene on the GPU (the procedural eye\n"
+      "first, then the files given) and prices it with the surface area heuristic\n"
+      "(Ct = 1 per internal node, Ci = 1 per triangle, one triangle per leaf), next\n"
+      "to a CPU binned-SAH tree (32 bins) over the same triangles. ratio = GPU / CPU: 1.0 is as good\n"
+      "as binned SAH, higher is worse. \"GPU SAH\" prices the tree the renderer builds\n"
+      "(H-PLOC) with exact boxes; \"stored\" prices its boxes as the nodes store them,\n"
+      "quantised to 8 bits within each node (what a ray tests); \"+restructure\" is\n"
+      "the same build followed by three rounds of treelet restructuring.");
+  sub->footer(kHelpFooter);
+  sub->add_option("scenes", o->files, "glTF files measured after the procedural eye")->type_name("SCENE.glb");
+  sub->add_option("--json", o->json, "write the results as JSON too")->type_name("FILE");
+  // The procedural eye's own limits (scene::checkEyeOptions), named after this option.
+  sub->add_option("--eye-resolution", o->eyeResolution, "segments of the procedural eye, 8-2048 (default 64)")
+      ->type_name("N")
+      ->check(CLI::Range(8u, 2048u));
+  sub->callback([o, &run] { run = [o] { return runBvh(*o); }; });
 }
 
 }  // namespace snell::cli

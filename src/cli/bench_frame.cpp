@@ -1,8 +1,9 @@
 // `snell bench frame`: GPU time of each pass of a frame (deform, bottom-level
 // build or refit, top level, raster, trace) while the scene animates, medians
 // over many frames, and what each frame did and skipped.
-#include "cli/cli.h"
-#include "cli/image_file.h"
+#include "cli/commands.h"
+#include "io/image_file.h"
+#include "io/json.h"
 
 #include "render/method.h"
 #include "render/renderer.h"
@@ -12,43 +13,26 @@
 #include "scene/scene_summary.h"
 #include "scene/view.h"
 
-#include <sstream>
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <fstream>
+#include <cstdlib>
+#include <limits>
 #include <map>
 
 namespace snell::cli {
 
 namespace {
 
-constexpr const char* kHelp = R"(usage: snell bench frame [SCENE.glb] [options]
-
-Renders animated frames of the procedural eye (or SCENE) and reports each
-pass's GPU time: the median, min and max over the measured frames. The first
-frame builds the trees ("blas build"); later frames refit what deformed and
-rebuild trees the surface area heuristic finds spoiled.
-
-"refraction" sums the passes refraction costs: deform, the trees and the
-trace (with --viewport the trace covers only the pixels whose visible face is
-transmissive); the raster passes draw the viewport with or without it.
-
-options:
-  --size WxH          image size (default 1920x1080)
-  --frames N          frames measured (default 30)
-  --warmup N          frames rendered first and not measured (default 5)
-  --eye-resolution N  segments of the procedural eye (default 64)
-  --crowd N           N characters' eye pairs instead of one eye
-  --viewport          the viewport composite: raster pass, transmissive pixels traced
-  --no-mask           with --viewport: trace every pixel
-  --no-refraction     with --viewport: glass left out, nothing traced
-  --json FILE         write the results as JSON too
-  --soak SECONDS      render for SECONDS instead, and every twentieth of it
-                      report the frame time, host memory (resident), GPU memory
-                      and validation messages; fails if GPU memory grows
-)";
+struct Options {
+  std::string file;  ///< empty: the procedural eye
+  uint32_t width = 1920, height = 1080, frames = 30, warmup = 5;
+  scene::EyeOptions eye;
+  bool viewport = false, noMask = false, noRefraction = false;
+  std::string json;
+  double soak = 0;  ///< seconds; 0: measure --frames instead
+};
 
 // The refraction work these tables quote: the refraction passes, and the
 // deform that trees and trace both wait for.
@@ -84,7 +68,7 @@ int soakFrames(const vk::Context& context, const render::Renderer& renderer, Ren
     wallMs.push_back(wall);
     double now = std::chrono::duration<double>(Clock::now() - start).count();
     if (now < interval * double(samples.size() + 1)) continue;
-    Sample s{now, f - warmup, median(frameMs), median(wallMs), hostResidentBytes(), context.memoryInUse(),
+    Sample s{now, f - warmup, median(frameMs), median(wallMs), io::hostResidentBytes(), context.memoryInUse(),
              context.validationMessageCount()};
     samples.push_back(s);
     frameMs.clear();
@@ -104,81 +88,40 @@ int soakFrames(const vk::Context& context, const render::Renderer& renderer, Ren
               double(first.deviceBytes) / 1048576.0, double(last.deviceBytes) / 1048576.0, hostGrowth / 1048576.0,
               (unsigned long long)last.validation, double(renderer.memoryBytes()) / 1048576.0);
   if (!json.empty()) {
-    std::ostringstream out;
-    out << "{\n  \"device\": \"" << jsonEscape(context.facts().name) << "\",\n  \"scene\": \"" << jsonEscape(label)
-        << "\",\n  \"mode\": \"" << mode << "\",\n  \"soak_seconds\": " << seconds << ",\n  \"frames\": " << last.frames
-        << ",\n  \"device_memory_flat\": " << (deviceFlat ? "true" : "false")
-        << ",\n  \"host_growth_bytes\": " << int64_t(hostGrowth) << ",\n  \"samples\": [\n";
-    for (size_t i = 0; i < samples.size(); ++i) {
-      const Sample& s = samples[i];
-      out << "    {\"seconds\": " << s.atSeconds << ", \"frames\": " << s.frames << ", \"frame_median_ms\": " << s.frameMs
-          << ", \"wall_median_ms\": " << s.wallMs << ", \"host_resident_bytes\": " << s.hostBytes
-          << ", \"device_bytes\": " << s.deviceBytes << ", \"validation_messages\": " << s.validation << "}"
-          << (i + 1 < samples.size() ? "," : "") << "\n";
+    io::Json j = io::reportHead("bench-frame", &context.facts());
+    j["scene"] = label;
+    j["mode"] = mode;
+    j["soak_seconds"] = seconds;
+    j["frames"] = last.frames;
+    j["device_memory_flat"] = deviceFlat;
+    j["host_growth_bytes"] = int64_t(hostGrowth);
+    io::Json rows = io::Json::array();
+    for (const Sample& s : samples) {
+      rows.push_back(io::Json{{"seconds", s.atSeconds},
+                              {"frames", s.frames},
+                              {"frame_median_ms", s.frameMs},
+                              {"wall_median_ms", s.wallMs},
+                              {"host_resident_bytes", s.hostBytes},
+                              {"device_bytes", s.deviceBytes},
+                              {"validation_messages", s.validation}});
     }
-    out << "  ]\n}\n";
-    writeTextFile(json, out.str());
+    j["samples"] = std::move(rows);
+    io::writeJson(json, j);
   }
-  return deviceFlat && last.validation == 0 ? 0 : 1;
+  return deviceFlat && last.validation == 0 ? kExitOk : kExitFailure;
 }
 
-}  // namespace
-
-int runBenchFrame(const Args& args) {
-  uint32_t width = 1920, height = 1080, frames = 30, warmup = 5;
-  scene::EyeOptions eye;
-  bool viewport = false, masked = true, refraction = true;
-  std::string json, file;
-  double soak = 0;
-  for (size_t i = 0; i < args.size(); ++i) {
-    const std::string& a = args[i];
-    if (a == "--help" || a == "-h") {
-      std::fputs(kHelp, stdout);
-      return 0;
-    }
-    if (!a.empty() && a[0] != '-') {
-      file = a;
-      continue;
-    }
-    if (a == "--viewport" || a == "--no-mask" || a == "--no-refraction") {
-      viewport = viewport || a == "--viewport";
-      masked = masked && a != "--no-mask";
-      refraction = refraction && a != "--no-refraction";
-      continue;
-    }
-    if (i + 1 >= args.size()) throw UsageError{"bench frame: " + a + " needs a value (or is unknown)"};
-    const std::string& v = args[++i];
-    if (a == "--size") {
-      parseSize(a, v, width, height);
-    } else if (a == "--frames") {
-      frames = std::max<uint32_t>(1, uint32_t(parseCount(a, v)));
-    } else if (a == "--warmup") {
-      warmup = uint32_t(parseCount(a, v));
-    } else if (a == "--eye-resolution") {
-      eye.resolution = uint32_t(parseCount(a, v));
-    } else if (a == "--crowd") {
-      eye.crowd = uint32_t(parseCount(a, v));
-    } else if (a == "--json") {
-      checkWritable(json = v);
-    } else if (a == "--soak") {
-      soak = parseNumbers(a, v, 1)[0];
-      if (!(soak > 0)) throw UsageError{"bench frame: --soak takes seconds above 0, got " + v};
-    } else {
-      throw UsageError{"bench frame: unknown option " + a};
-    }
+int runFrame(const Options& o) {
+  if (!o.json.empty()) io::checkWritable(o.json);
+  const uint32_t width = o.width, height = o.height, frames = o.frames, warmup = o.warmup;
+  const bool viewport = o.viewport, masked = !o.noMask, refraction = !o.noRefraction;
+  scene::Scene scene = o.file.empty() ? scene::makeEye(o.eye) : scene::loadGltf(o.file);
+  std::string label = o.file;
+  if (o.file.empty()) {
+    label = o.eye.crowd ? "eye crowd of " + std::to_string(o.eye.crowd) : std::string("eye");
+    label += " (resolution " + std::to_string(o.eye.resolution) + ")";
   }
-  try {
-    scene::checkEyeOptions(eye);
-  } catch (const std::invalid_argument& e) {
-    throw UsageError{std::string("bench frame: ") + e.what()};
-  }
-  scene::Scene scene = file.empty() ? scene::makeEye(eye) : scene::loadGltf(file);
-  std::string label = file;
-  if (file.empty()) {
-    label = eye.crowd ? "eye crowd of " + std::to_string(eye.crowd) : std::string("eye");
-    label += " (resolution " + std::to_string(eye.resolution) + ")";
-  }
-  auto context = vk::Context::create(contextDescFromEnvironment());
+  auto context = vk::Context::create(io::contextDescFromEnvironment());
   render::checkImageSize(*context, width, height);
   scene::SceneSummary summary = scene::summarize(scene);
   std::string mode = !viewport ? "trace" : !refraction ? "viewport, no refraction" : masked ? "viewport, masked trace"
@@ -218,7 +161,11 @@ int runBenchFrame(const Args& args) {
     wall = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
     return result;
   };
-  if (soak > 0) return soakFrames(*context, renderer, renderFrame, warmup, soak, json, label, mode);
+  if (o.soak > 0) {
+    int soaked = soakFrames(*context, renderer, renderFrame, warmup, o.soak, o.json, label, mode);
+    int validation = validationExitCode(*context);
+    return soaked == kExitOk ? validation : soaked;
+  }
   for (uint32_t f = 0; f < warmup + frames; ++f) {
     double wall = 0;
     const render::FrameResult& result = renderFrame(f, wall);
@@ -263,28 +210,82 @@ int runBenchFrame(const Args& args) {
   for (const std::string& c : counterOrder) std::printf(" %s %.0f,", c.c_str(), median(counters[c]));
   std::printf("\nGPU memory (geometry, deformation, trees, per-frame tables): %.2f MiB, trees %.1f bytes per triangle\n",
               double(renderer.memoryBytes()) / 1048576.0, renderer.treeBytesPerTriangle());
-  if (!json.empty()) {
-    std::ostringstream out;  // written whole or not at all
-    out << "{\n  \"device\": \"" << jsonEscape(context->facts().name) << "\",\n  \"scene\": \"" << jsonEscape(label)
-        << "\",\n  \"mode\": \"" << mode << "\",\n  \"triangles\": " << summary.triangles << ",\n  \"width\": " << width
-        << ",\n  \"height\": " << height << ",\n  \"memory_bytes\": " << renderer.memoryBytes()
-        << ",\n  \"tree_bytes_per_triangle\": " << renderer.treeBytesPerTriangle() << ",\n  \"passes\": [\n";
-    for (size_t i = 0; i < order.size(); ++i) {
-      const std::vector<double>& v = times[order[i]];
-      out << "    {\"pass\": \"" << order[i] << "\", \"median_ms\": " << median(v)
-          << ", \"min_ms\": " << *std::min_element(v.begin(), v.end())
-          << ", \"max_ms\": " << *std::max_element(v.begin(), v.end()) << ", \"frames\": " << v.size() << "}"
-          << (i + 1 < order.size() ? "," : "") << "\n";
+  if (!o.json.empty()) {
+    io::Json j = io::reportHead("bench-frame", &context->facts());
+    j["scene"] = label;
+    j["mode"] = mode;
+    j["triangles"] = summary.triangles;
+    j["width"] = width;
+    j["height"] = height;
+    j["memory_bytes"] = renderer.memoryBytes();
+    j["tree_bytes_per_triangle"] = renderer.treeBytesPerTriangle();
+    io::Json passes = io::Json::array();
+    for (const std::string& name : order) {
+      const std::vector<double>& v = times[name];
+      passes.push_back(io::Json{{"pass", name},
+                                {"median_ms", median(v)},
+                                {"min_ms", *std::min_element(v.begin(), v.end())},
+                                {"max_ms", *std::max_element(v.begin(), v.end())},
+                                {"frames", v.size()}});
     }
-    out << "  ],\n  \"frame_median_ms\": " << median(totals) << ",\n  \"refraction_median_ms\": "
-        << median(refractionTotals) << ",\n  \"wall_median_ms\": " << median(walls) << ",\n  \"counters_median\": {";
-    for (size_t i = 0; i < counterOrder.size(); ++i) {
-      out << (i ? ", " : "") << "\"" << counterOrder[i] << "\": " << median(counters[counterOrder[i]]);
-    }
-    out << "}\n}\n";
-    writeTextFile(json, out.str());
+    j["passes"] = std::move(passes);
+    j["frame_median_ms"] = median(totals);
+    j["refraction_median_ms"] = median(refractionTotals);
+    j["wall_median_ms"] = median(walls);
+    io::Json countersMedian = io::Json::object();
+    for (const std::string& c : counterOrder) countersMedian[c] = median(counters[c]);
+    j["counters_median"] = std::move(countersMedian);
+    io::writeJson(o.json, j);
   }
-  return 0;
+  return validationExitCode(*context);
+}
+
+}  // namespace
+
+void addBenchFrame(CLI::App& bench, Runner& run) {
+  auto o = std::make_shared<Options>();
+  CLI::App* sub = bench.add_subcommand("frame", "GPU time of each pass of an animated frame, with counters");
+  describe(*sub,
+      "Renders animated frames of the procedural eye (or SCENE) and reports each\n"
+      "pass's GPU time: the median, min and max over the measured frames. The first\n"
+      "frame builds the trees (\"blas build\"); later frames refit what deformed and\n"
+      "rebuild trees the surface area heuristic finds spoiled.\n"
+      "\n"
+      "\"refraction\" sums the passes refraction costs: deform, the trees and the\n"
+      "trace (with --viewport the trace covers only the pixels whose visible face is\n"
+      "transmissive); the raster passes draw the viewport with or without it.");
+  sub->footer(kHelpFooter);
+  sub->add_option("scene", o->file, "the glTF file instead of the procedural eye")->type_name("SCENE.glb");
+  addSize(*sub, "--size", o->width, o->height, "image size (default 1920x1080)");
+  CLI::Option* frames = sub->add_option("--frames", o->frames, "frames measured (default 30)")
+                            ->type_name("N")
+                            ->check(CLI::Range(1u, std::numeric_limits<uint32_t>::max(), "POSITIVE"));
+  sub->add_option("--warmup", o->warmup, "frames rendered first and not measured (default 5)")->type_name("N");
+  // The procedural eye's own limits (scene::checkEyeOptions), named after these options.
+  sub->add_option("--eye-resolution", o->eye.resolution, "segments of the procedural eye, 8-2048 (default 64)")
+      ->type_name("N")
+      ->check(CLI::Range(8u, 2048u));
+  sub->add_option("--crowd", o->eye.crowd, "N characters' eye pairs instead of one eye (at most 10000)")
+      ->type_name("N")
+      ->check(CLI::Range(0u, 10000u));
+  CLI::Option* viewport =
+      sub->add_flag("--viewport", o->viewport, "the viewport composite: raster pass, transmissive pixels traced");
+  CLI::Option* noMask = sub->add_flag("--no-mask", o->noMask, "with --viewport: trace every pixel")->needs(viewport);
+  sub->add_flag("--no-refraction", o->noRefraction, "with --viewport: glass left out, nothing traced")
+      ->needs(viewport)
+      ->excludes(noMask);
+  sub->add_option("--json", o->json, "write the results as JSON too")->type_name("FILE");
+  sub->add_option("--soak", o->soak,
+                  "render for SECONDS instead, and every twentieth of it\n"
+                  "report the frame time, host memory (resident), GPU memory\n"
+                  "and validation messages; fails if GPU memory grows")
+      ->type_name("SECONDS")
+      ->check([](const std::string& value) -> std::string {
+        double seconds = std::strtod(value.c_str(), nullptr);
+        return seconds > 0 && std::isfinite(seconds) ? "" : "takes seconds above 0, got " + value;
+      })
+      ->excludes(frames);
+  sub->callback([o, &run] { run = [o] { return runFrame(*o); }; });
 }
 
 }  // namespace snell::cli

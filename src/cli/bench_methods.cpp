@@ -1,10 +1,12 @@
 // `snell bench methods`: what each way of drawing refraction costs and how
 // wrong it is, on the same animated frames. Errors are against the CPU
 // double-precision reference of each frame, never against another GPU image.
-#include "cli/cli.h"
+#include "cli/commands.h"
 
 #include "bake/refraction_bake.h"
-#include "cli/image_file.h"
+#include "io/image_file.h"
+#include "io/json.h"
+#include "io/progress.h"
 #include "ref/reference_tracer.h"
 #include "render/method.h"
 #include "render/renderer.h"
@@ -20,6 +22,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <functional>
 #include <limits>
 #include <optional>
@@ -31,60 +34,15 @@ namespace snell::cli {
 
 namespace {
 
-constexpr const char* kHelp = R"(usage: snell bench methods [SCENE.glb] [options]
-
-Renders an animated sequence of the procedural eye (or SCENE) with every way
-snell can draw refraction and reports, per method, the median GPU time of its
-refraction work per frame and its error against the CPU double-precision
-reference of the same frames. The sequence plays the scene's animation (the
-eye looks around, squashes and dilates) while the camera orbits from the
-scene's own view to 80 degrees aside, a grazing view of the cornea.
-
-Refraction work is every pass but deform and the viewport's own raster depth
-and shading, which a viewport pays with or without glass; the first frame's
-tree build is a warm-up and not counted. Times are medians over three passes
-through the sequence after one to warm up, every method drawing each frame in
-turn (so the GPU's clock changes fall on all alike), two frames in flight and
-nothing read back; the errors come from one more pass that reads every frame
-back. Errors compare 8-bit sRGB pixels as
-a PNG would hold them: RMSE, the share of pixels over 1/255 and over 8/255,
-the largest difference, over the pixels whose first hit in the reference is
-transmissive, and over the whole image.
-
-methods: trace, trace-1, masked, iris-plane, normal-offset, refraction-map
-(a map baked by the trace at the first frame, read by every frame after: a
-table shows its glass error against animation time beside the others'), none, and
-driver-rt, the peer: the same rays and shading code with the hits found by
-the driver's own ray tracing (VK_KHR_ray_tracing_pipeline), where the device
-has it (not lavapipe: reported unsupported). For it the table adds the share
-of pixels whose first hit (instance, triangle) agrees with trace's, and its
-build (first frame), update and trace times.
-
-With --optics the rows are not methods but the optics features, each drawn
-by trace on its own copy of the scene against its own reference: "plain"
-(no Fresnel: the bend only), "fresnel" (the default: Fresnel, one reflected
-ray, the lights' highlights, the studio gradient), "environment" (an HDR sky
-instead of the gradient), "reflections-4", and on every transmissive
-material "volume" (Beer-Lambert), "dispersion" (Abbe number 20: three rays
-where it applies), "ior-texture" (the scene's first texture as IOR, scale
-0.05); for the procedural eye "aqueous" (nested media), and "all" of them.
-
-options:
-  --size WxH          image size (default 320x240)
-  --frames N          frames of the sequence (default 24)
-  --methods A,B,...   only these methods
-  --max-interfaces N  refractive faces a traced ray may cross (default 8)
-  --offset-strength S normal-offset's displacement in image heights (0.02)
-  --eye-resolution N  segments of the procedural eye (default 64)
-  --crowd N           N characters' eye pairs instead of one eye
-  --optics            rows per optics feature (trace) instead of per method
-  --no-reference      time only: no CPU reference, no errors (for scaling runs)
-  --json FILE         write the results as JSON
-  --svg FILE          write a chart of time against error (log-log, the
-                      Pareto front drawn) that a browser opens
-  --images DIR        write the last (grazing) frame of each method and of the
-                      reference there as PNG (DIR/METHOD.png, DIR/reference.png)
-)";
+struct Options {
+  std::string file;  ///< empty: the procedural eye
+  uint32_t width = 320, height = 240, frames = 24, maxInterfaces = gpu::kDefaultMaxInterfaces;
+  float offsetStrength = render::RasterOptions{}.offsetStrength;
+  std::vector<std::string> methods;  ///< empty: every method
+  scene::EyeOptions eye;
+  bool optics = false, noReference = false;
+  std::string json, svg, images;
+};
 
 // Times of each method come from this many passes over the sequence.
 constexpr uint32_t kTimingRounds = 3;
@@ -102,7 +60,7 @@ struct Frame {
   scene::Pose pose;
   scene::View view;
   render::RasterOptions raster;  ///< depth range fitted to the frame, offset strength
-  Rgb8Image reference;
+  io::Rgb8Image reference;
   std::vector<bool> transmissive;  ///< the reference's first hit is a refractive face
 };
 
@@ -129,7 +87,7 @@ struct MethodResult {
 };
 
 // Adds a frame's differences to the row's errors; returns the frame's own glass error.
-Error accumulate(const Rgb8Image& got, const Frame& frame, Error& glass, Error& image, double& worstWithin1) {
+Error accumulate(const io::Rgb8Image& got, const Frame& frame, Error& glass, Error& image, double& worstWithin1) {
   Error frameError, frameGlass;
   for (size_t i = 0; i < size_t(got.width) * got.height; ++i) {
     int worst = 0;
@@ -166,14 +124,6 @@ scene::View orbitView(const scene::Scene& scene, const scene::Pose& pose, const 
                                  start.up};
   request.yfov = 2.0 * std::atan(start.halfHeight);
   return scene::resolveView(scene, pose, request);
-}
-
-std::vector<std::string> splitList(const std::string& value) {
-  std::vector<std::string> parts;
-  std::stringstream in(value);
-  std::string part;
-  while (std::getline(in, part, ',')) parts.push_back(part);
-  return parts;
 }
 
 // ------------------------------------------------------------------ chart
@@ -269,10 +219,11 @@ struct SequenceSettings {
 };
 
 // The animated sequence of one scene, with the reference image of each frame
-// under `optics` (unless the run has no reference).
+// under `optics` (unless the run has no reference). `progress` counts the
+// reference frames of every sequence of the run, `done` of them made so far.
 std::shared_ptr<const std::vector<Frame>> makeFrames(const scene::Scene& scene, const scene::Optics& optics,
                                                      const SequenceSettings& s, const std::string& imageName,
-                                                     std::chrono::steady_clock::time_point began) {
+                                                     io::Progress& progress, uint64_t& done) {
   double duration = scene::animationDuration(scene);
   scene::Pose first = scene::evaluate(scene, 0.0);
   scene::View start = scene::resolveView(scene, first, scene::ViewRequest{});
@@ -296,7 +247,7 @@ std::shared_ptr<const std::vector<Frame>> makeFrames(const scene::Scene& scene, 
     settings.maxInterfaces = s.maxInterfaces;
     settings.optics = optics;
     ref::ReferenceImage reference = ref::renderReference(scene, frame.pose, settings);
-    LinearImage linear{s.width, s.height, {}};
+    io::LinearImage linear{s.width, s.height, {}};
     frame.transmissive.resize(reference.color.size());
     for (size_t i = 0; i < reference.color.size(); ++i) {
       linear.rgba.emplace_back(glm::vec3(reference.color[i]), 1.0f);
@@ -306,10 +257,9 @@ std::shared_ptr<const std::vector<Frame>> makeFrames(const scene::Scene& scene, 
       int material = scene.shapes[size_t(shape)].material;
       frame.transmissive[i] = material >= 0 && scene.materials[size_t(material)].refractive();
     }
-    frame.reference = toSrgb8(linear);
-    if (!s.images.empty() && f + 1 == s.frames) writeImage(s.images + "/" + imageName + ".png", linear);
-    double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - began).count();
-    std::fprintf(stderr, "\rCPU reference (%s): frame %u/%u, %.1f s   ", imageName.c_str(), f + 1, s.frames, seconds);
+    frame.reference = io::toSrgb8(linear);
+    if (!s.images.empty() && f + 1 == s.frames) io::writeImage(s.images + "/" + imageName + ".png", linear);
+    progress.update(++done, imageName);
   }
   return frames;
 }
@@ -359,80 +309,28 @@ std::vector<OpticsVariant> opticsVariants(const scene::Scene& scene, const std::
   return rows;
 }
 
-}  // namespace
-
-int runBenchMethods(const Args& args) {
-  uint32_t width = 320, height = 240, frameCount = 24, maxInterfaces = gpu::kDefaultMaxInterfaces;
-  float offsetStrength = render::RasterOptions{}.offsetStrength;
-  std::string file, json, svg, images;
-  scene::EyeOptions eye;
-  bool reference = true, optics = false;
+int runMethods(const Options& o) {
+  if (!o.json.empty()) io::checkWritable(o.json);
+  if (!o.svg.empty()) io::checkWritable(o.svg);
+  if (!o.images.empty()) io::checkWritable(o.images + "/trace.png");  // the folder exists and takes files
+  const uint32_t width = o.width, height = o.height, frameCount = o.frames, maxInterfaces = o.maxInterfaces;
+  const bool reference = !o.noReference, optics = o.optics;
   std::vector<render::MethodInfo> chosen = render::methods();
-  for (size_t i = 0; i < args.size(); ++i) {
-    const std::string& a = args[i];
-    if (a == "--help" || a == "-h") {
-      std::fputs(kHelp, stdout);
-      return 0;
-    }
-    if (!a.empty() && a[0] != '-') {
-      file = a;
-      continue;
-    }
-    if (a == "--no-reference" || a == "--optics") {
-      reference = reference && a != "--no-reference";
-      optics = optics || a == "--optics";
-      continue;
-    }
-    if (i + 1 >= args.size()) throw UsageError{"bench methods: " + a + " needs a value (or is unknown)"};
-    const std::string& v = args[++i];
-    if (a == "--size") {
-      parseSize(a, v, width, height);
-    } else if (a == "--frames") {
-      frameCount = std::max<uint32_t>(1, uint32_t(parseCount(a, v)));
-    } else if (a == "--max-interfaces") {
-      maxInterfaces = uint32_t(std::min<unsigned long long>(parseCount(a, v), 1024));
-    } else if (a == "--offset-strength") {
-      char* end = nullptr;
-      offsetStrength = std::strtof(v.c_str(), &end);
-      if (v.empty() || *end != '\0' || !std::isfinite(offsetStrength)) {
-        throw UsageError{"bench methods: --offset-strength expects a number, got '" + v + "'"};
+  if (!o.methods.empty()) {
+    chosen.clear();
+    for (const std::string& name : o.methods) {
+      for (const render::MethodInfo& info : render::methods()) {
+        if (info.name == name) chosen.push_back(info);
       }
-    } else if (a == "--methods") {
-      chosen.clear();
-      for (const std::string& name : splitList(v)) {
-        std::optional<render::Method> m = render::methodFromName(name);
-        if (!m) throw UsageError{"bench methods: unknown method '" + name + "' (" + render::methodNames() + ")"};
-        for (const render::MethodInfo& info : render::methods()) {
-          if (info.method == *m) chosen.push_back(info);
-        }
-      }
-    } else if (a == "--eye-resolution") {
-      eye.resolution = uint32_t(parseCount(a, v));
-    } else if (a == "--crowd") {
-      eye.crowd = uint32_t(parseCount(a, v));
-    } else if (a == "--json") {
-      checkWritable(json = v);
-    } else if (a == "--svg") {
-      checkWritable(svg = v);
-    } else if (a == "--images") {
-      images = v;
-      checkWritable(images + "/trace.png");  // the folder exists and takes files
-    } else {
-      throw UsageError{"bench methods: unknown option " + a};
     }
   }
-  try {
-    scene::checkEyeOptions(eye);
-  } catch (const std::invalid_argument& e) {
-    throw UsageError{std::string("bench methods: ") + e.what()};
+  scene::Scene scene = o.file.empty() ? scene::makeEye(o.eye) : scene::loadGltf(o.file);
+  std::string label = o.file;
+  if (o.file.empty()) {
+    label = o.eye.crowd ? "eye crowd of " + std::to_string(o.eye.crowd) : std::string("procedural eye");
+    label += " (resolution " + std::to_string(o.eye.resolution) + ")";
   }
-  scene::Scene scene = file.empty() ? scene::makeEye(eye) : scene::loadGltf(file);
-  std::string label = file;
-  if (file.empty()) {
-    label = eye.crowd ? "eye crowd of " + std::to_string(eye.crowd) : std::string("procedural eye");
-    label += " (resolution " + std::to_string(eye.resolution) + ")";
-  }
-  vk::ContextDesc desc = contextDescFromEnvironment();
+  vk::ContextDesc desc = io::contextDescFromEnvironment();
   desc.driverRayTracing = true;  // for driver-rt, where the device has it
   auto context = vk::Context::create(desc);
   render::checkImageSize(*context, width, height);
@@ -443,14 +341,17 @@ int runBenchMethods(const Args& args) {
   // on each optics variant. Frames and references are made once per variant.
   std::vector<OpticsVariant> variants;
   if (optics) {
-    variants = opticsVariants(scene, file.empty() ? std::optional<scene::EyeOptions>(eye) : std::nullopt);
+    variants = opticsVariants(scene, o.file.empty() ? std::optional<scene::EyeOptions>(o.eye) : std::nullopt);
     auto trace = std::find_if(render::methods().begin(), render::methods().end(),
                               [](const render::MethodInfo& m) { return m.method == render::Method::Trace; });
     chosen.assign(variants.size(), *trace);
   }
   std::vector<MethodResult> results(chosen.size());
-  SequenceSettings sequence{width, height, frameCount, maxInterfaces, offsetStrength, reference, images};
-  auto began = std::chrono::steady_clock::now();
+  SequenceSettings sequence{width, height, frameCount, maxInterfaces, o.offsetStrength, reference, o.images};
+  // One sequence per optics row, or one that every method shares.
+  size_t sequences = optics ? chosen.size() : std::min<size_t>(chosen.size(), 1);
+  io::Progress progress("CPU reference frames", reference ? frameCount * sequences : 0, quiet());
+  uint64_t referenceFrames = 0;
   for (size_t m = 0; m < chosen.size(); ++m) {
     MethodResult& r = results[m];
     r.info = chosen[m];
@@ -459,12 +360,12 @@ int runBenchMethods(const Args& args) {
     r.scene = optics ? &variants[m].scene : &scene;
     r.optics = optics ? variants[m].optics : scene::Optics{};
     if (m == 0 || optics) {
-      r.frames = makeFrames(*r.scene, r.optics, sequence, optics ? "reference-" + r.name : "reference", began);
+      r.frames = makeFrames(*r.scene, r.optics, sequence, optics ? "reference-" + r.name : "reference", progress,
+                            referenceFrames);
     } else {
       r.frames = results[0].frames;
     }
   }
-  if (reference) std::fputc('\n', stderr);
 
   // One renderer per row, all alive at once, so the timing can take the rows
   // in turn on every frame: whatever the GPU's clocks do, they do it to every
@@ -559,12 +460,12 @@ int runBenchMethods(const Args& args) {
         for (const gpu::TraceAov& a : pixels.aov) hits.emplace_back(a.instance, a.primitive);
         if (method == render::Method::DriverRt) driver = &result;
       }
-      LinearImage image{width, height, render::drawsComposite(method) ? pixels.composite : pixels.trace};
+      io::LinearImage image{width, height, render::drawsComposite(method) ? pixels.composite : pixels.trace};
       if (reference) {
-        Error glass = accumulate(toSrgb8(image), frame, result.glass, result.image, result.worstFrameWithin1);
+        Error glass = accumulate(io::toSrgb8(image), frame, result.glass, result.image, result.worstFrameWithin1);
         result.frameGlassRmse.push_back(glass.rmse());
       }
-      if (!images.empty() && f + 1 == frameCount) writeImage(images + "/" + result.name + ".png", image);
+      if (!o.images.empty() && f + 1 == frameCount) io::writeImage(o.images + "/" + result.name + ".png", image);
       if (f + 1 == frameCount) result.memoryBytes = renderers[m]->memoryBytes();
     }
     if (driver && traceHits.size() == driverHits.size()) {
@@ -660,46 +561,134 @@ int runBenchMethods(const Args& args) {
 
   std::string title = "snell bench methods: " + label + ", " + std::to_string(width) + "x" + std::to_string(height) +
                       ", " + std::to_string(frameCount) + " frames, " + context->facts().name;
-  if (!json.empty()) {
-    std::ostringstream out;
+  if (!o.json.empty()) {
     auto errorJson = [](const Error& e) {
-      std::ostringstream o;
-      o << "{\"pixels\": " << e.pixels << ", \"rmse\": " << e.rmse() << ", \"share_over_1\": " << e.share(e.over1)
-        << ", \"share_over_8\": " << e.share(e.over8) << ", \"max\": " << e.maximum << "}";
-      return o.str();
+      return io::Json{{"pixels", e.pixels},
+                      {"rmse", e.rmse()},
+                      {"share_over_1", e.share(e.over1)},
+                      {"share_over_8", e.share(e.over8)},
+                      {"max", e.maximum}};
     };
-    out << "{\n  \"device\": \"" << jsonEscape(context->facts().name) << "\",\n  \"scene\": \"" << jsonEscape(label)
-        << "\",\n  \"width\": " << width << ",\n  \"height\": " << height << ",\n  \"frames\": " << frameCount
-        << ",\n  \"rows\": \"" << (optics ? "optics features, drawn by trace" : "methods") << "\",\n  \"methods\": [\n";
-    for (size_t i = 0; i < results.size(); ++i) {
-      const MethodResult& r = results[i];
+    io::Json j = io::reportHead("bench-methods", &context->facts());
+    j["scene"] = label;
+    j["width"] = width;
+    j["height"] = height;
+    j["frames"] = frameCount;
+    j["rows"] = optics ? "optics features, drawn by trace" : "methods";
+    io::Json rows = io::Json::array();
+    for (const MethodResult& r : results) {
       if (!r.unsupported.empty()) {
-        out << "    {\"method\": \"" << r.name << "\", \"unsupported\": \"" << jsonEscape(r.unsupported) << "\"}"
-            << (i + 1 < results.size() ? "," : "") << "\n";
+        rows.push_back(io::Json{{"method", r.name}, {"unsupported", r.unsupported}});
         continue;
       }
-      out << "    {\"method\": \"" << r.name << "\", \"passes_median_ms\": {";
-      bool comma = false;
-      for (const auto& [name, v] : r.passMs) out << (comma ? ", " : "") << "\"" << name << "\": " << median(v), comma = true;
-      out << "}, \"first_frame_ms\": {";
-      comma = false;
-      for (const auto& [name, v] : r.firstFrameMs) out << (comma ? ", " : "") << "\"" << name << "\": " << v, comma = true;
-      out << "}, \"first_hits_agreeing_with_trace\": "
-          << (r.hitsCompared ? double(r.hitsAgreeing) / double(r.hitsCompared) : -1.0);
-      out << ", \"summary\": \"" << jsonEscape(r.summary)
-          << "\", \"refraction_median_ms\": " << median(r.refractionMs) << ", \"glass\": " << errorJson(r.glass)
-          << ", \"image\": " << errorJson(r.image) << ", \"worst_frame_within_1\": " << r.worstFrameWithin1
-          << ", \"memory_bytes\": " << r.memoryBytes << ", \"glass_rmse_per_frame\": [";
-      for (size_t f = 0; f < r.frameGlassRmse.size(); ++f) out << (f ? ", " : "") << r.frameGlassRmse[f];
-      out << "]";
-      if (r.map) out << ", \"bake_ms\": " << r.bakeMs;
-      out << "}" << (i + 1 < results.size() ? "," : "") << "\n";
+      io::Json passes = io::Json::object(), firstFrame = io::Json::object();
+      for (const auto& [name, v] : r.passMs) passes[name] = median(v);
+      for (const auto& [name, v] : r.firstFrameMs) firstFrame[name] = v;
+      io::Json row{{"method", r.name},
+                   {"passes_median_ms", std::move(passes)},
+                   {"first_frame_ms", std::move(firstFrame)},
+                   {"first_hits_agreeing_with_trace",
+                    r.hitsCompared ? double(r.hitsAgreeing) / double(r.hitsCompared) : -1.0},
+                   {"summary", r.summary},
+                   {"refraction_median_ms", median(r.refractionMs)},
+                   {"glass", errorJson(r.glass)},
+                   {"image", errorJson(r.image)},
+                   {"worst_frame_within_1", r.worstFrameWithin1},
+                   {"memory_bytes", r.memoryBytes},
+                   {"glass_rmse_per_frame", r.frameGlassRmse}};
+      if (r.map) row["bake_ms"] = r.bakeMs;
+      rows.push_back(std::move(row));
     }
-    out << "  ]\n}\n";
-    writeTextFile(json, out.str());
+    j["methods"] = std::move(rows);
+    io::writeJson(o.json, j);
   }
-  if (!svg.empty()) writeTextFile(svg, chartSvg(results, title));
+  if (!o.svg.empty()) io::writeTextFile(o.svg, chartSvg(results, title));
   return validationExitCode(*context);
+}
+
+}  // namespace
+
+void addBenchMethods(CLI::App& bench, Runner& run) {
+  auto o = std::make_shared<Options>();
+  CLI::App* sub =
+      bench.add_subcommand("methods", "each way of drawing refraction: its GPU time against its error");
+  describe(*sub,
+      "Renders an animated sequence of the procedural eye (or SCENE) with every way\n"
+      "snell can draw refraction and reports, per method, the median GPU time of its\n"
+      "refraction work per frame and its error against the CPU double-precision\n"
+      "reference of the same frames. The sequence plays the scene's animation (the\n"
+      "eye looks around, squashes and dilates) while the camera orbits from the\n"
+      "scene's own view to 80 degrees aside, a grazing view of the cornea.\n"
+      "\n"
+      "Refraction work is every pass but deform and the viewport's own raster depth\n"
+      "and shading, which a viewport pays with or without glass; the first frame's\n"
+      "tree build is a warm-up and not counted. Times are medians over three passes\n"
+      "through the sequence after one to warm up, every method drawing each frame in\n"
+      "turn (so the GPU's clock changes fall on all alike), two frames in flight and\n"
+      "nothing read back; the errors come from one more pass that reads every frame\n"
+      "back. Errors compare 8-bit sRGB pixels as\n"
+      "a PNG would hold them: RMSE, the share of pixels over 1/255 and over 8/255,\n"
+      "the largest difference, over the pixels whose first hit in the reference is\n"
+      "transmissive, and over the whole image.\n"
+      "\n"
+      "methods: trace, trace-1, masked, iris-plane, normal-offset, refraction-map\n"
+      "(a map baked by the trace at the first frame, read by every frame after: a\n"
+      "table shows its glass error against animation time beside the others'), none, and\n"
+      "driver-rt, the peer: the same rays and shading code with the hits found by\n"
+      "the driver's own ray tracing (VK_KHR_ray_tracing_pipeline), where the device\n"
+      "has it (not lavapipe: reported unsupported). For it the table adds the share\n"
+      "of pixels whose first hit (instance, triangle) agrees with trace's, and its\n"
+      "build (first frame), update and trace times.\n"
+      "\n"
+      "With --optics the rows are not methods but the optics features, each drawn\n"
+      "by trace on its own copy of the scene against its own reference: \"plain\"\n"
+      "(no Fresnel: the bend only), \"fresnel\" (the default: Fresnel, one reflected\n"
+      "ray, the lights' highlights, the studio gradient), \"environment\" (an HDR sky\n"
+      "instead of the gradient), \"reflections-4\", and on every transmissive\n"
+      "material \"volume\" (Beer-Lambert), \"dispersion\" (Abbe number 20: three rays\n"
+      "where it applies), \"ior-texture\" (the scene's first texture as IOR, scale\n"
+      "0.05); for the procedural eye \"aqueous\" (nested media), and \"all\" of them.");
+  sub->footer(kHelpFooter);
+  sub->add_option("scene", o->file, "the glTF file instead of the procedural eye")->type_name("SCENE.glb");
+  addSize(*sub, "--size", o->width, o->height, "image size (default 320x240)");
+  sub->add_option("--frames", o->frames, "frames of the sequence (default 24)")
+      ->type_name("N")
+      ->check(CLI::Range(1u, std::numeric_limits<uint32_t>::max(), "POSITIVE"));
+  std::vector<std::string> names;
+  for (const render::MethodInfo& m : render::methods()) names.push_back(m.name);
+  // A list takes one word, so it never swallows the scene file after it.
+  CLI::Option* methods = sub->add_option("--methods", o->methods, "only these methods")
+                             ->type_name("A,B,...")
+                             ->delimiter(',')
+                             ->allow_extra_args(false)
+                             ->check(CLI::IsMember(names));
+  sub->add_option("--max-interfaces", o->maxInterfaces,
+                  "refractive faces a traced ray may cross (default 8, at most 1024)")
+      ->type_name("N")
+      ->check(CLI::Range(0u, 1024u));
+  sub->add_option("--offset-strength", o->offsetStrength, "normal-offset's displacement in image heights (0.02)")
+      ->type_name("S")
+      ->check([](const std::string& value) -> std::string {
+        return std::isfinite(std::strtof(value.c_str(), nullptr)) ? "" : "expects a finite number, got " + value;
+      });
+  // The procedural eye's own limits (scene::checkEyeOptions), named after these options.
+  sub->add_option("--eye-resolution", o->eye.resolution, "segments of the procedural eye, 8-2048 (default 64)")
+      ->type_name("N")
+      ->check(CLI::Range(8u, 2048u));
+  sub->add_option("--crowd", o->eye.crowd, "N characters' eye pairs instead of one eye (at most 10000)")
+      ->type_name("N")
+      ->check(CLI::Range(0u, 10000u));
+  sub->add_flag("--optics", o->optics, "rows per optics feature (trace) instead of per method")->excludes(methods);
+  sub->add_flag("--no-reference", o->noReference, "time only: no CPU reference, no errors (for scaling runs)");
+  sub->add_option("--json", o->json, "write the results as JSON")->type_name("FILE");
+  sub->add_option("--svg", o->svg,
+                  "write a chart of time against error (log-log, the\nPareto front drawn) that a browser opens")
+      ->type_name("FILE");
+  sub->add_option("--images", o->images,
+                  "write the last (grazing) frame of each method and of the\n"
+                  "reference there as PNG (DIR/METHOD.png, DIR/reference.png)")
+      ->type_name("DIR");
+  sub->callback([o, &run] { run = [o] { return runMethods(*o); }; });
 }
 
 }  // namespace snell::cli

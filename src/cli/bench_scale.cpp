@@ -4,8 +4,9 @@
 // against a CPU binned-SAH tree, next to the driver's own acceleration
 // structures built and updated over the same triangles in the same run.
 // With characters, on crowds of the procedural eye: the viewport frame's passes.
-#include "cli/cli.h"
-#include "cli/image_file.h"
+#include "cli/commands.h"
+#include "io/image_file.h"
+#include "io/json.h"
 
 #include "peer/driver_bvh.h"
 #include "ref/sah_bvh.h"
@@ -18,47 +19,25 @@
 #include "vk/commands.h"
 #include "vk/upload_arena.h"
 
-#include <map>
-#include <optional>
-
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <fstream>
-#include <sstream>
+#include <cstdlib>
+#include <limits>
+#include <map>
 
 namespace snell::cli {
 
 namespace {
 
-constexpr const char* kHelp = R"(usage: snell bench scale [options]
-
-Triangles: builds and refits the bottom-level tree of UV spheres of
-increasing size on the GPU and reports, per size, the median GPU time of a
-build (boxes, Morton codes, sort, H-PLOC) and of a refit, in milliseconds and
-millions of triangles per second, the tree's memory per triangle (the build's
-scratch separately) and, up to --sah-limit triangles, its SAH cost against a
-CPU binned-SAH tree of the same triangles. Where the device has its own
-acceleration structures (VK_KHR_acceleration_structure), the same triangles
-are built with them in the same run (fast-build and fast-trace), and the
-fast-trace one updated in place, as the peer to beat.
-
-Characters: animated viewport frames of crowds of the procedural eye (two
-eyes a character): the median GPU time of each pass, the refraction work
-(deform, trees, masked trace), pixels traced and the trace's rays per second.
-
-options:
-  --triangles N,N,...  sphere sizes (default 10000,100000,1000000,10000000; 0 skips)
-  --runs N             timed builds and refits per size (default 10, after one warm-up)
-  --restructure N      rounds of treelet restructuring after each build (default 0)
-  --sah-limit N        price the tree against binned SAH up to this size (default 1000000)
-  --hploc-workgroup N  H-PLOC's workgroup size (default: the device's choice)
-  --refit-workgroup N  the refit's workgroup size (default: the device's choice)
-  --crowds N,N,...     characters per crowd (default 1,2,10,100,1000; 0 skips)
-  --size WxH           viewport size of the crowd frames (default 3840x2160)
-  --frames N           animated frames measured per crowd (default 20, after 5)
-  --json FILE          write the results as JSON too
-)";
+struct Options {
+  // Lists as given: numbers in any notation (1e6), 0 skipping an entry.
+  std::vector<double> triangles = {1e4, 1e5, 1e6, 1e7}, crowds = {1, 2, 10, 100, 1000};
+  uint32_t runs = 10, restructure = 0, width = 3840, height = 2160, frames = 20;
+  uint64_t sahLimit = 1000000;
+  render::BvhTuning tuning;
+  std::string json;
+};
 
 struct Mesh {
   std::vector<float> positions;
@@ -102,20 +81,24 @@ struct CrowdRow {
   double frameMs = 0, refractionMs = 0, pixelsTraced = 0, memoryPerTriangle = 0, treeBytesPerTriangle = 0;
 };
 
-std::vector<uint64_t> parseList(const std::string& option, const std::string& value) {
+// Checks an entry of a list option: 0 (skipped) or a whole count from 1 to `most`.
+CLI::Validator countOrZero(uint64_t most) {
+  return CLI::Validator(
+      [most](std::string& item) -> std::string {
+        char* end = nullptr;
+        double v = std::strtod(item.c_str(), &end);
+        if (item.empty() || *end != '\0') return "takes numbers separated by commas, not '" + item + "'";
+        if (v == 0 || (v >= 1 && v <= double(most))) return "";
+        return "entries must be 0 (skip) or within 1 and " + std::to_string(most) + ", got " + item;
+      },
+      "");
+}
+
+// The counts a list option asks for, its zeros left out.
+std::vector<uint64_t> counts(const std::vector<double>& list) {
   std::vector<uint64_t> out;
-  std::stringstream in(value);
-  std::string item;
-  while (std::getline(in, item, ',')) {
-    double v = 0;
-    try {
-      v = std::stod(item);
-    } catch (const std::exception&) {
-      throw UsageError{"bench scale: " + option + " takes numbers separated by commas, not '" + item + "'"};
-    }
-    if (v == 0) continue;  // none
-    if (!(v >= 1 && v <= 1e9)) throw UsageError{"bench scale: " + option + " sizes must be within 1 and 1e9"};
-    out.push_back(static_cast<uint64_t>(v));
+  for (double v : list) {
+    if (v != 0) out.push_back(static_cast<uint64_t>(v));
   }
   return out;
 }
@@ -170,41 +153,17 @@ CrowdRow measureCrowd(vk::Context& context, uint32_t characters, uint32_t width,
   return row;
 }
 
-}  // namespace
-
-int runBenchScale(const Args& args) {
-  std::vector<uint64_t> sizes = {10000, 100000, 1000000, 10000000}, crowds = {1, 2, 10, 100, 1000};
-  uint32_t runs = 10, restructure = 0, width = 3840, height = 2160, frames = 20;
-  uint64_t sahLimit = 1000000;
-  render::BvhTuning tuning;
-  std::string json;
-  for (size_t i = 0; i < args.size(); ++i) {
-    const std::string& a = args[i];
-    if (a == "--help" || a == "-h") {
-      std::fputs(kHelp, stdout);
-      return 0;
-    }
-    if (i + 1 >= args.size()) throw UsageError{"bench scale: " + a + " needs a value (or is unknown)"};
-    const std::string& v = args[++i];
-    if (a == "--triangles") sizes = parseList(a, v);
-    else if (a == "--runs") runs = std::max<uint32_t>(1, uint32_t(parseCount(a, v)));
-    else if (a == "--restructure") restructure = uint32_t(parseCount(a, v));
-    else if (a == "--sah-limit") sahLimit = parseCount(a, v);
-    else if (a == "--crowds") crowds = parseList(a, v);
-    else if (a == "--hploc-workgroup") tuning.hplocWorkgroup = uint32_t(parseCount(a, v));
-    else if (a == "--refit-workgroup") tuning.refitWorkgroup = uint32_t(parseCount(a, v));
-    else if (a == "--size") parseSize(a, v, width, height);
-    else if (a == "--frames") frames = std::max<uint32_t>(1, uint32_t(parseCount(a, v)));
-    else if (a == "--json") checkWritable(json = v);
-    else throw UsageError{"bench scale: unknown option " + a};
-  }
-  vk::ContextDesc desc = contextDescFromEnvironment();
+int runScale(const Options& o) {
+  if (!o.json.empty()) io::checkWritable(o.json);
+  const std::vector<uint64_t> sizes = counts(o.triangles), crowds = counts(o.crowds);
+  const uint32_t runs = o.runs, restructure = o.restructure, width = o.width, height = o.height, frames = o.frames;
+  vk::ContextDesc desc = io::contextDescFromEnvironment();
   desc.driverAccelerationStructures = true;
   auto context = vk::Context::create(desc);
   bool driver = context->caps().driverAccelerationStructures;
   std::printf("device: %s; the driver's acceleration structures: %s\n", context->facts().name.c_str(),
               driver ? "measured beside snell's" : "unsupported");
-  render::BvhBuilder builder(*context, tuning);
+  render::BvhBuilder builder(*context, o.tuning);
   vk::UploadArena arena(*context, "bench scale uploads");
   std::vector<Row> rows;
   if (!sizes.empty()) {
@@ -273,7 +232,7 @@ int runBenchScale(const Args& args) {
     row.refitMs = median(refit);
     row.bytesPerTriangle = double(bvh.treeBytes()) / triangles;
     row.scratchPerTriangle = double(builder.scratchBytes()) / triangles;
-    if (triangles <= sahLimit) {
+    if (triangles <= o.sahLimit) {
       render::BvhSnapshot snapshot = builder.download(bvh);
       std::vector<ref::Aabb> boxes(triangles);
       for (uint32_t t = 0; t < triangles; ++t) {
@@ -317,41 +276,97 @@ int runBenchScale(const Args& args) {
     std::fflush(stdout);
     crowdRows.push_back(std::move(r));
   }
-  if (!json.empty()) {
-    std::ostringstream out;  // written whole or not at all
-    out << "{\n  \"device\": \"" << context->facts().name << "\",\n  \"driver_acceleration_structures\": "
-        << (driver ? "true" : "false") << ",\n  \"restructure_rounds\": " << restructure << ",\n  \"runs\": " << runs
-        << ",\n  \"spheres\": [\n";
-    for (size_t i = 0; i < rows.size(); ++i) {
-      const Row& r = rows[i];
-      out << "    {\"triangles\": " << r.triangles << ", \"build_ms\": " << r.buildMs << ", \"refit_ms\": " << r.refitMs
-          << ", \"build_mtris_per_s\": " << double(r.triangles) / r.buildMs / 1e3
-          << ", \"refit_mtris_per_s\": " << double(r.triangles) / r.refitMs / 1e3 << ", \"tree_bytes_per_triangle\": "
-          << r.bytesPerTriangle << ", \"scratch_bytes_per_triangle\": " << r.scratchPerTriangle
-          << ", \"sah_over_binned\": " << r.sahRatio << ", \"driver_fast_build_ms\": " << r.driverFastBuildMs
-          << ", \"driver_fast_trace_build_ms\": " << r.driverFastTraceMs << ", \"driver_update_ms\": " << r.driverUpdateMs
-          << ", \"driver_bytes_per_triangle\": " << r.driverBytesPerTriangle << "}" << (i + 1 < rows.size() ? "," : "")
-          << "\n";
+  if (!o.json.empty()) {
+    io::Json j = io::reportHead("bench-scale", &context->facts());
+    j["driver_acceleration_structures"] = driver;
+    j["restructure_rounds"] = restructure;
+    j["runs"] = runs;
+    io::Json spheres = io::Json::array();
+    for (const Row& r : rows) {
+      spheres.push_back(io::Json{{"triangles", r.triangles},
+                                 {"build_ms", r.buildMs},
+                                 {"refit_ms", r.refitMs},
+                                 {"build_mtris_per_s", double(r.triangles) / r.buildMs / 1e3},
+                                 {"refit_mtris_per_s", double(r.triangles) / r.refitMs / 1e3},
+                                 {"tree_bytes_per_triangle", r.bytesPerTriangle},
+                                 {"scratch_bytes_per_triangle", r.scratchPerTriangle},
+                                 {"sah_over_binned", r.sahRatio},
+                                 {"driver_fast_build_ms", r.driverFastBuildMs},
+                                 {"driver_fast_trace_build_ms", r.driverFastTraceMs},
+                                 {"driver_update_ms", r.driverUpdateMs},
+                                 {"driver_bytes_per_triangle", r.driverBytesPerTriangle}});
     }
-    out << "  ],\n  \"crowd_viewport\": {\"width\": " << width << ", \"height\": " << height
-        << ", \"frames\": " << frames << "},\n  \"crowds\": [\n";
-    for (size_t i = 0; i < crowdRows.size(); ++i) {
-      const CrowdRow& r = crowdRows[i];
-      out << "    {\"characters\": " << r.characters << ", \"triangles\": " << r.triangles
-          << ", \"frame_ms\": " << r.frameMs << ", \"refraction_ms\": " << r.refractionMs
-          << ", \"pixels_traced\": " << r.pixelsTraced << ", \"memory_bytes_per_triangle\": " << r.memoryPerTriangle
-          << ", \"tree_bytes_per_triangle\": " << r.treeBytesPerTriangle << ", \"passes_ms\": {";
-      bool first = true;
-      for (const auto& [name, ms] : r.passMs) {
-        out << (first ? "" : ", ") << "\"" << name << "\": " << ms;
-        first = false;
-      }
-      out << "}}" << (i + 1 < crowdRows.size() ? "," : "") << "\n";
+    j["spheres"] = std::move(spheres);
+    j["crowd_viewport"] = io::Json{{"width", width}, {"height", height}, {"frames", frames}};
+    io::Json crowdsJson = io::Json::array();
+    for (const CrowdRow& r : crowdRows) {
+      io::Json passes = io::Json::object();
+      for (const auto& [name, ms] : r.passMs) passes[name] = ms;
+      crowdsJson.push_back(io::Json{{"characters", r.characters},
+                                    {"triangles", r.triangles},
+                                    {"frame_ms", r.frameMs},
+                                    {"refraction_ms", r.refractionMs},
+                                    {"pixels_traced", r.pixelsTraced},
+                                    {"memory_bytes_per_triangle", r.memoryPerTriangle},
+                                    {"tree_bytes_per_triangle", r.treeBytesPerTriangle},
+                                    {"passes_ms", std::move(passes)}});
     }
-    out << "  ]\n}\n";
-    writeTextFile(json, out.str());
+    j["crowds"] = std::move(crowdsJson);
+    io::writeJson(o.json, j);
   }
-  return 0;
+  return validationExitCode(*context);
+}
+
+}  // namespace
+
+void addBenchScale(CLI::App& bench, Runner& run) {
+  auto o = std::make_shared<Options>();
+  CLI::App* sub =
+      bench.add_subcommand("scale", "tree build and refit from 1e4 to 1e7 triangles, and crowds of characters");
+  describe(*sub,
+      "Triangles: builds and refits the bottom-level tree of UV spheres of\n"
+      "increasing size on the GPU and reports, per size, the median GPU time of a\n"
+      "build (boxes, Morton codes, sort, H-PLOC) and of a refit, in milliseconds and\n"
+      "millions of triangles per second, the tree's memory per triangle (the build's\n"
+      "scratch separately) and, up to --sah-limit triangles, its SAH cost against a\n"
+      "CPU binned-SAH tree of the same triangles. Where the device has its own\n"
+      "acceleration structures (VK_KHR_acceleration_structure), the same triangles\n"
+      "are built with them in the same run (fast-build and fast-trace), and the\n"
+      "fast-trace one updated in place, as the peer to beat.\n"
+      "\n"
+      "Characters: animated viewport frames of crowds of the procedural eye (two\n"
+      "eyes a character): the median GPU time of each pass, the refraction work\n"
+      "(deform, trees, masked trace), pixels traced and the trace's rays per second.");
+  sub->footer(kHelpFooter);
+  // Lists take one word each, so they never swallow the words after them.
+  sub->add_option("--triangles", o->triangles, "sphere sizes (default 10000,100000,1000000,10000000; 0 skips)")
+      ->type_name("N,N,...")
+      ->delimiter(',')
+      ->allow_extra_args(false)
+      ->check(countOrZero(1000000000));
+  sub->add_option("--runs", o->runs, "timed builds and refits per size (default 10, after one warm-up)")
+      ->type_name("N")
+      ->check(CLI::Range(1u, std::numeric_limits<uint32_t>::max(), "POSITIVE"));
+  sub->add_option("--restructure", o->restructure, "rounds of treelet restructuring after each build (default 0)")
+      ->type_name("N");
+  sub->add_option("--sah-limit", o->sahLimit, "price the tree against binned SAH up to this size (default 1000000)")
+      ->type_name("N");
+  sub->add_option("--hploc-workgroup", o->tuning.hplocWorkgroup, "H-PLOC's workgroup size (default: the device's choice)")
+      ->type_name("N");
+  sub->add_option("--refit-workgroup", o->tuning.refitWorkgroup, "the refit's workgroup size (default: the device's choice)")
+      ->type_name("N");
+  // At most the procedural eye's crowd limit (scene::checkEyeOptions).
+  sub->add_option("--crowds", o->crowds, "characters per crowd (default 1,2,10,100,1000; 0 skips; at most 10000)")
+      ->type_name("N,N,...")
+      ->delimiter(',')
+      ->allow_extra_args(false)
+      ->check(countOrZero(10000));
+  addSize(*sub, "--size", o->width, o->height, "viewport size of the crowd frames (default 3840x2160)");
+  sub->add_option("--frames", o->frames, "animated frames measured per crowd (default 20, after 5)")
+      ->type_name("N")
+      ->check(CLI::Range(1u, std::numeric_limits<uint32_t>::max(), "POSITIVE"));
+  sub->add_option("--json", o->json, "write the results as JSON too")->type_name("FILE");
+  sub->callback([o, &run] { run = [o] { return runScale(*o); }; });
 }
 
 }  // namespace snell::cli

@@ -1,20 +1,18 @@
 // `snell bench sort`: pairs per second of the GPU radix sort, from GPU
 // timestamps, median of many runs after warm-up; every size is also checked
 // against std::sort so a fast wrong sort never makes the table.
-#include "cli/cli.h"
-#include "cli/image_file.h"
+#include "cli/commands.h"
+#include "io/image_file.h"
+#include "io/json.h"
 
 #include "render/radix_sort.h"
 #include "vk/buffer.h"
 #include "vk/commands.h"
 #include "vk/context.h"
 
-#include <sstream>
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
-#include <cstdlib>
-#include <fstream>
 #include <map>
 #include <numeric>
 #include <random>
@@ -37,66 +35,6 @@ struct Options {
   bool pipelineStats = false;
   render::RadixSortTuning tuning;
 };
-
-constexpr const char* kHelp = R"(usage: snell bench sort [options]
-
-Sorts random key-value pairs (32-bit values) on the GPU and prints pairs per
-second from GPU timestamps: the median over --runs back-to-back runs, after
-at least 250 ms of warm-up runs.
-Each size is checked against std::sort before it is reported.
-
-options:
-  --min-log N          smallest size, 2^N pairs (default 16)
-  --max-log N          largest size, 2^N pairs (default 24)
-  --runs N             timed runs per size, 10 to 100 (default 20)
-  --warmup N           untimed runs per warm-up submission, repeated for at
-                       least 250 ms (default 10)
-  --keys 32|64|both    key width (default both)
-  --json FILE          also write the results as JSON
-  --breakdown          also time each step (histogram, scan, scatter) separately
-  --pipeline-stats     print the driver's statistics of each program (registers, spills)
-  --workgroup N        override the workgroup size (tuning)
-  --keys-per-thread N  override keys per invocation (tuning)
-)";
-
-Options parse(const Args& args) {
-  Options o;
-  for (size_t i = 0; i < args.size(); ++i) {
-    const std::string& a = args[i];
-    if (a == "--help" || a == "-h") {
-      std::fputs(kHelp, stdout);
-      std::exit(0);
-    }
-    if (a == "--breakdown") {
-      o.breakdown = true;
-      continue;
-    }
-    if (a == "--pipeline-stats") {
-      o.pipelineStats = true;
-      continue;
-    }
-    if (i + 1 >= args.size()) throw UsageError{"bench sort: " + a + " needs a value (or is unknown)"};
-    const std::string& v = args[++i];
-    if (a == "--min-log") o.minLog = static_cast<unsigned>(parseCount(a, v));
-    else if (a == "--max-log") o.maxLog = static_cast<unsigned>(parseCount(a, v));
-    else if (a == "--runs") o.runs = static_cast<unsigned>(parseCount(a, v));
-    else if (a == "--warmup") o.warmup = static_cast<unsigned>(parseCount(a, v));
-    else if (a == "--json") checkWritable(o.json = v);
-    else if (a == "--workgroup") o.tuning.workgroupSize = static_cast<uint32_t>(parseCount(a, v));
-    else if (a == "--keys-per-thread") o.tuning.keysPerThread = static_cast<uint32_t>(parseCount(a, v));
-    else if (a == "--keys") {
-      if (v == "32") o.keyBits = {32};
-      else if (v == "64") o.keyBits = {64};
-      else if (v == "both") o.keyBits = {32, 64};
-      else throw UsageError{"bench sort: --keys takes 32, 64 or both"};
-    } else {
-      throw UsageError{"bench sort: unknown option " + a};
-    }
-  }
-  if (o.minLog > o.maxLog || o.maxLog > 30) throw UsageError{"bench sort: need --min-log <= --max-log <= 30"};
-  if (o.runs < 10 || o.runs > 100) throw UsageError{"bench sort: --runs must be 10 to 100"};
-  return o;
-}
 
 struct Row {
   uint64_t pairs;
@@ -195,12 +133,9 @@ Row measure(vk::Context& context, render::RadixSort& sort, uint64_t count, const
   return {count, static_cast<unsigned>(sizeof(Key) * 8), times[times.size() / 2], times.front(), times.back(), correct};
 }
 
-}  // namespace
-
-int runBenchSort(const Args& args) {
-  Options o = parse(args);
-  if (!o.json.empty()) checkWritable(o.json);
-  vk::ContextDesc desc = contextDescFromEnvironment();
+int runSort(const Options& o) {
+  if (!o.json.empty()) io::checkWritable(o.json);
+  vk::ContextDesc desc = io::contextDescFromEnvironment();
   desc.pipelineStatistics = o.pipelineStats;
   auto context = vk::Context::create(desc);
   const vk::DeviceFacts& device = context->facts();
@@ -235,29 +170,78 @@ int runBenchSort(const Args& args) {
   }
 
   if (!o.json.empty()) {
-    {
-      std::ostringstream out;
-      out << "{\n  \"benchmark\": \"sort\",\n  \"device\": \"" << device.name << "\",\n  \"driver\": \"" << device.driverName
-          << " " << device.driverInfo << "\",\n  \"vulkan\": \"" << vk::versionString(device.apiVersion)
-          << "\",\n  \"runs\": " << o.runs << ",\n  \"warmup\": " << o.warmup << ",\n  \"results\": [\n";
-      for (size_t i = 0; i < rows.size(); ++i) {
-        const Row& r = rows[i];
-        out << "    {\"pairs\": " << r.pairs << ", \"key_bits\": " << r.keyBits << ", \"median_ms\": " << r.medianMs
-            << ", \"min_ms\": " << r.minMs << ", \"max_ms\": " << r.maxMs
-            << ", \"gpairs_per_s\": " << static_cast<double>(r.pairs) / (r.medianMs * 1e6) << ", \"correct\": " << (r.correct ? "true" : "false")
-            << ", \"workgroup_size\": " << r.workgroup << ", \"keys_per_thread\": " << r.keysPerThread
-            << "}" << (i + 1 < rows.size() ? "," : "") << "\n";
-      }
-      out << "  ]\n}\n";
-      writeTextFile(o.json, out.str());
+    io::Json j = io::reportHead("bench-sort", &device);
+    j["benchmark"] = "sort";
+    j["runs"] = o.runs;
+    j["warmup"] = o.warmup;
+    io::Json results = io::Json::array();
+    for (const Row& r : rows) {
+      results.push_back(io::Json{{"pairs", r.pairs},
+                                 {"key_bits", r.keyBits},
+                                 {"median_ms", r.medianMs},
+                                 {"min_ms", r.minMs},
+                                 {"max_ms", r.maxMs},
+                                 {"gpairs_per_s", static_cast<double>(r.pairs) / (r.medianMs * 1e6)},
+                                 {"correct", r.correct},
+                                 {"workgroup_size", r.workgroup},
+                                 {"keys_per_thread", r.keysPerThread}});
     }
+    j["results"] = std::move(results);
+    io::writeJson(o.json, j);
     std::printf("wrote %s\n", o.json.c_str());
   }
+  int validation = validationExitCode(*context);
   if (!allCorrect) {
     std::fprintf(stderr, "snell: error: the GPU sort disagreed with std::sort (rows marked NO)\n");
-    return 1;
+    return kExitFailure;
   }
-  return 0;
+  return validation;
+}
+
+}  // namespace
+
+void addBenchSort(CLI::App& bench, Runner& run) {
+  auto o = std::make_shared<Options>();
+  CLI::App* sub = bench.add_subcommand("sort", "GPU radix sort: pairs per second, each size checked against std::sort");
+  describe(*sub,
+      "Sorts random key-value pairs (32-bit values) on the GPU and prints pairs per\n"
+      "second from GPU timestamps: the median over --runs back-to-back runs, after\n"
+      "at least 250 ms of warm-up runs.\n"
+      "Each size is checked against std::sort before it is reported.");
+  sub->footer(kHelpFooter);
+  sub->add_option("--min-log", o->minLog, "smallest size, 2^N pairs (default 16)")
+      ->type_name("N")
+      ->check(CLI::Range(0u, 30u));
+  sub->add_option("--max-log", o->maxLog, "largest size, 2^N pairs (default 24, at most 30)")
+      ->type_name("N")
+      ->check(CLI::Range(0u, 30u));
+  sub->add_option("--runs", o->runs, "timed runs per size, 10 to 100 (default 20)")
+      ->type_name("N")
+      ->check(CLI::Range(10u, 100u));
+  sub->add_option("--warmup", o->warmup,
+                  "untimed runs per warm-up submission, repeated for at\nleast 250 ms (default 10)")
+      ->type_name("N");
+  sub->add_option_function<std::string>(
+         "--keys",
+         [o](const std::string& keys) {
+           o->keyBits = keys == "32" ? std::vector<unsigned>{32} :
+                        keys == "64" ? std::vector<unsigned>{64} :
+                                       std::vector<unsigned>{32, 64};
+         },
+         "key width (default both)")
+      ->type_name("32|64|both")
+      ->check(CLI::IsMember({"32", "64", "both"}));
+  sub->add_option("--json", o->json, "also write the results as JSON")->type_name("FILE");
+  sub->add_flag("--breakdown", o->breakdown, "also time each step (histogram, scan, scatter) separately");
+  sub->add_flag("--pipeline-stats", o->pipelineStats,
+                "print the driver's statistics of each program (registers, spills)");
+  sub->add_option("--workgroup", o->tuning.workgroupSize, "override the workgroup size (tuning)")->type_name("N");
+  sub->add_option("--keys-per-thread", o->tuning.keysPerThread, "override keys per invocation (tuning)")
+      ->type_name("N");
+  sub->callback([o, &run] {
+    if (o->minLog > o->maxLog) throw UsageError{"bench sort: need --min-log <= --max-log"};
+    run = [o] { return runSort(*o); };
+  });
 }
 
 }  // namespace snell::cli

@@ -1,36 +1,148 @@
-// Option parsing and the device choice shared by `snell` and `snell-view`.
-#include "cli/cli.h"
+// Command-line conventions shared by `snell` and `snell-view` (options.h).
+#include "cli/options.h"
 
+#include "io/environment.h"
 #include "render/renderer.h"
 #include "scene/procedural_eye.h"
 
 #include <algorithm>
+#include <charconv>
 #include <cmath>
 #include <cstdio>
-#include <sstream>
-#include <charconv>
 #include <cstdlib>
+#include <map>
+#include <sstream>
 
+#include <fcntl.h>
 #include <unistd.h>
 
 namespace snell::cli {
 
-vk::ContextDesc contextDescFromEnvironment() {
-  vk::ContextDesc desc;
-  const char* validation = std::getenv("SNELL_VALIDATION");
-  desc.validation = validation && std::string(validation) == "1";
-  desc.synchronizationValidation = desc.validation;  // as the tests' own context has it
-  return desc;
+const char* const kHelpFooter = R"(exit codes: 0 done, 1 failed (the message says what), 2 bad command line
+
+environment:
+  SNELL_DEVICE=INDEX|NAME  the device to use (as --device; 'snell info --devices' lists them)
+  SNELL_VALIDATION=1       turn on the Khronos validation layer; any message it
+                           reports makes the exit code 1)";
+
+namespace {
+
+bool quietFlag = false;
+
+std::string programName(const CLI::App& app) {
+  const CLI::App* root = &app;
+  while (root->get_parent()) root = root->get_parent();
+  return root->get_name();
 }
 
-uint64_t hostResidentBytes() {
-  std::FILE* statm = std::fopen("/proc/self/statm", "r");
-  if (!statm) return 0;
-  unsigned long long size = 0, resident = 0;
-  int read = std::fscanf(statm, "%llu %llu", &size, &resident);
-  std::fclose(statm);
-  return read == 2 ? uint64_t(resident) * uint64_t(::sysconf(_SC_PAGESIZE)) : 0;
+// The deepest subcommand the parse reached ("snell bench frame"), for the hint.
+std::string reachedCommand(CLI::App& app) {
+  std::string path = app.get_name();
+  CLI::App* at = &app;
+  while (!at->get_subcommands().empty()) {
+    at = at->get_subcommands().front();
+    path += " " + at->get_name();
+  }
+  return path;
 }
+
+// The long descriptions, by command: CLI11 keeps one description, which its
+// parent's list prints whole.
+std::map<const CLI::App*, std::string>& longDescriptions() {
+  static std::map<const CLI::App*, std::string> texts;
+  return texts;
+}
+
+class SnellHelpFormat : public CLI::Formatter {
+ public:
+  std::string make_description(const CLI::App* app) const override {
+    auto text = longDescriptions().find(app);
+    if (text == longDescriptions().end()) return CLI::Formatter::make_description(app);
+    return app->get_description() + "\n\n" + text->second + "\n\n";
+  }
+};
+
+}  // namespace
+
+void describe(CLI::App& command, std::string text) { longDescriptions()[&command] = std::move(text); }
+
+void useSnellHelpFormat(CLI::App& app) {
+  auto format = std::make_shared<SnellHelpFormat>();
+  format->column_width(34);
+  app.formatter(format);
+}
+
+bool quiet() { return quietFlag; }
+
+void note(const std::string& text) {
+  if (!quietFlag) std::fprintf(stderr, "snell: note: %s\n", text.c_str());
+}
+
+void addGlobalOptions(CLI::App& app) {
+  app.add_option_function<std::string>(
+         "--device",
+         [](const std::string& device) {
+           if (device.empty()) throw UsageError{"--device needs an index or part of a name"};
+           ::setenv("SNELL_DEVICE", device.c_str(), 1);
+         },
+         "the device to use: an index from 'snell info --devices', or part of\nits name (the same as SNELL_DEVICE)")
+      ->type_name("INDEX|NAME");
+  app.add_flag_callback(
+      "-q,--quiet",
+      [] {
+        quietFlag = true;
+        // Nothing on standard output: every "wrote ..." line and table goes;
+        // errors, on standard error, stay.
+        std::fflush(stdout);
+        int null = ::open("/dev/null", O_WRONLY);
+        if (null >= 0) {
+          ::dup2(null, STDOUT_FILENO);
+          ::close(null);
+        }
+      },
+      "print nothing but errors: no results on standard output, no progress, no notes");
+}
+
+void parseOnly(CLI::App& app, const Args& args) {
+  try {
+    app.parse(Args(args.rbegin(), args.rend()));  // CLI11 takes the words last first
+  } catch (const CLI::Success&) {
+  } catch (const CLI::ParseError& e) {
+    throw UsageError{e.what()};
+  }
+}
+
+int runCommandLine(CLI::App& app, int argc, char** argv, const Runner& run) {
+  const std::string program = programName(app);
+  auto usage = [&](const std::string& message) {
+    std::string command = reachedCommand(app);
+    std::fprintf(stderr, "%s: %s\nRun '%s --help' for usage.\n", program.c_str(), message.c_str(), command.c_str());
+    return kExitUsage;
+  };
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::Success& e) {
+    return app.exit(e);  // --help or --version: printed, exit 0
+  } catch (const CLI::ParseError& e) {
+    return usage(e.what());
+  } catch (const UsageError& e) {
+    return usage(e.message);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "%s: error: %s\n", program.c_str(), e.what());
+    return kExitFailure;
+  }
+  if (!run) return usage("give a command");
+  try {
+    return run();
+  } catch (const UsageError& e) {
+    return usage(e.message);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "%s: error: %s\n", program.c_str(), e.what());
+    return kExitFailure;
+  }
+}
+
+namespace {
 
 unsigned long long parseCount(const std::string& option, const std::string& value) {
   unsigned long long result = 0;
@@ -41,6 +153,8 @@ unsigned long long parseCount(const std::string& option, const std::string& valu
   return result;
 }
 
+}  // namespace
+
 void parseSize(const std::string& option, const std::string& value, uint32_t& width, uint32_t& height) {
   size_t x = value.find('x');
   if (x == std::string::npos) throw UsageError{option + " expects WxH, e.g. 640x480, got '" + value + "'"};
@@ -50,12 +164,6 @@ void parseSize(const std::string& option, const std::string& value, uint32_t& wi
   }
   width = uint32_t(w);
   height = uint32_t(h);
-}
-
-uint64_t parseTextureBudget(const std::string& option, const std::string& value) {
-  unsigned long long mib = parseCount(option, value);
-  if (mib == 0 || mib > (1ull << 20)) throw UsageError{option + " " + value + " is out of range (1 to 1048576 MiB)"};
-  return uint64_t(mib) << 20;
 }
 
 std::vector<double> parseNumbers(const std::string& option, const std::string& value, size_t count) {
@@ -74,48 +182,83 @@ std::vector<double> parseNumbers(const std::string& option, const std::string& v
   return numbers;
 }
 
-bool ShotOptions::take(const std::string& command, const Args& args, size_t& i) {
-  const std::string& a = args[i];
-  if (a == "--eye") {
-    eye = true;
-    return true;
-  }
-  if (!a.empty() && a[0] != '-') {
-    if (!input.empty()) throw UsageError{command + ": more than one scene given ('" + input + "', '" + a + "')"};
-    input = a;
-    return true;
-  }
-  static const char* const kWithValue[] = {"--size", "--camera", "--look-at", "--fov", "--time", "--max-interfaces",
-                                           "--background", "--scene", "--ignore-extension", "--texture-budget"};
-  if (std::find(std::begin(kWithValue), std::end(kWithValue), a) == std::end(kWithValue)) return false;
-  if (i + 1 >= args.size()) throw UsageError{command + ": " + a + " needs a value"};
-  const std::string& v = args[++i];
-  if (a == "--size") {
-    parseSize(a, v, width, height);
-  } else if (a == "--camera") {
-    view.camera = int(parseCount(a, v));
-  } else if (a == "--look-at") {
-    std::vector<double> n = parseNumbers(a, v, 6);
-    view.lookAt = scene::LookAt{{n[0], n[1], n[2]}, {n[3], n[4], n[5]}, {0.0, 1.0, 0.0}};
-  } else if (a == "--fov") {
-    double deg = parseNumbers(a, v, 1)[0];
-    if (!(deg > 0.0 && deg < 180.0)) throw UsageError{"--fov must be between 0 and 180 degrees, got " + v};
-    view.yfov = deg * 3.14159265358979 / 180.0;
-  } else if (a == "--time") {
-    time = parseNumbers(a, v, 1)[0];
-  } else if (a == "--max-interfaces") {
-    maxInterfaces = uint32_t(std::min<unsigned long long>(parseCount(a, v), 1024));
-  } else if (a == "--background") {
-    std::vector<double> n = parseNumbers(a, v, 3);
-    background = glm::vec3(glm::dvec3(n[0], n[1], n[2]));
-  } else if (a == "--scene") {
-    load.scene = v;
-  } else if (a == "--ignore-extension") {
-    load.ignoredExtensions.push_back(v);
-  } else {
-    load.textureBudget = parseTextureBudget(a, v);
-  }
-  return true;
+const CLI::Validator& finite() {
+  static const CLI::Validator validator(
+      [](std::string& value) -> std::string {
+        char* end = nullptr;
+        double v = std::strtod(value.c_str(), &end);
+        return value.empty() || *end != '\0' || !std::isfinite(v) ? "expects a finite number, got '" + value + "'" : "";
+      },
+      "NUMBER");
+  return validator;
+}
+
+CLI::Option* addSize(CLI::App& app, const std::string& name, uint32_t& width, uint32_t& height,
+                     const std::string& description) {
+  std::string option = name.substr(name.rfind(',') == std::string::npos ? 0 : name.rfind(',') + 1);
+  return app
+      .add_option_function<std::string>(
+          name, [&width, &height, option](const std::string& v) { parseSize(option, v, width, height); }, description)
+      ->type_name("WxH");
+}
+
+CLI::Option* addNumbers(CLI::App& app, const std::string& name, std::vector<double>& values, size_t count,
+                        const std::string& description) {
+  return app
+      .add_option_function<std::string>(
+          name, [&values, name, count](const std::string& v) { values = parseNumbers(name, v, count); }, description)
+      ->type_name(count == 1 ? "X" : count == 3 ? "X,Y,Z" : "N,N,...");
+}
+
+CLI::Option* addTextureBudget(CLI::App& app, uint64_t& bytes) {
+  return app
+      .add_option_function<uint64_t>(
+          "--texture-budget", [&bytes](uint64_t mib) { bytes = mib << 20; },
+          "textures (with their mips) beyond MIB MiB load at a lower mip level")
+      ->type_name("MIB")
+      ->check(CLI::Range(uint64_t(1), uint64_t(1) << 20));
+}
+
+void ShotOptions::addTo(CLI::App& app) {
+  app.add_option("scene", input, "the glTF file (.gltf or .glb)")->type_name("SCENE");
+  app.add_flag("--eye", eye, "the procedural eye instead of a file");
+  addSize(app, "--size", width, height, "image size in pixels (default " + std::to_string(width) + "x" +
+                                            std::to_string(height) + ")");
+  app.add_option("--camera", view.camera,
+                 "the scene's glTF camera N (default: camera 0, or a view\nframing the whole scene when it has none)")
+      ->type_name("N")
+      ->check(CLI::Range(0, 1 << 20));
+  app.add_option_function<std::string>(
+         "--look-at",
+         [this](const std::string& v) {
+           std::vector<double> n = parseNumbers("--look-at", v, 6);
+           view.lookAt = scene::LookAt{{n[0], n[1], n[2]}, {n[3], n[4], n[5]}, {0.0, 1.0, 0.0}};
+         },
+         "camera at E looking at T, +Y up (overrides --camera)")
+      ->type_name("EX,EY,EZ,TX,TY,TZ");
+  app.add_option_function<double>(
+         "--fov", [this](double degrees) { view.yfov = degrees * 3.14159265358979 / 180.0; },
+         "vertical field of view in degrees for --look-at and framed views (40)")
+      ->type_name("DEGREES")
+      ->check(CLI::Range(0.001, 179.999));
+  timeOption = app.add_option("--time", time, "seconds into the animation (default 0)")->type_name("T")->check(finite());
+  app.add_option("--max-interfaces", maxInterfaces, "refractive faces a ray may cross (default 8, at most 1024)")
+      ->type_name("N")
+      ->check(CLI::Range(0u, 1024u));
+  app.add_option_function<std::string>(
+         "--background",
+         [this](const std::string& v) {
+           std::vector<double> n = parseNumbers("--background", v, 3);
+           background = glm::vec3(glm::dvec3(n[0], n[1], n[2]));
+         },
+         "linear colour of misses (default 0.02,0.02,0.025)")
+      ->type_name("R,G,B");
+  app.add_option("--scene", load.scene, "which glTF scene of the file")->type_name("NAME|INDEX");
+  app.add_option("--ignore-extension", load.ignoredExtensions, "load a file that requires extension E anyway")
+      ->type_name("E")
+      ->allow_extra_args(false)  // one extension per --ignore-extension: the scene file after it stays the scene
+      ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
+  addTextureBudget(app, load.textureBudget);
 }
 
 void ShotOptions::require(const std::string& command) const {
@@ -126,7 +269,7 @@ void ShotOptions::require(const std::string& command) const {
 scene::Scene ShotOptions::loadScene() const {
   scene::Scene scene = eye ? scene::makeEye() : scene::loadGltf(input, load);
   if (eye) scene.source = "procedural eye";
-  for (const std::string& w : scene.warnings) std::fprintf(stderr, "snell: note: %s\n", w.c_str());
+  for (const std::string& w : scene.warnings) note(w);
   return scene;
 }
 
@@ -140,7 +283,7 @@ scene::View ShotOptions::resolveView(const std::string& command, const scene::Sc
 }
 
 std::unique_ptr<vk::Context> ShotOptions::openContext(const std::string& command) const {
-  std::unique_ptr<vk::Context> context = vk::Context::create(contextDescFromEnvironment());
+  std::unique_ptr<vk::Context> context = vk::Context::create(io::contextDescFromEnvironment());
   try {
     render::checkImageSize(*context, width, height);
   } catch (const std::invalid_argument& e) {
@@ -149,52 +292,11 @@ std::unique_ptr<vk::Context> ShotOptions::openContext(const std::string& command
   return context;
 }
 
-uint32_t findTexturedMaterial(const std::string& command, const scene::Scene& scene, const std::string& wanted) {
-  for (size_t i = 0; i < scene.materials.size(); ++i) {
-    if (scene.materials[i].name != wanted && std::to_string(i) != wanted) continue;
-    if (!scene.materials[i].baseColorTexture.present()) {
-      throw UsageError{command + ": --material " + wanted + " has no base colour texture for the UVs to address"};
-    }
-    return uint32_t(i);
-  }
-  throw UsageError{command + ": --material " + wanted + ": the scene has no such material (" +
-                   std::to_string(scene.materials.size()) + " materials)"};
-}
-
 int validationExitCode(const vk::Context& context) {
-  if (context.validationMessageCount() == 0) return 0;
+  if (context.validationMessageCount() == 0) return kExitOk;
   std::fprintf(stderr, "snell: the validation layer reported %llu message(s)\n",
                static_cast<unsigned long long>(context.validationMessageCount()));
-  return 1;
-}
-
-std::string xmlEscape(const std::string& text) {
-  std::string out;
-  for (char c : text) {
-    if (c == '&') out += "&amp;";
-    else if (c == '<') out += "&lt;";
-    else if (c == '>') out += "&gt;";
-    else if (c == '"') out += "&quot;";
-    else out += c;
-  }
-  return out;
-}
-
-double median(std::vector<double> values) {
-  if (values.empty()) return 0;
-  std::sort(values.begin(), values.end());
-  size_t n = values.size();
-  return n % 2 ? values[n / 2] : 0.5 * (values[n / 2 - 1] + values[n / 2]);
-}
-
-std::string jsonEscape(const std::string& text) {
-  std::string out;
-  for (char c : text) {
-    if (c == '"' || c == '\\') out += '\\';
-    if (static_cast<unsigned char>(c) < 0x20) continue;
-    out += c;
-  }
-  return out;
+  return kExitFailure;
 }
 
 }  // namespace snell::cli

@@ -1,10 +1,10 @@
 // `snell export-web SCENE -o DIR`: the Sky paper's web page, baked by the
 // trace: a page that draws the glass from a sky8 refraction map with a few
 // lines of WebGL, no 3D mesh and no framework.
-#include "cli/cli.h"
+#include "cli/commands.h"
 
 #include "bake/refraction_bake.h"
-#include "cli/image_file.h"
+#include "io/image_file.h"
 #include "render/method.h"
 #include "render/renderer.h"
 #include "scene/evaluate.h"
@@ -16,6 +16,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <memory>
 #include <optional>
 #include <stdexcept>
 
@@ -24,44 +25,6 @@
 namespace snell::cli {
 
 namespace {
-
-constexpr const char* kHelp = R"(usage: snell export-web SCENE.glb|SCENE.gltf|--eye -o DIR [options]
-
-Writes a self-contained web page that draws one view of the scene the way the
-Sky paper's page draws its glass: no mesh and no ray tracing in the browser,
-only a refraction map baked by the GPU trace (sky8, decoded in the fragment
-shader exactly as the seed's GLSL decodes it), the texture behind the glass,
-and the diffuse layer. It opens from the file system in any WebGL 2 browser.
-
-DIR gets:
-  index.html     the page: a canvas the size of the view
-  snell-web.js   the WebGL script (no framework)
-  images.js      the four images as data: URIs (a page opened from the file
-                 system may not read image files into WebGL)
-  map.png        the refraction map (sky8; A: 1 lands, 1/2 marked, 0 not glass)
-  behind-N.png   the texture behind the glass, level N of snell's mip chain
-  diffuse.png    what the glass adds (reflections, highlights), and the rest of
-                 the picture drawn by the viewport (sRGB)
-  weight.png     what the texture behind is multiplied by, over weightScale
-                 (sRGB), and in alpha the level of detail it is read at x 16
-The PNGs are the same images as images.js holds, for inspection; the page
-loads only index.html and the two scripts. It shows, on the page, the time
-from navigation to its first frame.
-
-A pixel of the page is diffuse + weightScale x weight x behind(map's UV) in
-linear light: what 'snell render --method refraction-map' draws at the baked
-pose, the texture read trilinearly at the level of detail the trace read it
-at, from the same mip chain, but by the browser's sampler in 8-bit sRGB.
-
-options:
-  -o, --output DIR       the folder to write (made if missing; files in it are replaced)
-  --material NAME|INDEX  the surface behind (default: the one most glass pixels land on)
-  --eye                  the procedural eye instead of a file
-  --size WxH             page size in pixels (default 640x480)
-  --camera N, --look-at EX,EY,EZ,TX,TY,TZ, --fov DEGREES, --time T,
-  --max-interfaces N, --background R,G,B, --scene NAME|INDEX,
-  --ignore-extension E, --texture-budget MIB    as for 'snell render'
-)";
 
 constexpr const char* kHtml = R"(<!doctype html>
 <html>
@@ -238,41 +201,10 @@ struct Options {
   std::string material;
 };
 
-Options parse(const Args& args) {
-  Options o;
-  for (size_t i = 0; i < args.size(); ++i) {
-    const std::string& a = args[i];
-    if (o.shot.take("export-web", args, i)) continue;
-    if (i + 1 >= args.size()) throw UsageError{"export-web: " + a + " needs a value (or is unknown)"};
-    const std::string& v = args[++i];
-    if (a == "-o" || a == "--output") {
-      o.output = v;
-    } else if (a == "--material") {
-      o.material = v;
-    } else {
-      throw UsageError{"export-web: unknown option " + a};
-    }
-  }
-  o.shot.require("export-web");
-  if (o.output.empty()) throw UsageError{"export-web: give the folder to write with -o DIR"};
-  return o;
-}
-
-}  // namespace
-
-void parseExportWebOptions(const Args& args) { (void)parse(args); }
-
-int runExportWeb(const Args& args) {
-  for (const std::string& a : args) {
-    if (a == "--help" || a == "-h") {
-      std::fputs(kHelp, stdout);
-      return 0;
-    }
-  }
-  Options o = parse(args);
+int runExportWeb(const Options& o) {
   namespace fs = std::filesystem;
   // Nothing is made until the page is ready; a folder that cannot be made or written fails now.
-  checkWritable(fs::is_directory(o.output) ? (fs::path(o.output) / "index.html").string() : o.output);
+  io::checkWritable(fs::is_directory(o.output) ? (fs::path(o.output) / "index.html").string() : o.output);
   scene::Scene scene = o.shot.loadScene();
   std::optional<uint32_t> material;
   if (!o.material.empty()) material = findTexturedMaterial("export-web", scene, o.material);
@@ -317,8 +249,8 @@ int runExportWeb(const Args& args) {
     glm::vec3 d = lands ? glm::vec3(baked.texels[i].shine) : glm::vec3(picture[i]);
     glm::vec3 w = lands ? glm::vec3(baked.texels[i].weight) / weightScale : glm::vec3(0.0f);
     for (int c = 0; c < 3; ++c) {
-      diffuse[4 * i + size_t(c)] = linearToSrgb8(d[c]);
-      weight[4 * i + size_t(c)] = linearToSrgb8(w[c]);
+      diffuse[4 * i + size_t(c)] = io::linearToSrgb8(d[c]);
+      weight[4 * i + size_t(c)] = io::linearToSrgb8(w[c]);
     }
     // The level of detail the trace read the texture at, in sixteenths (the page reads it there too).
     float lod = baked.texels[i].weight.w;
@@ -370,10 +302,10 @@ int runExportWeb(const Args& args) {
   fs::path writing = fresh ? fs::path(dir.string() + ".partial-" + std::to_string(::getpid())) : dir;
   try {
     if (fresh) fs::create_directory(writing);
-    for (const Layer& l : layers) writeTextFile((writing / l.file).string(), std::string(l.png.begin(), l.png.end()));
-    writeTextFile((writing / "images.js").string(), images);
-    writeTextFile((writing / "snell-web.js").string(), kScript);
-    writeTextFile((writing / "index.html").string(), html);
+    for (const Layer& l : layers) io::writeTextFile((writing / l.file).string(), std::string(l.png.begin(), l.png.end()));
+    io::writeTextFile((writing / "images.js").string(), images);
+    io::writeTextFile((writing / "snell-web.js").string(), kScript);
+    io::writeTextFile((writing / "index.html").string(), html);
     if (fresh) fs::rename(writing, dir);
   } catch (...) {
     std::error_code ignored;
@@ -389,6 +321,50 @@ int runExportWeb(const Args& args) {
               context->facts().name.c_str(), seconds, bake::describe(baked, scene).c_str(), pageBytes,
               fs::file_size(dir / "index.html"), fs::file_size(dir / "snell-web.js"), fs::file_size(dir / "images.js"));
   return validationExitCode(*context);
+}
+
+}  // namespace
+
+void addExportWeb(CLI::App& parent, Runner& run) {
+  auto o = std::make_shared<Options>();
+  CLI::App* sub = parent.add_subcommand("export-web", "a self-contained WebGL page drawing the glass from a sky8 map");
+  describe(*sub,
+      "Writes a self-contained web page that draws one view of the scene the way the\n"
+      "Sky paper's page draws its glass: no mesh and no ray tracing in the browser,\n"
+      "only a refraction map baked by the GPU trace (sky8, decoded in the fragment\n"
+      "shader exactly as the seed's GLSL decodes it), the texture behind the glass,\n"
+      "and the diffuse layer. It opens from the file system in any WebGL 2 browser.\n"
+      "\n"
+      "DIR gets:\n"
+      "  index.html     the page: a canvas the size of the view\n"
+      "  snell-web.js   the WebGL script (no framework)\n"
+      "  images.js      the four images as data: URIs (a page opened from the file\n"
+      "                 system may not read image files into WebGL)\n"
+      "  map.png        the refraction map (sky8; A: 1 lands, 1/2 marked, 0 not glass)\n"
+      "  behind-N.png   the texture behind the glass, level N of snell's mip chain\n"
+      "  diffuse.png    what the glass adds (reflections, highlights), and the rest of\n"
+      "                 the picture drawn by the viewport (sRGB)\n"
+      "  weight.png     what the texture behind is multiplied by, over weightScale\n"
+      "                 (sRGB), and in alpha the level of detail it is read at x 16\n"
+      "The PNGs are the same images as images.js holds, for inspection; the page\n"
+      "loads only index.html and the two scripts. It shows, on the page, the time\n"
+      "from navigation to its first frame.\n"
+      "\n"
+      "A pixel of the page is diffuse + weightScale x weight x behind(map's UV) in\n"
+      "linear light: what 'snell render --method refraction-map' draws at the baked\n"
+      "pose, the texture read trilinearly at the level of detail the trace read it\n"
+      "at, from the same mip chain, but by the browser's sampler in 8-bit sRGB.");
+  sub->footer(kHelpFooter);
+  o->shot.addTo(*sub);
+  sub->add_option("-o,--output", o->output, "the folder to write (made if missing; files in it are replaced)")
+      ->required()
+      ->type_name("DIR");
+  sub->add_option("--material", o->material, "the surface behind (default: the one most glass pixels land on)")
+      ->type_name("NAME|INDEX");
+  sub->callback([o, &run] {
+    o->shot.require("export-web");
+    run = [o] { return runExportWeb(*o); };
+  });
 }
 
 }  // namespace snell::cli

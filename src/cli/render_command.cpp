@@ -1,10 +1,14 @@
 // `snell render SCENE -o OUT.png|OUT.exr`: headless frames of a glTF scene,
 // traced on the GPU (or by the CPU reference with --reference), or with
 // --viewport the viewer's composite: rasterized, with the trace on glass.
-#include "cli/cli.h"
+// EXR files carry alpha = coverage, the camera and time as metadata, and on
+// request the trace's per-pixel AOVs as named layers.
+#include "cli/commands.h"
 
 #include "bake/refraction_bake.h"
-#include "cli/image_file.h"
+#include "io/image_file.h"
+#include "io/json.h"
+#include "io/progress.h"
 #include "ref/reference_tracer.h"
 #include "render/method.h"
 #include "render/raster_pass.h"
@@ -15,75 +19,35 @@
 #include "scene/view.h"
 #include "vk/context.h"
 
+#include <glm/gtc/packing.hpp>
+
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <limits>
+#include <map>
 #include <optional>
-#include <sstream>
 #include <stdexcept>
 
 namespace snell::cli {
 
 namespace {
 
-constexpr const char* kHelp = R"(usage: snell render SCENE.glb|SCENE.gltf|--eye -o OUT.png|OUT.exr [options]
+constexpr const char* kDescription =
+    "Ray traces the scene on the GPU: one ray per pixel, refracted through every\n"
+    "transmissive face (KHR_materials_transmission, KHR_materials_ior, _volume,\n"
+    "_dispersion; overlapping glass by priority), Phong-shaded where it lands. Glass\n"
+    "reflects by Fresnel: the lights as highlights (an eye's catch lights) and the\n"
+    "environment. PNG is written as 8-bit sRGB; EXR as linear half floats (or\n"
+    "--float) with alpha = coverage (1 where the pixel's ray met a surface), the\n"
+    "camera, time, method, device and snell version in its header, and with --aov\n"
+    "the trace's per-pixel data as layers compositors read. A file appears only\n"
+    "once it is complete.";
 
-Ray traces the scene on the GPU: one ray per pixel, refracted through every
-transmissive face (KHR_materials_transmission, KHR_materials_ior, _volume,
-_dispersion; overlapping glass by priority), Phong-shaded where it lands. Glass
-reflects by Fresnel: the lights as highlights (an eye's catch lights) and the
-environment. PNG is written as 8-bit sRGB, EXR as linear half floats. The
-file appears only once it is complete.
-
-options:
-  -o, --output FILE      the image to write (required); with --frames, '#'s in
-                         the name become the frame number, else it is added
-                         before the extension (out.0012.png)
-  --eye                  render the procedural eye instead of a file
-  --size WxH             image size in pixels (default 640x480)
-  --camera N             the scene's glTF camera N (default: camera 0, or a view
-                         framing the whole scene when it has none)
-  --look-at EX,EY,EZ,TX,TY,TZ   camera at E looking at T, +Y up (overrides --camera)
-  --fov DEGREES          vertical field of view for --look-at and framed views (40)
-  --time T               seconds into the animation (default 0)
-  --frames A:B           frames A to B inclusive at --fps (default 24), with progress
-  --fps N                frames per second for --frames
-  --max-interfaces N     refractive faces a ray may cross (default 8)
-  --background R,G,B     linear colour of misses (default 0.02,0.02,0.025)
-  --environment FILE     what glass reflects: an equirectangular HDR, EXR or PNG
-                         (+Y up, -Z in the middle; default: a studio gradient)
-  --reflections N        interfaces per ray that send a reflected ray (default 1)
-  --no-fresnel           glass transmits everything and reflects nothing
-  --scene NAME|INDEX     which glTF scene of the file
-  --ignore-extension E   load a file that requires extension E anyway
-  --texture-budget MIB   textures (with mips) beyond MIB MiB load at a lower mip level
-  --reference            render with the CPU double-precision reference instead
-                         of the GPU (slow; golden images are made this way)
-  --method M             how refraction is drawn (default trace): trace,
-                         trace-1 (bends at the first interface only), masked
-                         (the viewport: raster, glass pixels traced),
-                         iris-plane and normal-offset (raster, no trace),
-                         refraction-map (raster, no trace: the texture
-                         behind the glass read where a map baked by the
-                         trace at --bake-time says, as the scene moves on),
-                         none (glass seen straight through), driver-rt
-                         (the trace's rays through the driver's own ray
-                         tracing, where the GPU has it)
-  --offset-strength S    normal-offset's displacement in image heights (0.02)
-  --bake-time T          refraction-map's pose: the seconds the map is baked at
-                         (default: the first frame's time)
-  --viewport             write the viewport's composite instead of the trace
-                         alone: every face rasterized and Phong-shaded, and
-                         transmissive faces showing the traced image (what
-                         snell-view shows); the same as --method masked
-  --no-refraction        with --viewport: see through glass without bending
-                         (--method none)
-  --wireframe            with --viewport: draw triangle edges over the image
-  --stats                print each frame's work: what was deformed, refit,
-                         rebuilt or skipped, pixels traced, dispatches, and the
-                         GPU time of each pass
-)";
+/// The AOV layers --aov may name, in the order they are written.
+const std::vector<std::string> kAovNames = {"depth", "normal", "instance", "primitive", "interfaces", "cost"};
 
 struct Options {
   ShotOptions shot;
@@ -99,84 +63,15 @@ struct Options {
   render::RasterOptions raster;
   scene::Optics optics;
   std::string environment;
-};
+  std::vector<std::string> aovs;
+  bool floatPixels = false;
 
-Options parse(const Args& args) {
-  Options o;
-  for (size_t i = 0; i < args.size(); ++i) {
-    const std::string& a = args[i];
-    if (a == "--reference") { o.reference = true; continue; }
-    if (a == "--viewport") { o.viewport = true; continue; }
-    if (a == "--no-refraction") { o.raster.refraction = false; continue; }
-    if (a == "--wireframe") { o.raster.wireframe = true; continue; }
-    if (a == "--stats") { o.stats = true; continue; }
-    if (a == "--no-fresnel") { o.optics.fresnel = false; continue; }
-    if (o.shot.take("render", args, i)) continue;
-    if (i + 1 >= args.size()) throw UsageError{"render: " + a + " needs a value (or is unknown)"};
-    const std::string& v = args[++i];
-    if (a == "-o" || a == "--output") {
-      o.output = v;
-    } else if (a == "--bake-time") {
-      o.bakeTime = parseNumbers(a, v, 1)[0];
-    } else if (a == "--frames") {
-      size_t colon = v.find(':');
-      if (colon == std::string::npos) throw UsageError{"--frames expects A:B, e.g. 1:48, got '" + v + "'"};
-      o.firstFrame = long(parseCount("--frames", v.substr(0, colon)));
-      o.lastFrame = long(parseCount("--frames", v.substr(colon + 1)));
-      if (o.lastFrame < o.firstFrame) throw UsageError{"--frames " + v + ": the last frame comes before the first"};
-      o.frames = true;
-    } else if (a == "--fps") {
-      o.fps = parseNumbers(a, v, 1)[0];
-      if (!(o.fps > 0.0)) throw UsageError{"--fps must be positive, got " + v};
-    } else if (a == "--method") {
-      o.method = render::methodFromName(v);
-      if (!o.method) throw UsageError{"render: --method takes one of " + render::methodNames() + ", got '" + v + "'"};
-    } else if (a == "--offset-strength") {
-      char* end = nullptr;
-      double strength = std::strtod(v.c_str(), &end);
-      if (v.empty() || *end != '\0' || !std::isfinite(strength)) {
-        throw UsageError{"render: --offset-strength expects a number, got '" + v + "'"};
-      }
-      o.raster.offsetStrength = float(strength);
-    } else if (a == "--environment") {
-      o.environment = v;
-    } else if (a == "--reflections") {
-      o.optics.reflections = uint32_t(std::min<unsigned long long>(parseCount(a, v), 1024));
-    } else {
-      throw UsageError{"render: unknown option " + a};
-    }
+  bool exr() const {
+    std::string ext = std::filesystem::path(output).extension().string();
+    return ext == ".exr" || ext == ".EXR";
   }
-  o.shot.require("render");
-  if (o.stats && o.reference) throw UsageError{"render: --stats counts GPU work; the reference (--reference) has none"};
-  if (o.output.empty()) throw UsageError{"render: give the output image with -o FILE.png or FILE.exr"};
-  if (o.viewport && o.reference) {
-    throw UsageError{"render: --viewport is drawn on the GPU; the reference traces (--reference) without it"};
-  }
-  if (o.method && o.reference) {
-    throw UsageError{"render: --method draws on the GPU; the reference (--reference) is the physics they approximate"};
-  }
-  if (o.method && o.viewport && !render::drawsComposite(*o.method)) {
-    throw UsageError{std::string("render: --method ") + render::methodName(*o.method) +
-                     " draws the trace image, not the viewport (--viewport)"};
-  }
-  if (!o.method) {
-    o.method = !o.viewport ? render::Method::Trace : o.raster.refraction ? render::Method::Masked : render::Method::None;
-  } else if (!o.raster.refraction) {
-    if (*o.method != render::Method::None && render::drawsComposite(*o.method)) {
-      throw UsageError{"render: --no-refraction is --method none; it cannot go with --method " +
-                       std::string(render::methodName(*o.method))};
-    }
-    o.method = render::Method::None;
-  }
-  if (!render::drawsComposite(*o.method) && (!o.raster.refraction || o.raster.wireframe)) {
-    throw UsageError{"render: --no-refraction and --wireframe need --viewport (or a viewport --method)"};
-  }
-  std::string ext = std::filesystem::path(o.output).extension().string();
-  if (ext != ".png" && ext != ".exr" && ext != ".PNG" && ext != ".EXR") {
-    throw UsageError{"render: the output must end in .png or .exr, got '" + o.output + "'"};
-  }
-  return o;
-}
+  bool wants(const std::string& aov) const { return std::find(aovs.begin(), aovs.end(), aov) != aovs.end(); }
+};
 
 std::string framePath(const std::string& pattern, long frame) {
   size_t first = pattern.find('#');
@@ -191,15 +86,6 @@ std::string framePath(const std::string& pattern, long frame) {
   char number[32];
   std::snprintf(number, sizeof number, ".%04ld", frame);
   return (p.parent_path() / (p.stem().string() + number + p.extension().string())).string();
-}
-
-void progress(long done, long total, double seconds) {
-  const int width = 30;
-  int filled = int(width * done / std::max(total, 1L));
-  std::fprintf(stderr, "\r[%.*s%.*s] %ld/%ld frames, %.1f s", filled, "##############################", width - filled,
-               "..............................", done, total, seconds);
-  if (done == total) std::fputc('\n', stderr);
-  std::fflush(stderr);
 }
 
 // One frame's counters and pass times, for --stats: what a pipeline engineer
@@ -222,25 +108,272 @@ void printStats(long frameNumber, const render::FrameStats& s, const std::vector
   std::printf(" total %.3f\n", total);
 }
 
-}  // namespace
 
-void parseRenderOptions(const Args& args) { (void)parse(args); }
+// Camera-space depth along the view axis from the trace's distance along
+// each pixel's unit ray (the reference tracer's ray, in double).
+double depthOf(const scene::View& view, uint32_t width, uint32_t height, size_t pixel, double distance) {
+  if (view.orthographic) return distance;
+  double w = width, h = height;
+  double x = double(pixel % width), y = double(pixel / width);
+  double sx = (2.0 * (x + 0.5) / w - 1.0) * view.halfHeight * w / h + view.shift.x;
+  double sy = (1.0 - 2.0 * (y + 0.5) / h) * view.halfHeight + view.shift.y;
+  return distance / std::sqrt(1.0 + sx * sx + sy * sy);
+}
 
-int runRender(const Args& args) {
-  for (const std::string& a : args) {
-    if (a == "--help" || a == "-h") {
-      std::fputs(kHelp, stdout);
-      return 0;
+// The world-space face normal of each (item, triangle) the pixels hit, from
+// the item's deformed positions at this pose (deformed once per item).
+class FaceNormals {
+ public:
+  FaceNormals(const scene::Scene& scene, const scene::Pose& pose) : scene_(scene), pose_(pose) {}
+  glm::vec3 of(uint32_t item, uint32_t triangle) {
+    if (item >= pose_.items.size()) return glm::vec3(0.0f);
+    auto [at, fresh] = positions_.try_emplace(item);
+    const scene::DrawItem& drawn = pose_.items[item];
+    if (fresh) {
+      std::vector<glm::dvec3> normals;
+      scene::deformOnCpu(drawn, at->second, normals);
     }
+    const std::vector<uint32_t>& indices = scene_.shapes[size_t(drawn.shape)].indices;
+    if (3 * size_t(triangle) + 2 >= indices.size()) return glm::vec3(0.0f);
+    const std::vector<glm::dvec3>& p = at->second;
+    glm::dvec3 a = p[indices[3 * triangle]], b = p[indices[3 * triangle + 1]], c = p[indices[3 * triangle + 2]];
+    glm::dmat3 toWorld = glm::transpose(glm::inverse(glm::dmat3(drawn.world)));
+    glm::dvec3 n = toWorld * glm::cross(b - a, c - a);
+    double length = glm::length(n);
+    return length > 0.0 ? glm::vec3(n / length) : glm::vec3(0.0f);
   }
-  Options o = parse(args);
-  checkWritable(o.frames ? framePath(o.output, o.firstFrame) : o.output);
-  if (!o.environment.empty()) o.optics.environment = std::make_shared<scene::Environment>(readEnvironment(o.environment));
-  scene::Scene scene = o.shot.loadScene();
 
+ private:
+  const scene::Scene& scene_;
+  const scene::Pose& pose_;
+  std::map<uint32_t, std::vector<glm::dvec3>> positions_;
+};
+
+// What one pixel's trace found, from the GPU's AOV or the reference.
+struct PixelHit {
+  double distance;  // < 0: missed
+  uint32_t instance, primitive, interfaces, cost;
+};
+
+// The layers --aov asked for, and alpha = coverage written into the image.
+template <typename HitAt>
+std::vector<io::AovLayer> aovLayers(const Options& o, const scene::Scene& scene, const scene::Pose& pose,
+                                    const scene::View& view, io::LinearImage& image, HitAt hitAt) {
+  const size_t pixels = image.pixels();
+  std::vector<io::AovLayer> layers;
+  auto layer = [&](const char* name, std::vector<std::string> channels, bool integer) -> io::AovLayer& {
+    io::AovLayer& l = layers.emplace_back();
+    l.layer = name;
+    l.integer = integer;
+    if (integer) l.ids.resize(pixels * channels.size());
+    else l.values.resize(pixels * channels.size());
+    l.channels = std::move(channels);
+    return l;
+  };
+  FaceNormals normals(scene, pose);
+  std::map<std::string, io::AovLayer*> wanted;
+  for (const std::string& name : kAovNames) {
+    if (!o.wants(name)) continue;
+    if (name == "depth") layer("depth", {"Z"}, false);
+    if (name == "normal") layer("normal", {"X", "Y", "Z"}, false);
+    if (name == "instance") layer("instance", {"id"}, true);
+    if (name == "primitive") layer("primitive", {"id"}, true);
+    if (name == "interfaces") layer("interfaces", {"count"}, true);
+    if (name == "cost") layer("cost", {"nodes"}, true);
+  }
+  for (io::AovLayer& l : layers) wanted[l.layer] = &l;
+  const uint16_t one = glm::packHalf1x16(1.0f), zero = glm::packHalf1x16(0.0f);
+  for (size_t i = 0; i < pixels; ++i) {
+    PixelHit hit = hitAt(i);
+    bool covered = hit.distance >= 0.0;
+    if (image.rgba.empty()) image.rgbaHalf[4 * i + 3] = covered ? one : zero;
+    else image.rgba[i].a = covered ? 1.0f : 0.0f;
+    if (auto l = wanted.find("depth"); l != wanted.end()) {
+      l->second->values[i] = covered ? float(depthOf(view, image.width, image.height, i, hit.distance))
+                                     : std::numeric_limits<float>::infinity();
+    }
+    if (auto l = wanted.find("normal"); l != wanted.end()) {
+      glm::vec3 n = covered ? normals.of(hit.instance, hit.primitive) : glm::vec3(0.0f);
+      for (int c = 0; c < 3; ++c) l->second->values[3 * i + size_t(c)] = n[c];
+    }
+    if (auto l = wanted.find("instance"); l != wanted.end()) l->second->ids[i] = hit.instance;
+    if (auto l = wanted.find("primitive"); l != wanted.end()) l->second->ids[i] = hit.primitive;
+    if (auto l = wanted.find("interfaces"); l != wanted.end()) l->second->ids[i] = hit.interfaces;
+    if (auto l = wanted.find("cost"); l != wanted.end()) l->second->ids[i] = hit.cost;
+  }
+  return layers;
+}
+
+// The EXR header: what a compositor or a pipeline wants to know about the frame.
+io::ImageExtras exrExtras(const Options& o, const scene::Scene& scene, const scene::View& view, double time,
+                          const std::string& device) {
+  io::ImageExtras extras;
+  extras.floatPixels = o.floatPixels;
+  extras.text = {{"snell:scene", scene.source},
+                 {"snell:camera", view.description},
+                 {"snell:method", o.reference ? "reference" : render::methodName(*o.method)},
+                 {"snell:device", device},
+                 {"snell:version", io::version()},
+                 {"snell:command_line", io::commandLine()}};
+  extras.numbers = {{"snell:time", float(time)},
+                    {"snell:vertical_fov_degrees",
+                     view.orthographic ? 0.0f : float(2.0 * std::atan(view.halfHeight) * 180.0 / 3.14159265358979)}};
+  // Camera space as OpenGL has it: x right, y up, looking down -z.
+  glm::dmat4 cameraToWorld(glm::dvec4(view.right, 0.0), glm::dvec4(view.up, 0.0), glm::dvec4(-view.forward, 0.0),
+                           glm::dvec4(view.eye, 1.0));
+  extras.worldToCamera = glm::mat4(glm::inverse(cameraToWorld));
+  extras.hasWorldToCamera = true;
+  return extras;
+}
+
+
+void addOptions(CLI::App& render, Options& o) {
+  render.add_option("-o,--output", o.output,
+                    "the image to write: .png or .exr; with --frames, '#'s in the\n"
+                    "name become the frame number, else it is added before the\n"
+                    "extension (out.0012.png)")
+      ->required()
+      ->type_name("FILE")
+      ->check([](const std::string& path) -> std::string {
+        std::string ext = std::filesystem::path(path).extension().string();
+        return ext == ".png" || ext == ".exr" || ext == ".PNG" || ext == ".EXR" ? "" : "must end in .png or .exr, got '" + path + "'";
+      });
+  o.shot.addTo(render);
+  CLI::Option* frames = render.add_option_function<std::string>(
+      "--frames",
+      [&o](const std::string& v) {
+        size_t colon = v.find(':');
+        if (colon == std::string::npos) throw UsageError{"--frames expects A:B, e.g. 1:48, got '" + v + "'"};
+        auto number = [&](const std::string& part) {
+          try {
+            size_t used = 0;
+            long n = std::stol(part, &used);
+            if (used == part.size() && n >= 0) return n;
+          } catch (const std::exception&) {
+          }
+          throw UsageError{"--frames expects A:B with whole numbers, got '" + v + "'"};
+        };
+        o.firstFrame = number(v.substr(0, colon));
+        o.lastFrame = number(v.substr(colon + 1));
+        if (o.lastFrame < o.firstFrame) throw UsageError{"--frames " + v + ": the last frame comes before the first"};
+        o.frames = true;
+      },
+      "frames A to B inclusive at --fps, with progress");
+  frames->type_name("A:B")->excludes(o.shot.timeOption);
+  render.add_option("--fps", o.fps, "frames per second for --frames (default 24)")
+      ->type_name("N")
+      ->check(CLI::PositiveNumber & finite())
+      ->needs(frames);
+  render.add_option_function<double>("--bake-time", [&o](double t) { o.bakeTime = t; },
+                                     "refraction-map's pose: the seconds the map is baked at\n(default: the first frame's time)")
+      ->type_name("T")
+      ->check(finite());
+  render.add_flag("--reference", o.reference,
+                  "render with the CPU double-precision reference instead\n"
+                  "of the GPU (slow; golden images are made this way)");
+  render.add_option_function<std::string>(
+         "--method",
+         [&o](const std::string& name) {
+           o.method = render::methodFromName(name);
+           if (!o.method) throw UsageError{"--method takes one of " + render::methodNames() + ", got '" + name + "'"};
+         },
+         "how refraction is drawn (default trace): trace,\n"
+         "trace-1 (bends at the first interface only), masked\n"
+         "(the viewport: raster, glass pixels traced),\n"
+         "iris-plane and normal-offset (raster, no trace),\n"
+         "refraction-map (raster, no trace: the texture\n"
+         "behind the glass read where a map baked by the\n"
+         "trace at --bake-time says, as the scene moves on),\n"
+         "none (glass seen straight through), driver-rt\n"
+         "(the trace's rays through the driver's own ray\n"
+         "tracing, where the GPU has it)")
+      ->type_name("M");
+  render.add_option("--offset-strength", o.raster.offsetStrength, "normal-offset's displacement in image heights (0.02)")
+      ->type_name("S")
+      ->check(CLI::Range(-10.0f, 10.0f));
+  render.add_option("--environment", o.environment,
+                    "what glass reflects: an equirectangular HDR, EXR or PNG\n(+Y up, -Z in the middle; default: a studio gradient)")
+      ->type_name("FILE")
+      ->check(CLI::ExistingFile);
+  render.add_option("--reflections", o.optics.reflections,
+                    "interfaces per ray that send a reflected ray (default 1, at most 1024)")
+      ->type_name("N")
+      ->check(CLI::Range(0u, 1024u));
+  render.add_flag_callback("--no-fresnel", [&o] { o.optics.fresnel = false; }, "glass transmits everything and reflects nothing");
+  render.add_flag("--viewport", o.viewport,
+                  "write the viewport's composite instead of the trace\n"
+                  "alone: every face rasterized and Phong-shaded, and\n"
+                  "transmissive faces showing the traced image (what\n"
+                  "snell-view shows); the same as --method masked");
+  render.add_flag_callback("--no-refraction", [&o] { o.raster.refraction = false; },
+                           "with --viewport: see through glass without bending (--method none)");
+  render.add_flag("--wireframe", o.raster.wireframe, "with --viewport: draw triangle edges over the image");
+  render.add_flag("--stats", o.stats,
+                  "print each frame's work: what was deformed, refit,\n"
+                  "rebuilt or skipped, pixels traced, dispatches, and the\n"
+                  "GPU time of each pass");
+  render.add_option("--aov", o.aovs,
+                    "with an .exr: add the trace's per-pixel data as layers,\n"
+                    "any of depth (depth.Z, camera-space, +inf on a miss),\n"
+                    "normal (normal.XYZ, world-space face normal), instance\n"
+                    "(instance.id, the draw item hit), primitive (primitive.id,\n"
+                    "its triangle), interfaces (interfaces.count, refractive\n"
+                    "faces crossed), cost (cost.nodes, BVH nodes visited);\n"
+                    "ids are 32-bit unsigned, 4294967295 on a miss")
+      ->type_name("LIST")
+      ->delimiter(',')
+      ->allow_extra_args(false)
+      ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll)
+      ->check(CLI::IsMember(kAovNames));
+  render.add_flag("--float", o.floatPixels, "with an .exr: 32-bit float channels instead of half");
+}
+
+// The checks that need several options at once.
+void check(Options& o) {
+  o.shot.require("render");
+  if (o.stats && o.reference) throw UsageError{"render: --stats counts GPU work; the reference (--reference) has none"};
+  if (o.viewport && o.reference) {
+    throw UsageError{"render: --viewport is drawn on the GPU; the reference traces (--reference) without it"};
+  }
+  if (o.method && o.reference) {
+    throw UsageError{"render: --method draws on the GPU; the reference (--reference) is the physics they approximate"};
+  }
+  if (o.method && o.viewport && !render::drawsComposite(*o.method)) {
+    throw UsageError{std::string("render: --method ") + render::methodName(*o.method) +
+                     " draws the trace image, not the viewport (--viewport)"};
+  }
+  if (!o.method) {
+    o.method = !o.viewport ? render::Method::Trace : o.raster.refraction ? render::Method::Masked : render::Method::None;
+  } else if (!o.raster.refraction) {
+    if (*o.method != render::Method::None && render::drawsComposite(*o.method)) {
+      throw UsageError{"render: --no-refraction is --method none; it cannot go with --method " +
+                       std::string(render::methodName(*o.method))};
+    }
+    o.method = render::Method::None;
+  }
+  if (!render::drawsComposite(*o.method) && (!o.raster.refraction || o.raster.wireframe)) {
+    throw UsageError{"render: --no-refraction and --wireframe need --viewport (or a viewport --method)"};
+  }
   if (o.bakeTime && *o.method != render::Method::RefractionMap) {
     throw UsageError{"render: --bake-time is for --method refraction-map"};
   }
+  if ((!o.aovs.empty() || o.floatPixels) && !o.exr()) {
+    throw UsageError{std::string("render: ") + (o.floatPixels ? "--float" : "--aov") + " needs an .exr output, got '" +
+                     o.output + "'"};
+  }
+  if (!o.aovs.empty() && !o.reference && *o.method != render::Method::Trace && *o.method != render::Method::TraceOnce) {
+    throw UsageError{std::string("render: --aov comes from the trace of every pixel (--method trace or trace-1, or "
+                                 "--reference), not --method ") + render::methodName(*o.method)};
+  }
+  if (o.reference && o.wants("cost")) throw UsageError{"render: --aov cost counts BVH nodes on the GPU; the reference has none"};
+}
+
+
+int runRender(Options& o) {
+  io::checkWritable(o.frames ? framePath(o.output, o.firstFrame) : o.output);
+  if (!o.environment.empty()) o.optics.environment = std::make_shared<scene::Environment>(io::readEnvironment(o.environment));
+  scene::Scene scene = o.shot.loadScene();
+
   std::vector<std::pair<long, double>> frames;  // (frame number, time)
   if (o.frames) {
     for (long f = o.firstFrame; f <= o.lastFrame; ++f) frames.emplace_back(f, double(f) / o.fps);
@@ -252,7 +385,7 @@ int runRender(const Args& args) {
   std::unique_ptr<vk::Context> context;
   std::unique_ptr<render::Renderer> renderer;
   if (!o.reference) {
-    vk::ContextDesc desc = contextDescFromEnvironment();
+    vk::ContextDesc desc = io::contextDescFromEnvironment();
     desc.driverRayTracing = render::needsDriverRayTracing(*o.method);
     context = vk::Context::create(desc);
     if (desc.driverRayTracing && !context->caps().driverRayTracing) {
@@ -266,6 +399,7 @@ int runRender(const Args& args) {
     }
     renderer = std::make_unique<render::Renderer>(*context, scene, layout);
   }
+  const std::string device = o.reference ? "CPU reference" : context->facts().name;
 
   // refraction-map: the trace bakes the map once, at --bake-time (default:
   // the first frame's), and every frame reads it as the scene moves on.
@@ -273,12 +407,7 @@ int runRender(const Args& args) {
   if (renderer && *o.method == render::Method::RefractionMap) {
     double t = o.bakeTime.value_or(frames.front().second);
     scene::Pose bakePose = scene::evaluate(scene, t);
-    scene::View bakeView;
-    try {
-      bakeView = scene::resolveView(scene, bakePose, o.shot.view);
-    } catch (const std::invalid_argument& e) {
-      throw UsageError{std::string("render: ") + e.what()};
-    }
+    scene::View bakeView = o.shot.resolveView("render", scene, bakePose);
     render::FrameSettings settings{o.shot.width, o.shot.height, bakeView, o.shot.background, o.shot.maxInterfaces};
     settings.optics = o.optics;
     bake::RefractionBake baked = bake::bakeRefraction(*context, *renderer, bakePose, settings);
@@ -287,16 +416,17 @@ int runRender(const Args& args) {
     std::printf("baked the refraction map at %g s: %s\n", t, bake::describe(baked, scene).c_str());
   }
 
+  // Coverage (EXR alpha) comes from the trace's AOV, so an EXR trace asks for it.
+  const bool traced = !render::drawsComposite(*o.method) && *o.method != render::Method::DriverRt;
+  const bool wantAov = o.exr() && traced;
+  io::Progress progress("frames", frames.size(), quiet());
   auto start = std::chrono::steady_clock::now();
   for (size_t i = 0; i < frames.size(); ++i) {
     scene::Pose pose = i == 0 ? layout : scene::evaluate(scene, frames[i].second);
-    scene::View view;
-    try {
-      view = scene::resolveView(scene, pose, o.shot.view);
-    } catch (const std::invalid_argument& e) {
-      throw UsageError{std::string("render: ") + e.what()};
-    }
-    LinearImage image{o.shot.width, o.shot.height, {}};
+    scene::View view = o.shot.resolveView("render", scene, pose);
+    io::LinearImage image{o.shot.width, o.shot.height, {}, {}};
+    io::ImageExtras extras;
+    if (o.exr()) extras = exrExtras(o, scene, view, frames[i].second, device);
     if (o.reference) {
       ref::ReferenceSettings settings;
       settings.width = o.shot.width;
@@ -308,31 +438,54 @@ int runRender(const Args& args) {
       ref::ReferenceImage r = ref::renderReference(scene, pose, settings);
       image.rgba.reserve(r.color.size());
       for (const glm::dvec3& c : r.color) image.rgba.emplace_back(glm::vec3(c), 1.0f);
+      if (o.exr()) {
+        extras.aovs = aovLayers(o, scene, pose, view, image, [&](size_t p) {
+          bool hit = r.instance[p] >= 0;
+          return PixelHit{hit ? r.distance[p] : -1.0, hit ? uint32_t(r.instance[p]) : gpu::kNoHit,
+                          hit ? uint32_t(r.primitive[p]) : gpu::kNoHit, uint32_t(r.interfaces[p]), 0u};
+        });
+      }
     } else {
       render::FrameSettings settings{o.shot.width, o.shot.height, view, o.shot.background, o.shot.maxInterfaces};
       settings.optics = o.optics;
+      if (o.exr()) settings.backgroundAlpha = 0.0f;  // a composite's coverage: the raster clears alpha to 0
       render::RasterOptions raster = o.raster;
       glm::dvec3 lo, hi;
       scene::sceneBounds(scene, pose, lo, hi);
       render::fitDepthRange(view, lo, hi, raster);
       render::ViewRequest request = render::methodView(*o.method, settings, raster);
       request.readback = true;
+      request.halfReadback = true;
+      request.aov = request.aov || wantAov;
       render::FrameRequest frame;
       frame.pose = &pose;
       frame.views.push_back(request);
       const render::FrameResult& result = renderer->wait(renderer->submit(frame));
       const render::ViewPixels& pixels = result.views.at(0);
-      image.rgba = render::drawsComposite(*o.method) ? pixels.composite : pixels.trace;
+      image.rgbaHalf = render::drawsComposite(*o.method) ? pixels.compositeHalf : pixels.traceHalf;
+      if (wantAov) {
+        const std::vector<gpu::TraceAov>& aov = pixels.aov;
+        extras.aovs = aovLayers(o, scene, pose, view, image, [&](size_t p) {
+          const gpu::TraceAov& a = aov[p];
+          return PixelHit{a.instance == gpu::kNoHit ? -1.0 : double(a.distance), a.instance, a.primitive, a.interfaces,
+                          a.nodeVisits};
+        });
+      }
       if (o.stats) printStats(frames[i].first, result.stats, result.passes);
     }
     std::string path = o.frames ? framePath(o.output, frames[i].first) : o.output;
-    writeImage(path, image);
+    io::writeImage(path, image, extras);
     double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     if (frames.size() > 1) {
-      progress(long(i + 1), long(frames.size()), seconds);
+      progress.update(i + 1, path);
     } else {
       std::printf("wrote %s: %ux%u, %s, %s, %.2f s\n", path.c_str(), o.shot.width, o.shot.height, view.description.c_str(),
-                  o.reference ? "CPU reference" : context->facts().name.c_str(), seconds);
+                  device.c_str(), seconds);
+      if (!o.aovs.empty()) {
+        std::string layers;
+        for (const io::AovLayer& l : extras.aovs) layers += (layers.empty() ? "" : ", ") + l.layer;
+        std::printf("  AOV layers: %s\n", layers.c_str());
+      }
       if (!o.reference) {
         for (const render::MethodInfo& m : render::methods()) {
           if (m.method == *o.method) std::printf("  method %s: %s\n", m.name, m.summary);
@@ -340,12 +493,21 @@ int runRender(const Args& args) {
       }
     }
   }
-  if (context && context->validationMessageCount() > 0) {
-    std::fprintf(stderr, "snell: the validation layer reported %llu message(s)\n",
-                 static_cast<unsigned long long>(context->validationMessageCount()));
-    return 1;
-  }
-  return 0;
+  return context ? validationExitCode(*context) : kExitOk;
+}
+
+}  // namespace
+
+void addRender(CLI::App& parent, Runner& run) {
+  auto o = std::make_shared<Options>();
+  CLI::App* render = parent.add_subcommand("render", "ray trace a frame (or frames) to PNG or EXR");
+  describe(*render, kDescription);
+  render->footer(kHelpFooter);
+  addOptions(*render, *o);
+  render->callback([o, &run] {
+    check(*o);
+    run = [o] { return runRender(*o); };
+  });
 }
 
 }  // namespace snell::cli

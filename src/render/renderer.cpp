@@ -75,7 +75,7 @@ struct Renderer::Slot {
   struct ViewReadback {
     size_t view = 0;
     uint32_t width = 0, height = 0;
-    bool composite = false, aov = false;
+    bool composite = false, aov = false, half = false;
     vk::Buffer pixels;  ///< trace image, then composite, then AOV
   };
   std::vector<ViewReadback> readbacks;
@@ -657,6 +657,7 @@ void Renderer::recordView(vk::Commands& commands, Slot& slot, size_t index, cons
   rb.height = settings.height;
   rb.composite = request.output == ViewOutput::Composite;
   rb.aov = request.aov;
+  rb.half = request.halfReadback;
   VkDeviceSize pixels = VkDeviceSize(settings.width) * settings.height;
   VkDeviceSize bytes = pixels * 8 * (rb.composite ? 2 : 1) + (rb.aov ? pixels * sizeof(gpu::TraceAov) : 0);
   rb.pixels = vk::Buffer(context_, {bytes, VK_BUFFER_USAGE_TRANSFER_DST_BIT, vk::MemoryDomain::Readback,
@@ -845,8 +846,14 @@ void Renderer::collect(Slot& slot) {
     v.height = rb.height;
     size_t pixels = size_t(rb.width) * rb.height;
     const std::byte* bytes = rb.pixels.mapped().data();
-    v.trace = unpackHalves(bytes, pixels);
-    if (rb.composite) v.composite = unpackHalves(bytes + pixels * 8, pixels);
+    if (rb.half) {
+      const auto* halves = reinterpret_cast<const uint16_t*>(bytes);
+      v.traceHalf.assign(halves, halves + 4 * pixels);
+      if (rb.composite) v.compositeHalf.assign(halves + 4 * pixels, halves + 8 * pixels);
+    } else {
+      v.trace = unpackHalves(bytes, pixels);
+      if (rb.composite) v.composite = unpackHalves(bytes + pixels * 8, pixels);
+    }
     if (rb.aov) {
       v.aov.resize(pixels);
       std::memcpy(v.aov.data(), bytes + pixels * 8 * (rb.composite ? 2 : 1), pixels * sizeof(gpu::TraceAov));

@@ -59,6 +59,9 @@ struct ViewRequest {
   bool driverTrace = false;
   bool aov = false;       ///< per-pixel gpu::TraceAov of the traced pixels
   bool readback = false;  ///< bring the images (and AOV) back with the frame
+  /// With readback: keep the images as the GPU's half floats (ViewPixels::*Half),
+  /// for writers that convert them once, straight to the file's encoding.
+  bool halfReadback = false;
 };
 
 /// What one frame did and skipped.
@@ -85,6 +88,8 @@ struct ViewPixels {
   std::vector<glm::vec4> trace;      ///< the trace image, linear RGBA, row 0 at the top
   std::vector<glm::vec4> composite;  ///< composite views
   std::vector<gpu::TraceAov> aov;    ///< when asked for
+  /// ViewRequest::halfReadback: the same images as 4 IEEE halves per pixel (then trace and composite stay empty).
+  std::vector<uint16_t> traceHalf, compositeHalf;
 };
 
 struct FrameResult {

@@ -7,6 +7,9 @@
 #include <tiny_gltf.h>
 #include <stb/stb_image_write.h>
 
+// Debian's libstb exports stb's deflate but its header declares it only in the implementation part.
+extern "C" unsigned char* stbi_zlib_compress(unsigned char* data, int data_len, int* out_len, int quality);
+
 #include <glm/gtc/type_ptr.hpp>
 
 #include <algorithm>
@@ -14,6 +17,7 @@
 #include <cmath>
 #include <map>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <stdexcept>
@@ -121,25 +125,38 @@ std::vector<uint8_t> encodePng(uint32_t width, uint32_t height, const std::vecto
 
 std::vector<uint8_t> encodePng16(uint32_t width, uint32_t height, const std::vector<uint16_t>& rgba) {
   if (rgba.size() != size_t(width) * height * 4) throw std::invalid_argument("encodePng16: pixels do not fill the image");
-  std::vector<uint8_t> raw;  // filter byte 0, then the row, big-endian samples
-  raw.reserve(size_t(height) * (size_t(width) * 8 + 1));
+  // Each row big-endian, then filtered as PNG allows (none, sub or up: the
+  // one with the smallest sum, as stb and libpng choose), then deflated.
+  const size_t rowBytes = size_t(width) * 8;
+  std::vector<uint8_t> previous(rowBytes, 0), row(rowBytes), best, candidate(rowBytes);
+  std::vector<uint8_t> raw;
+  raw.reserve(size_t(height) * (rowBytes + 1));
   for (uint32_t y = 0; y < height; ++y) {
-    raw.push_back(0);
-    for (size_t i = size_t(y) * width * 4; i < size_t(y + 1) * width * 4; ++i) {
-      raw.push_back(uint8_t(rgba[i] >> 8));
-      raw.push_back(uint8_t(rgba[i]));
+    for (size_t i = 0; i < size_t(width) * 4; ++i) {
+      uint16_t v = rgba[size_t(y) * width * 4 + i];
+      row[2 * i] = uint8_t(v >> 8);
+      row[2 * i + 1] = uint8_t(v);
     }
+    uint8_t bestFilter = 0;
+    uint64_t bestSum = UINT64_MAX;
+    for (uint8_t filter = 0; filter < 3; ++filter) {
+      uint64_t sum = 0;
+      for (size_t i = 0; i < rowBytes; ++i) {
+        uint8_t left = i >= 8 ? row[i - 8] : 0;
+        candidate[i] = uint8_t(row[i] - (filter == 1 ? left : filter == 2 ? previous[i] : 0));
+        sum += uint64_t(std::abs(int(int8_t(candidate[i]))));
+      }
+      if (sum < bestSum) bestSum = sum, bestFilter = filter, best = candidate;
+    }
+    raw.push_back(bestFilter);
+    raw.insert(raw.end(), best.begin(), best.end());
+    std::swap(previous, row);
   }
-  std::vector<uint8_t> zlib = {0x78, 0x01};
-  for (size_t at = 0; at < raw.size(); at += 65535) {
-    size_t n = std::min<size_t>(65535, raw.size() - at);
-    zlib.push_back(at + n >= raw.size() ? 1 : 0);  // stored block
-    zlib.insert(zlib.end(), {uint8_t(n), uint8_t(n >> 8), uint8_t(~n), uint8_t((~n) >> 8)});
-    zlib.insert(zlib.end(), raw.begin() + std::ptrdiff_t(at), raw.begin() + std::ptrdiff_t(at + n));
-  }
-  uint32_t a = 1, b = 0;
-  for (uint8_t c : raw) a = (a + c) % 65521, b = (b + a) % 65521;
-  putBigEndian(zlib, (b << 16) | a);
+  int zlibBytes = 0;
+  unsigned char* deflated = stbi_zlib_compress(raw.data(), int(raw.size()), &zlibBytes, stbi_write_png_compression_level);
+  if (!deflated) throw std::runtime_error("encodePng16: stb could not deflate a " + std::to_string(width) + "x" + std::to_string(height) + " image");
+  std::vector<uint8_t> zlib(deflated, deflated + zlibBytes);
+  std::free(deflated);
   std::vector<uint8_t> png = {0x89, 'P', 'N', 'G', 0x0D, 0x0A, 0x1A, 0x0A};
   std::vector<uint8_t> header;
   putBigEndian(header, width);
@@ -151,7 +168,13 @@ std::vector<uint8_t> encodePng16(uint32_t width, uint32_t height, const std::vec
   return png;
 }
 
-void saveGlb(const Scene& scene, const std::string& path) {
+void saveGltf(const Scene& scene, const std::string& path) {
+  std::string ext = std::filesystem::path(path).extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+  if (ext != ".glb" && ext != ".gltf") {
+    throw SceneError(path + ": a scene is written as .glb (binary) or .gltf (JSON and a .bin beside it), not '" + ext + "'");
+  }
+  const bool binary = ext == ".glb";
   tinygltf::Model model;
   model.asset.version = "2.0";
   model.asset.generator = "snell";
@@ -357,18 +380,32 @@ void saveGlb(const Scene& scene, const std::string& path) {
   model.extensionsUsed = used;
   model.buffers[0].name = "snell";
 
-  std::string temporary = path + ".partial";
-  tinygltf::TinyGLTF writer;
-  if (!writer.WriteGltfSceneToFile(&model, temporary, true, true, false, true)) {
-    std::filesystem::remove(temporary);
-    throw SceneError(path + ": could not write the file");
-  }
+  // Everything is written into a folder beside the target and renamed into
+  // place, so a failure leaves neither a half file nor a .gltf without its .bin.
+  std::filesystem::path target(path);
+  std::filesystem::path dir = target.has_parent_path() ? target.parent_path() : std::filesystem::path(".");
+  std::filesystem::path staging = dir / ("." + target.filename().string() + ".partial");
   std::error_code error;
-  std::filesystem::rename(temporary, path, error);
-  if (error) {
-    std::filesystem::remove(temporary);
-    throw SceneError(path + ": could not write the file: " + error.message());
+  std::filesystem::remove_all(staging, error);
+  std::filesystem::create_directory(staging, error);
+  if (error) throw SceneError(path + ": could not write the file: " + error.message());
+  std::vector<std::string> written = {target.filename().string()};
+  if (!binary) {
+    // The buffer goes beside the JSON, named after it; the .gltf refers to it by name.
+    model.buffers[0].uri = target.stem().string() + ".bin";
+    written.push_back(model.buffers[0].uri);
   }
+  tinygltf::TinyGLTF writer;
+  bool wrote = writer.WriteGltfSceneToFile(&model, (staging / target.filename()).string(), binary, binary, !binary, binary);
+  // The .bin first: a .gltf never appears before the buffer it names.
+  for (auto name = written.rbegin(); wrote && name != written.rend(); ++name) {
+    std::filesystem::rename(staging / *name, dir / *name, error);
+    if (error) break;
+  }
+  std::error_code ignored;
+  std::filesystem::remove_all(staging, ignored);
+  if (!wrote) throw SceneError(path + ": could not write the file");
+  if (error) throw SceneError(path + ": could not write the file: " + error.message());
 }
 
 }  // namespace snell::scene

@@ -1,4 +1,4 @@
-// Scene to glTF 2.0 binary (.glb): what `snell eye` writes, and later bakes.
+// Scene to glTF 2.0, binary (.glb) or JSON with its buffer beside it (.gltf): what `snell eye` writes.
 #pragma once
 
 #include "scene/scene.h"
@@ -9,16 +9,17 @@
 
 namespace snell::scene {
 
-/// Writes the scene as one self-contained .glb: geometry, morph targets,
-/// skins, materials (with the transmission/IOR/volume extensions), textures as
-/// PNG, cameras, punctual lights and animations. Writes to a temporary file and
-/// renames it, so a failure never leaves a half-written file; throws SceneError.
-void saveGlb(const Scene& scene, const std::string& path);
+/// Writes the scene as the extension says: one self-contained .glb, or a .gltf
+/// (JSON) with NAME.bin beside it. Geometry, morph targets, skins, materials
+/// (with the transmission/IOR/volume extensions), textures as PNG inside the
+/// buffer, cameras, punctual lights and animations. Writes into a temporary
+/// folder and renames, so a failure never leaves a half-written file; throws
+/// SceneError (also for any other extension).
+void saveGltf(const Scene& scene, const std::string& path);
 
 /// An RGBA8 image as a PNG file's bytes (stb's encoder: filtered and deflated).
 std::vector<uint8_t> encodePng(uint32_t width, uint32_t height, const std::vector<uint8_t>& rgba);
-/// A 16-bit RGBA image as a PNG file's bytes (stored deflate: exact; no
-/// Debian-packaged encoder at hand compresses 16-bit samples).
+/// A 16-bit RGBA image as a PNG file's bytes (filtered per row and deflated by stb).
 std::vector<uint8_t> encodePng16(uint32_t width, uint32_t height, const std::vector<uint16_t>& rgba);
 
 }  // namespace snell::scene

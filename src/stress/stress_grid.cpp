@@ -1,6 +1,6 @@
 // The stability grid: which cases, and how one case is rendered twice (GPU,
 // CPU reference) and compared.
-#include "cli/image_file.h"
+#include "io/image_file.h"
 #include "ref/reference_tracer.h"
 #include "render/renderer.h"
 #include "stress/stress.h"
@@ -387,7 +387,7 @@ Result run(vk::Context& context, const Case& c) {
         if (!std::isfinite(g.r) || !std::isfinite(g.g) || !std::isfinite(g.b) || !std::isfinite(g.a)) ++r.nanCount;
         int worst = 0;
         for (int k = 0; k < 3; ++k) {
-          int e = std::abs(int(cli::linearToSrgb8(g[k])) - int(cli::linearToSrgb8(float(cpu.color[i][k]))));
+          int e = std::abs(int(io::linearToSrgb8(g[k])) - int(io::linearToSrgb8(float(cpu.color[i][k]))));
           worst = std::max(worst, e);
           sum += e;
         }

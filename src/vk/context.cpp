@@ -167,6 +167,18 @@ std::unique_ptr<Context> Context::create(const ContextDesc& desc) {
     info.pfnUserCallback = &Context::onDebugMessage;
     info.pUserData = &c;
     if (createMessenger) VK_CHECK(createMessenger(c.instance_, &info, nullptr, &c.messenger_));
+    // SNELL_FAULT=validation-message: one message through the layer's own
+    // channel, so tests see each command fail the way a real one would make it.
+    const char* fault = std::getenv("SNELL_FAULT");
+    auto submit = reinterpret_cast<PFN_vkSubmitDebugUtilsMessageEXT>(
+        vkGetInstanceProcAddr(c.instance_, "vkSubmitDebugUtilsMessageEXT"));
+    if (c.messenger_ && submit && fault && std::string(fault) == kFaultValidationMessage) {
+      VkDebugUtilsMessengerCallbackDataEXT message{VK_STRUCTURE_TYPE_DEBUG_UTILS_MESSENGER_CALLBACK_DATA_EXT};
+      message.pMessageIdName = "snell-fault";
+      message.pMessage = "SNELL_FAULT=validation-message: a validation message injected for a test";
+      submit(c.instance_, VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT, VK_DEBUG_UTILS_MESSAGE_TYPE_VALIDATION_BIT_EXT,
+             &message);
+    }
   }
 
   std::vector<VkPhysicalDevice> handles;

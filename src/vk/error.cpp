@@ -80,12 +80,19 @@ VkResult resultFromName(const std::string& name) {
   return VK_SUCCESS;
 }
 
+}  // namespace
+
+const char* const kFaultValidationMessage = "validation-message";
+
+namespace {
+
 // Read once: the setting belongs to the process, as SNELL_DEVICE does.
 FaultSwitch& faultSwitch() {
   static FaultSwitch* instance = [] {
     auto* f = new FaultSwitch;  // never freed: calls may come from static destructors
     const char* setting = std::getenv("SNELL_FAULT");
-    if (!setting || !*setting) return f;
+    // "validation-message" is the context's to act on (context.cpp), not a call's.
+    if (!setting || !*setting || std::string(setting) == kFaultValidationMessage) return f;
     std::string text(setting);
     size_t first = text.find(':');
     size_t second = first == std::string::npos ? first : text.find(':', first + 1);
@@ -93,7 +100,8 @@ FaultSwitch& faultSwitch() {
     std::string result = first == std::string::npos ? "" : text.substr(first + 1, second - first - 1);
     f->result = resultFromName(result);
     if (call.rfind("vk", 0) != 0 || f->result >= 0) {
-      throw VulkanError("SNELL_FAULT=" + text + ": expected vkCALL:VK_ERROR_...[:N], e.g. vkQueueSubmit:VK_ERROR_DEVICE_LOST");
+      throw VulkanError("SNELL_FAULT=" + text + ": expected vkCALL:VK_ERROR_...[:N], e.g. vkQueueSubmit:VK_ERROR_DEVICE_LOST, or " +
+                        kFaultValidationMessage);
     }
     if (second != std::string::npos) {
       char* end = nullptr;

@@ -2,14 +2,16 @@
 // decoder, EXR through OpenImageIO where the build has it; the rename makes
 // every write all-or-nothing. Without OpenImageIO the binary carries to a
 // machine that has only the Vulkan loader (the GPU benchmarks do that).
-#include "cli/image_file.h"
+#include "io/image_file.h"
 
+#include "io/json.h"
 #include "scene/gltf_writer.h"
 #include "scene/scene.h"
 
 #if SNELL_WITH_OPENIMAGEIO
 #include <OpenImageIO/imageio.h>
 #endif
+#include <glm/gtc/packing.hpp>
 #include <tiny_gltf.h>
 
 #include <fstream>
@@ -24,7 +26,7 @@
 #include <fcntl.h>
 #include <unistd.h>
 
-namespace snell::cli {
+namespace snell::io {
 
 namespace fs = std::filesystem;
 
@@ -34,8 +36,24 @@ uint8_t linearToSrgb8(float linear) {
   return static_cast<uint8_t>(std::lround(s * 255.0f));
 }
 
+float LinearImage::channel(size_t i, int c) const {
+  return rgba.empty() ? glm::unpackHalf1x16(rgbaHalf[4 * i + size_t(c)]) : rgba[i][c];
+}
+
 Rgb8Image toSrgb8(const LinearImage& image) {
-  Rgb8Image out{image.width, image.height, std::vector<uint8_t>(size_t(image.width) * image.height * 3)};
+  Rgb8Image out{image.width, image.height, std::vector<uint8_t>(image.pixels() * 3)};
+  if (image.rgba.empty()) {
+    // Every half maps straight to its byte: one table, one conversion per sample.
+    static const std::vector<uint8_t> halfToSrgb = [] {
+      std::vector<uint8_t> table(65536);
+      for (uint32_t h = 0; h < 65536; ++h) table[h] = linearToSrgb8(glm::unpackHalf1x16(uint16_t(h)));
+      return table;
+    }();
+    for (size_t i = 0; i < image.pixels(); ++i) {
+      for (int c = 0; c < 3; ++c) out.rgb[3 * i + size_t(c)] = halfToSrgb[image.rgbaHalf[4 * i + size_t(c)]];
+    }
+    return out;
+  }
   for (size_t i = 0; i < image.rgba.size(); ++i) {
     for (int c = 0; c < 3; ++c) out.rgb[3 * i + size_t(c)] = linearToSrgb8(image.rgba[i][c]);
   }
@@ -91,28 +109,94 @@ std::vector<uint8_t> pngBytes(uint32_t width, uint32_t height, const std::vector
 
 }  // namespace
 
-void writeImage(const std::string& path, const LinearImage& image) {
+#if SNELL_WITH_OPENIMAGEIO
+namespace {
+
+// One EXR part: R, G, B, A then each AOV layer's channels, every channel in
+// its own type (half or float colour, float or uint AOVs), so ids stay exact.
+void writeExr(const std::string& path, const std::string& temp, const LinearImage& image, const ImageExtras& extras) {
+  const OIIO::TypeDesc colourType = extras.floatPixels ? OIIO::TypeDesc::FLOAT : OIIO::TypeDesc::HALF;
+  std::vector<OIIO::TypeDesc> formats(4, colourType);
+  std::vector<std::string> names = {"R", "G", "B", "A"};
+  for (const AovLayer& layer : extras.aovs) {
+    size_t expected = image.pixels() * layer.channels.size();
+    if ((layer.integer ? layer.ids.size() : layer.values.size()) != expected) {
+      throw std::runtime_error(path + ": the " + layer.layer + " layer does not fill the image");
+    }
+    for (const std::string& c : layer.channels) {
+      names.push_back(layer.layer + "." + c);
+      formats.push_back(layer.integer ? OIIO::TypeDesc::UINT : extras.floatPixels ? OIIO::TypeDesc::FLOAT : OIIO::TypeDesc::HALF);
+    }
+  }
+  // The pixels packed as the file holds them, so OpenImageIO converts nothing.
+  size_t pixelBytes = 0;
+  for (const OIIO::TypeDesc& f : formats) pixelBytes += f.size();
+  std::vector<std::byte> packed(pixelBytes * image.pixels());
+  for (size_t i = 0; i < image.pixels(); ++i) {
+    std::byte* at = packed.data() + i * pixelBytes;
+    for (int c = 0; c < 4; ++c) {
+      if (extras.floatPixels) {
+        float v = image.channel(i, c);
+        std::memcpy(at, &v, 4), at += 4;
+      } else {
+        uint16_t h = image.rgba.empty() ? image.rgbaHalf[4 * i + size_t(c)] : glm::packHalf1x16(image.rgba[i][c]);
+        std::memcpy(at, &h, 2), at += 2;
+      }
+    }
+    for (const AovLayer& layer : extras.aovs) {
+      for (size_t c = 0; c < layer.channels.size(); ++c) {
+        size_t k = i * layer.channels.size() + c;
+        if (layer.integer) {
+          std::memcpy(at, &layer.ids[k], 4), at += 4;
+        } else if (extras.floatPixels) {
+          std::memcpy(at, &layer.values[k], 4), at += 4;
+        } else {
+          uint16_t h = glm::packHalf1x16(layer.values[k]);
+          std::memcpy(at, &h, 2), at += 2;
+        }
+      }
+    }
+  }
+  OIIO::ImageSpec spec(int(image.width), int(image.height), int(names.size()), colourType);
+  spec.channelnames = names;
+  spec.channelformats = formats;
+  spec.alpha_channel = 3;
+  spec.attribute("oiio:ColorSpace", "Linear");
+  spec.attribute("compression", "zip");
+  spec.attribute("Software", std::string("snell ") + version());
+  for (const auto& [name, value] : extras.text) spec.attribute(name, value);
+  for (const auto& [name, value] : extras.numbers) spec.attribute(name, value);
+  if (extras.hasWorldToCamera) spec.attribute("worldToCamera", OIIO::TypeMatrix, &extras.worldToCamera);
+  auto out = OIIO::ImageOutput::create(temp);
+  if (!out) throw std::runtime_error(path + ": cannot write EXR (" + OIIO::geterror() + ")");
+  if (!out->open(temp, spec) || !out->write_image(OIIO::TypeDesc::UNKNOWN, packed.data()) || !out->close()) {
+    throw std::runtime_error(path + ": " + out->geterror());
+  }
+}
+
+}  // namespace
+#endif
+
+void writeImage(const std::string& path, const LinearImage& image, const ImageExtras& extras) {
   std::string ext = lowerExtension(path);
   if (ext != ".png" && ext != ".exr") {
     throw std::runtime_error(path + ": unsupported image type '" + ext + "' (use .png or .exr)");
   }
+  if (ext == ".png" && !extras.aovs.empty()) throw std::runtime_error(path + ": AOV layers need an .exr file");
 #if !SNELL_WITH_OPENIMAGEIO
   if (ext == ".exr") throw std::runtime_error(path + ": this build has no OpenImageIO, so no EXR; write a .png");
 #endif
+  if ((image.rgba.empty() ? image.rgbaHalf.size() / 4 : image.rgba.size()) != image.pixels()) {
+    throw std::runtime_error(path + ": the pixels do not fill a " + std::to_string(image.width) + "x" +
+                             std::to_string(image.height) + " image");
+  }
   writeAtomically(path, [&](const std::string& temp) {
     if (ext == ".png") {
       writeBytes(path, temp, pngBytes(image.width, image.height, toSrgb8(image).rgb));
       return;
     }
 #if SNELL_WITH_OPENIMAGEIO
-    OIIO::ImageSpec spec(int(image.width), int(image.height), 4, OIIO::TypeDesc::HALF);
-    spec.attribute("oiio:ColorSpace", "Linear");
-    spec.attribute("compression", "zip");
-    auto out = OIIO::ImageOutput::create(temp);
-    if (!out) throw std::runtime_error(path + ": cannot write EXR (" + OIIO::geterror() + ")");
-    if (!out->open(temp, spec) || !out->write_image(OIIO::TypeDesc::FLOAT, image.rgba.data()) || !out->close()) {
-      throw std::runtime_error(path + ": " + out->geterror());
-    }
+    writeExr(path, temp, image, extras);
 #endif
   });
 }
@@ -315,4 +399,4 @@ void writeTextFile(const std::string& path, const std::string& text) {
   });
 }
 
-}  // namespace snell::cli
+}  // namespace snell::io

@@ -1,5 +1,6 @@
-// Image files through OpenImageIO: PNG (8-bit sRGB) and EXR (half, linear),
-// written atomically so a failed or interrupted write leaves nothing behind.
+// Image files: PNG (8-bit sRGB, deflated) and EXR through OpenImageIO (linear
+// half or float, alpha = coverage, metadata, AOV layers), written atomically so
+// a failed or interrupted write leaves nothing behind.
 #pragma once
 
 #include "bake/refraction_bake.h"
@@ -11,11 +12,41 @@
 #include <string>
 #include <vector>
 
-namespace snell::cli {
+namespace snell::io {
 
+/// Linear RGBA, row 0 at the top: as floats, or as the GPU's half floats read
+/// back as they are (then converted once, where the file is encoded).
 struct LinearImage {
   uint32_t width = 0, height = 0;
-  std::vector<glm::vec4> rgba;  ///< linear, row 0 at the top
+  std::vector<glm::vec4> rgba;
+  std::vector<uint16_t> rgbaHalf;  ///< used when rgba is empty: 4 IEEE halves per pixel
+
+  size_t pixels() const { return size_t(width) * height; }
+  /// Pixel i's channel c, whichever way the image is held.
+  float channel(size_t i, int c) const;
+};
+
+/// Extra channels for an EXR, named the way compositors read layers:
+/// LAYER.CHANNEL (depth.Z, normal.X, instance.id).
+struct AovLayer {
+  std::string layer;
+  std::vector<std::string> channels;
+  bool integer = false;         ///< 32-bit unsigned (ids, counts) rather than float
+  std::vector<float> values;    ///< float layers: pixels * channels, interleaved
+  std::vector<uint32_t> ids;    ///< integer layers: the same
+};
+
+/// What an EXR carries beyond its colour; a PNG takes none of it.
+struct ImageExtras {
+  bool floatPixels = false;  ///< RGBA (and float AOVs) as 32-bit float rather than half
+  std::vector<AovLayer> aovs;
+  /// Header attributes: "snell:camera" and the like, strings...
+  std::vector<std::pair<std::string, std::string>> text;
+  /// ...and numbers ("snell:time").
+  std::vector<std::pair<std::string, float>> numbers;
+  /// The standard EXR worldToCamera matrix, when the camera is known.
+  bool hasWorldToCamera = false;
+  glm::mat4 worldToCamera{1.0f};
 };
 
 /// Encodes linear [0, 1] to 8-bit sRGB, rounding to nearest.
@@ -24,7 +55,8 @@ uint8_t linearToSrgb8(float linear);
 /// Writes `image` to `path` (format from the extension: .png or .exr): into a
 /// temporary file beside it, renamed into place once complete. Throws
 /// std::runtime_error naming the file and the problem; leaves no file then.
-void writeImage(const std::string& path, const LinearImage& image);
+/// PNG ignores alpha (8-bit sRGB, opaque); EXR keeps it.
+void writeImage(const std::string& path, const LinearImage& image, const ImageExtras& extras = {});
 
 /// Writes a refraction map file as `encoding` asks (rg16 and sky8: PNG,
 /// 16-bit and 8-bit RGBA; exr: float RGBA), complete or not at all. Throws
@@ -60,4 +92,4 @@ scene::Environment readEnvironment(const std::string& path);
 /// The image as 8-bit sRGB, as writeImage would put it in a PNG.
 Rgb8Image toSrgb8(const LinearImage& image);
 
-}  // namespace snell::cli
+}  // namespace snell::io

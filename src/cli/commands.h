@@ -1,0 +1,40 @@
+// The `snell` command's subcommands, one file each; main.cpp puts them
+// together. Each add function adds its subcommand's options to `parent` and,
+// once the command line has parsed, sets `run` to what runs it.
+#pragma once
+
+#include "cli/options.h"
+#include "io/environment.h"
+
+#include <string>
+#include <vector>
+
+namespace snell::cli {
+
+void addInfo(CLI::App& parent, Runner& run);
+void addEye(CLI::App& parent, Runner& run);
+void addRender(CLI::App& parent, Runner& run);
+void addBake(CLI::App& parent, Runner& run);
+void addExportWeb(CLI::App& parent, Runner& run);
+void addBenchSort(CLI::App& bench, Runner& run);
+void addBenchBvh(CLI::App& bench, Runner& run);
+void addBenchFrame(CLI::App& bench, Runner& run);
+void addBenchStress(CLI::App& bench, Runner& run);
+void addBenchScale(CLI::App& bench, Runner& run);
+void addBenchMethods(CLI::App& bench, Runner& run);
+
+/// The whole `snell` command line: every subcommand and the global options.
+/// `run` is set by whichever subcommand the parse picks.
+std::unique_ptr<CLI::App> makeSnellApp(Runner& run);
+
+/// The material `wanted` names (its name or index) that has a base colour
+/// texture, or a UsageError saying why there is none.
+uint32_t findTexturedMaterial(const std::string& command, const scene::Scene& scene, const std::string& wanted);
+
+/// `text` with &, <, > and " escaped for XML, SVG and HTML.
+std::string xmlEscape(const std::string& text);
+
+/// The median of `values` (0 when empty), for benchmark tables.
+double median(std::vector<double> values);
+
+}  // namespace snell::cli
