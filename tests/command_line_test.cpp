@@ -48,6 +48,14 @@ io::Json readJson(const std::string& path) {
   return io::Json::parse(in);  // throws on invalid JSON
 }
 
+void expectHead(const io::Json& j, const std::string& kind) {
+  EXPECT_EQ(j.at("schema"), "snell." + kind + "/1");
+  EXPECT_EQ(j.at("snell_version"), io::version());
+  EXPECT_FALSE(j.at("command_line").get<std::string>().empty());
+  EXPECT_FALSE(j.at("device").at("name").get<std::string>().empty()) << j.dump(2);
+  EXPECT_FALSE(j.at("device").at("driver").get<std::string>().empty());
+}
+
 // ---- exit codes and usage ---------------------------------------------------
 
 struct BadOption {
@@ -100,6 +108,13 @@ TEST(CommandLine, QuietPrintsNothingOnSuccess) {
                    shellQuoted(dir / "f.#.png") + " 2>&1 | grep -v -i lavapipe");
   EXPECT_EQ(run.output, "");
   EXPECT_TRUE(fs::exists(dir / "f.3.png"));
+}
+
+TEST(CommandLine, QuietKeepsTheJsonAskedForOnStandardOutput) {
+  CommandRun run = snellStdout("--quiet info --devices --json -");
+  EXPECT_EQ(run.exitCode, 0);
+  io::Json j = io::Json::parse(run.output);  // the JSON alone: no table, no notes
+  expectHead(j, "info");
 }
 
 TEST(CommandLine, HelpListsTheExitCodesAndExitsZero) {
@@ -156,13 +171,6 @@ std::string awkwardScene(const TempFolder& dir) {
   return path;
 }
 
-void expectHead(const io::Json& j, const std::string& kind) {
-  EXPECT_EQ(j.at("schema"), "snell." + kind + "/1");
-  EXPECT_EQ(j.at("snell_version"), io::version());
-  EXPECT_FALSE(j.at("command_line").get<std::string>().empty());
-  EXPECT_FALSE(j.at("device").at("name").get<std::string>().empty()) << j.dump(2);
-  EXPECT_FALSE(j.at("device").at("driver").get<std::string>().empty());
-}
 
 struct JsonCommand {
   const char* kind;

@@ -28,6 +28,7 @@ environment:
 namespace {
 
 bool quietFlag = false;
+std::FILE* askedForOutput = nullptr;  // the real standard output, kept when --quiet hides it
 
 std::string programName(const CLI::App& app) {
   const CLI::App* root = &app;
@@ -74,6 +75,8 @@ void useSnellHelpFormat(CLI::App& app) {
 
 bool quiet() { return quietFlag; }
 
+std::FILE* askedOutput() { return askedForOutput ? askedForOutput : stdout; }
+
 void note(const std::string& text) {
   if (!quietFlag) std::fprintf(stderr, "snell: note: %s\n", text.c_str());
 }
@@ -94,6 +97,7 @@ void addGlobalOptions(CLI::App& app) {
         // Nothing on standard output: every "wrote ..." line and table goes;
         // errors, on standard error, stay.
         std::fflush(stdout);
+        if (!askedForOutput) askedForOutput = ::fdopen(::dup(STDOUT_FILENO), "w");
         int null = ::open("/dev/null", O_WRONLY);
         if (null >= 0) {
           ::dup2(null, STDOUT_FILENO);

@@ -34,7 +34,8 @@ struct Options {
 // Where --json goes: standard output for "-", else a file written whole.
 void writeReport(const std::string& where, const io::Json& json) {
   if (where == "-") {
-    std::fputs(io::jsonText(json).c_str(), stdout);
+    std::fputs(io::jsonText(json).c_str(), askedOutput());
+    std::fflush(askedOutput());
   } else {
     io::writeJson(where, json);
   }

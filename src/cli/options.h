@@ -14,6 +14,7 @@
 #include <glm/glm.hpp>
 
 #include <cstdint>
+#include <cstdio>
 #include <functional>
 #include <memory>
 #include <string>
@@ -60,6 +61,9 @@ void parseOnly(CLI::App& app, const Args& args);
 void addGlobalOptions(CLI::App& app);
 /// Whether --quiet was given.
 bool quiet();
+/// Standard output as it was before --quiet hid it: for output the command line
+/// asked for by name (`--json -`), which --quiet does not silence.
+std::FILE* askedOutput();
 /// Prints a note to standard error unless --quiet ("PROGRAM: note: TEXT").
 void note(const std::string& text);
 
