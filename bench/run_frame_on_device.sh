@@ -24,6 +24,8 @@ OUT=${OUT:-/tmp/out}
 mkdir -p "$OUT"
 nvidia-smi --query-gpu=name,driver_version,clocks.sm,clocks.mem --format=csv
 step=${1:-all}
+# The tests that run the command find it where it was built.
+mkdir -p build/device && ln -sf "$PWD/.carry/snell" build/device/snell
 if [[ $step == all || $step == tests ]]; then
   echo "== tests on the GPU, validation on (not the ones that run the CLI, the viewer or node)"
   SNELL_VALIDATION=1 .carry/snell_tests --gtest_brief=1 \
