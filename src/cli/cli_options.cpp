@@ -206,14 +206,6 @@ CLI::Option* addSize(CLI::App& app, const std::string& name, uint32_t& width, ui
       ->type_name("WxH");
 }
 
-CLI::Option* addNumbers(CLI::App& app, const std::string& name, std::vector<double>& values, size_t count,
-                        const std::string& description) {
-  return app
-      .add_option_function<std::string>(
-          name, [&values, name, count](const std::string& v) { values = parseNumbers(name, v, count); }, description)
-      ->type_name(count == 1 ? "X" : count == 3 ? "X,Y,Z" : "N,N,...");
-}
-
 CLI::Option* addTextureBudget(CLI::App& app, uint64_t& bytes) {
   return app
       .add_option_function<uint64_t>(

@@ -72,8 +72,6 @@ const CLI::Validator& finite();
 
 /// Options whose values are parsed here, with errors naming the option.
 CLI::Option* addSize(CLI::App& app, const std::string& name, uint32_t& width, uint32_t& height, const std::string& description);
-CLI::Option* addNumbers(CLI::App& app, const std::string& name, std::vector<double>& values, size_t count,
-                        const std::string& description);
 CLI::Option* addTextureBudget(CLI::App& app, uint64_t& bytes);
 
 /// Parses WxH (each 1..65536) or throws UsageError naming the option.

@@ -127,26 +127,31 @@ class FaceNormals {
   FaceNormals(const scene::Scene& scene, const scene::Pose& pose) : scene_(scene), pose_(pose) {}
   glm::vec3 of(uint32_t item, uint32_t triangle) {
     if (item >= pose_.items.size()) return glm::vec3(0.0f);
-    auto [at, fresh] = positions_.try_emplace(item);
     const scene::DrawItem& drawn = pose_.items[item];
+    auto [at, fresh] = items_.try_emplace(item);
+    Deformed& d = at->second;
     if (fresh) {
       std::vector<glm::dvec3> normals;
-      scene::deformOnCpu(drawn, at->second, normals);
+      scene::deformOnCpu(drawn, d.positions, normals);
+      d.normalToWorld = glm::transpose(glm::inverse(glm::dmat3(drawn.world)));
     }
     const std::vector<uint32_t>& indices = scene_.shapes[size_t(drawn.shape)].indices;
     if (3 * size_t(triangle) + 2 >= indices.size()) return glm::vec3(0.0f);
-    const std::vector<glm::dvec3>& p = at->second;
+    const std::vector<glm::dvec3>& p = d.positions;
     glm::dvec3 a = p[indices[3 * triangle]], b = p[indices[3 * triangle + 1]], c = p[indices[3 * triangle + 2]];
-    glm::dmat3 toWorld = glm::transpose(glm::inverse(glm::dmat3(drawn.world)));
-    glm::dvec3 n = toWorld * glm::cross(b - a, c - a);
+    glm::dvec3 n = d.normalToWorld * glm::cross(b - a, c - a);
     double length = glm::length(n);
     return length > 0.0 ? glm::vec3(n / length) : glm::vec3(0.0f);
   }
 
  private:
+  struct Deformed {
+    std::vector<glm::dvec3> positions;
+    glm::dmat3 normalToWorld{1.0};
+  };
   const scene::Scene& scene_;
   const scene::Pose& pose_;
-  std::map<uint32_t, std::vector<glm::dvec3>> positions_;
+  std::map<uint32_t, Deformed> items_;
 };
 
 // What one pixel's trace found, from the GPU's AOV or the reference.
@@ -155,51 +160,46 @@ struct PixelHit {
   uint32_t instance, primitive, interfaces, cost;
 };
 
-// The layers --aov asked for, and alpha = coverage written into the image.
-template <typename HitAt>
+// Alpha = coverage written into the image, and the layers --aov asked for.
 std::vector<io::AovLayer> aovLayers(const Options& o, const scene::Scene& scene, const scene::Pose& pose,
-                                    const scene::View& view, io::LinearImage& image, HitAt hitAt) {
+                                    const scene::View& view, io::LinearImage& image, const std::vector<PixelHit>& hits) {
   const size_t pixels = image.pixels();
-  std::vector<io::AovLayer> layers;
-  auto layer = [&](const char* name, std::vector<std::string> channels, bool integer) -> io::AovLayer& {
-    io::AovLayer& l = layers.emplace_back();
-    l.layer = name;
-    l.integer = integer;
-    if (integer) l.ids.resize(pixels * channels.size());
-    else l.values.resize(pixels * channels.size());
-    l.channels = std::move(channels);
-    return l;
-  };
-  FaceNormals normals(scene, pose);
-  std::map<std::string, io::AovLayer*> wanted;
-  for (const std::string& name : kAovNames) {
-    if (!o.wants(name)) continue;
-    if (name == "depth") layer("depth", {"Z"}, false);
-    if (name == "normal") layer("normal", {"X", "Y", "Z"}, false);
-    if (name == "instance") layer("instance", {"id"}, true);
-    if (name == "primitive") layer("primitive", {"id"}, true);
-    if (name == "interfaces") layer("interfaces", {"count"}, true);
-    if (name == "cost") layer("cost", {"nodes"}, true);
-  }
-  for (io::AovLayer& l : layers) wanted[l.layer] = &l;
   const uint16_t one = glm::packHalf1x16(1.0f), zero = glm::packHalf1x16(0.0f);
   for (size_t i = 0; i < pixels; ++i) {
-    PixelHit hit = hitAt(i);
-    bool covered = hit.distance >= 0.0;
+    bool covered = hits[i].distance >= 0.0;
     if (image.rgba.empty()) image.rgbaHalf[4 * i + 3] = covered ? one : zero;
     else image.rgba[i].a = covered ? 1.0f : 0.0f;
-    if (auto l = wanted.find("depth"); l != wanted.end()) {
-      l->second->values[i] = covered ? float(depthOf(view, image.width, image.height, i, hit.distance))
-                                     : std::numeric_limits<float>::infinity();
+  }
+  std::vector<io::AovLayer> layers;
+  for (const std::string& name : kAovNames) {
+    if (!o.wants(name)) continue;
+    io::AovLayer& l = layers.emplace_back();
+    l.layer = name;
+    if (name == "depth") {
+      l.channels = {"Z"};
+      l.values.resize(pixels);
+      for (size_t i = 0; i < pixels; ++i) {
+        l.values[i] = hits[i].distance >= 0.0 ? float(depthOf(view, image.width, image.height, i, hits[i].distance))
+                                              : std::numeric_limits<float>::infinity();
+      }
+    } else if (name == "normal") {
+      FaceNormals normals(scene, pose);
+      l.channels = {"X", "Y", "Z"};
+      l.values.resize(3 * pixels);
+      for (size_t i = 0; i < pixels; ++i) {
+        glm::vec3 n = hits[i].distance >= 0.0 ? normals.of(hits[i].instance, hits[i].primitive) : glm::vec3(0.0f);
+        for (int c = 0; c < 3; ++c) l.values[3 * i + size_t(c)] = n[c];
+      }
+    } else {
+      uint32_t PixelHit::*field = name == "instance"   ? &PixelHit::instance
+                                  : name == "primitive"  ? &PixelHit::primitive
+                                  : name == "interfaces" ? &PixelHit::interfaces
+                                                         : &PixelHit::cost;
+      l.channels = {name == "interfaces" ? "count" : name == "cost" ? "nodes" : "id"};
+      l.integer = true;
+      l.ids.resize(pixels);
+      for (size_t i = 0; i < pixels; ++i) l.ids[i] = hits[i].*field;
     }
-    if (auto l = wanted.find("normal"); l != wanted.end()) {
-      glm::vec3 n = covered ? normals.of(hit.instance, hit.primitive) : glm::vec3(0.0f);
-      for (int c = 0; c < 3; ++c) l->second->values[3 * i + size_t(c)] = n[c];
-    }
-    if (auto l = wanted.find("instance"); l != wanted.end()) l->second->ids[i] = hit.instance;
-    if (auto l = wanted.find("primitive"); l != wanted.end()) l->second->ids[i] = hit.primitive;
-    if (auto l = wanted.find("interfaces"); l != wanted.end()) l->second->ids[i] = hit.interfaces;
-    if (auto l = wanted.find("cost"); l != wanted.end()) l->second->ids[i] = hit.cost;
   }
   return layers;
 }
@@ -439,11 +439,13 @@ int runRender(Options& o) {
       image.rgba.reserve(r.color.size());
       for (const glm::dvec3& c : r.color) image.rgba.emplace_back(glm::vec3(c), 1.0f);
       if (o.exr()) {
-        extras.aovs = aovLayers(o, scene, pose, view, image, [&](size_t p) {
+        std::vector<PixelHit> hits(image.pixels());
+        for (size_t p = 0; p < hits.size(); ++p) {
           bool hit = r.instance[p] >= 0;
-          return PixelHit{hit ? r.distance[p] : -1.0, hit ? uint32_t(r.instance[p]) : gpu::kNoHit,
-                          hit ? uint32_t(r.primitive[p]) : gpu::kNoHit, uint32_t(r.interfaces[p]), 0u};
-        });
+          hits[p] = {hit ? r.distance[p] : -1.0, hit ? uint32_t(r.instance[p]) : gpu::kNoHit,
+                     hit ? uint32_t(r.primitive[p]) : gpu::kNoHit, uint32_t(r.interfaces[p]), 0u};
+        }
+        extras.aovs = aovLayers(o, scene, pose, view, image, hits);
       }
     } else {
       render::FrameSettings settings{o.shot.width, o.shot.height, view, o.shot.background, o.shot.maxInterfaces};
@@ -464,12 +466,13 @@ int runRender(Options& o) {
       const render::ViewPixels& pixels = result.views.at(0);
       image.rgbaHalf = render::drawsComposite(*o.method) ? pixels.compositeHalf : pixels.traceHalf;
       if (wantAov) {
-        const std::vector<gpu::TraceAov>& aov = pixels.aov;
-        extras.aovs = aovLayers(o, scene, pose, view, image, [&](size_t p) {
-          const gpu::TraceAov& a = aov[p];
-          return PixelHit{a.instance == gpu::kNoHit ? -1.0 : double(a.distance), a.instance, a.primitive, a.interfaces,
-                          a.nodeVisits};
-        });
+        std::vector<PixelHit> hits(image.pixels());
+        for (size_t p = 0; p < hits.size(); ++p) {
+          const gpu::TraceAov& a = pixels.aov[p];
+          hits[p] = {a.instance == gpu::kNoHit ? -1.0 : double(a.distance), a.instance, a.primitive, a.interfaces,
+                     a.nodeVisits};
+        }
+        extras.aovs = aovLayers(o, scene, pose, view, image, hits);
       }
       if (o.stats) printStats(frames[i].first, result.stats, result.passes);
     }

@@ -8,6 +8,9 @@
 
 namespace snell::io {
 
+namespace {
+
+// "1 h 02 min", "3 min 05 s", "12.5 s": a duration as people read it.
 std::string readableSeconds(double seconds) {
   char text[48];
   if (!(seconds >= 0.0) || !std::isfinite(seconds)) return "?";
@@ -20,6 +23,8 @@ std::string readableSeconds(double seconds) {
   }
   return text;
 }
+
+}  // namespace
 
 Progress::Progress(std::string what, uint64_t total, bool quiet)
     : what_(std::move(what)), total_(total), quiet_(quiet), terminal_(::isatty(STDERR_FILENO) == 1),

@@ -16,8 +16,6 @@ class Progress {
   Progress(std::string what, uint64_t total, bool quiet);
   /// `done` steps are complete; `detail` (a file written) goes on a redirected line.
   void update(uint64_t done, const std::string& detail = {});
-  /// Whether this goes to a terminal (the bar) or a log (lines).
-  bool terminal() const { return terminal_; }
 
  private:
   std::string what_;
@@ -25,8 +23,5 @@ class Progress {
   bool quiet_, terminal_;
   std::chrono::steady_clock::time_point start_;
 };
-
-/// "1 h 02 min", "3 min 05 s", "12.5 s": a duration as people read it.
-std::string readableSeconds(double seconds);
 
 }  // namespace snell::io
