@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cctype>
 #include <cstdlib>
 #include <filesystem>
 #include <string>
@@ -24,9 +25,19 @@ inline std::filesystem::path assetsDir() {
 /// A model under ../shared/assets/gltf, e.g. model("Cameras/glTF/Cameras.gltf").
 inline std::string model(const std::string& relative) { return (assetsDir() / "gltf" / relative).string(); }
 
-/// A fresh empty folder for one test's files.
+/// A fresh empty folder for one test's files, left behind for a look after a
+/// failure. ctest runs tests several at once, each in its own process: the
+/// running test's own name (parameter index included) keeps two cases of one
+/// parameterised test out of each other's folder.
 inline std::filesystem::path scratchDir(const std::string& name) {
-  std::filesystem::path dir = std::filesystem::temp_directory_path() / ("snell-test-" + name);
+  std::string unique = name;
+  if (const auto* test = ::testing::UnitTest::GetInstance()->current_test_info()) {
+    unique += std::string("-") + test->test_suite_name() + "." + test->name();
+  }
+  for (char& c : unique) {
+    if (!std::isalnum(static_cast<unsigned char>(c)) && c != '-' && c != '_' && c != '.') c = '_';
+  }
+  std::filesystem::path dir = std::filesystem::temp_directory_path() / ("snell-test-" + unique);
   std::filesystem::remove_all(dir);
   std::filesystem::create_directories(dir);
   return dir;

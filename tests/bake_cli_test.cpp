@@ -1,5 +1,6 @@
 // `snell bake` and `snell export-web` as a user runs them, and the exported
 // page in a real browser: Debian's Chromium, headless, on software GL.
+#include "assets.h"
 #include "command_run.h"
 
 #include "bake/refraction_bake.h"
@@ -28,15 +29,8 @@ std::string readText(const fs::path& path) {
   return text.str();
 }
 
-fs::path freshDir(const std::string& name) {
-  fs::path dir = fs::temp_directory_path() / name;
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  return dir;
-}
-
 TEST(BakeCommand, WritesEachEncodingAndSaysWhatTheGlassLandsOn) {
-  fs::path dir = freshDir("snell_bake_cli");
+  fs::path dir = scratchDir("snell_bake_cli");
   for (const char* args : {"--encoding rg16 -o map16.png", "-o map.exr", "-o map8.png"}) {
     CommandRun bake = runCommand("cd " + shellQuoted(dir.string()) + " && " + SNELL_BINARY + " bake --eye --size 64x48 " + args);
     ASSERT_EQ(bake.exitCode, 0) << args << "\n" << bake.output;
@@ -49,7 +43,7 @@ TEST(BakeCommand, WritesEachEncodingAndSaysWhatTheGlassLandsOn) {
 }
 
 TEST(BakeCommand, AnEncodingItsExtensionCannotHoldIsAUsageErrorAndWritesNothing) {
-  fs::path dir = freshDir("snell_bake_wrong_extension");
+  fs::path dir = scratchDir("snell_bake_wrong_extension");
   CommandRun run = snell("bake --eye --encoding rg16 -o " + shellQuoted((dir / "map.exr").string()));
   EXPECT_EQ(run.exitCode, 2) << run.output;
   EXPECT_NE(run.output.find("rg16"), std::string::npos) << run.output;
@@ -121,7 +115,7 @@ PageMatch match(const io::Rgb8Image& page, const io::Rgb8Image& render, const ba
 TEST(ExportWebCommand, ThePageInChromiumDrawsWhatTheRefractionMapMethodRenders) {
   ASSERT_TRUE(fs::exists(chromium())) << chromium() << " is missing: 'scripts/bootstrap test' installs Debian's chromium";
   const uint32_t width = 160, height = 120;
-  fs::path dir = freshDir("snell_export_web");
+  fs::path dir = scratchDir("snell_export_web");
   fs::path site = dir / "site";
   CommandRun exported = snell("export-web --eye --size 160x120 -o " + shellQuoted(site.string()));
   ASSERT_EQ(exported.exitCode, 0) << exported.output;

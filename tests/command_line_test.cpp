@@ -1,6 +1,7 @@
 // The command line and file formats as a pipeline relies on them: exit codes,
 // errors that name the option, --quiet, JSON that parses whatever the names
 // hold, PNGs compressed like zlib would, EXRs a compositor reads.
+#include "assets.h"
 #include "command_run.h"
 
 #include "io/json.h"
@@ -35,10 +36,7 @@ CommandRun snellStdout(const std::string& arguments) {
 // A fresh folder per test, removed with it.
 struct TempFolder {
   fs::path path;
-  explicit TempFolder(const std::string& name) : path(fs::temp_directory_path() / ("snell_cli_" + name)) {
-    fs::remove_all(path);
-    fs::create_directories(path);
-  }
+  explicit TempFolder(const std::string& name) : path(test::scratchDir("cli-" + name)) {}
   ~TempFolder() { fs::remove_all(path); }
   std::string operator/(const std::string& file) const { return (path / file).string(); }
 };

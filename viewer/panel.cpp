@@ -4,6 +4,7 @@
 // drawing glass, the display switches and the controls' help.
 #include "viewer_state.h"
 
+#include "io/json.h"
 #include "render/method.h"
 
 #define GLFW_INCLUDE_VULKAN
@@ -33,7 +34,7 @@ void Viewer::drawUi(double frameSeconds) {
   if (frameTimeCount_ > 0) {
     std::vector<double> times(frameTimes_.begin(), frameTimes_.begin() + long(frameTimeCount_));
     auto [lo, hi] = std::minmax_element(times.begin(), times.end());
-    double least = *lo, most = *hi, middle = median(times);
+    double least = *lo, most = *hi, middle = io::median(times);
     ImGui::Text("last %zu frames: min %.2f, median %.2f, max %.2f ms", frameTimeCount_, least, middle, most);
     int offset = frameTimeCount_ == kGraphFrames ? int(frameTimeNext_) : 0;
     float font = ImGui::GetFontSize();

@@ -67,13 +67,13 @@ void Viewer::report(double seconds) const {
     gpuTotal.push_back(total);
   }
   std::printf("\n%-12s %10s\n", "pass", "median ms");
-  for (const auto& [name, v] : gpu) std::printf("%-12s %10.3f\n", name.c_str(), median(v));
-  std::printf("%-12s %10.3f\n%-12s %10.3f\n", "GPU total", median(gpuTotal), "frame (CPU)", median(cpu));
+  for (const auto& [name, v] : gpu) std::printf("%-12s %10.3f\n", name.c_str(), io::median(v));
+  std::printf("%-12s %10.3f\n%-12s %10.3f\n", "GPU total", io::median(gpuTotal), "frame (CPU)", io::median(cpu));
   std::printf("over %zu frames: %llu items deformed, %llu trees refit, %llu rebuilt, views drawn %llu, kept %llu; "
               "median %.0f pixels traced, %.0f dispatches a frame\n",
               cpu.size(), static_cast<unsigned long long>(deformed), static_cast<unsigned long long>(refit),
               static_cast<unsigned long long>(rebuilt), static_cast<unsigned long long>(viewsDrawn),
-              static_cast<unsigned long long>(viewsKept), median(pixels), median(dispatches));
+              static_cast<unsigned long long>(viewsKept), io::median(pixels), io::median(dispatches));
   if (options_.json.empty()) return;
 
   io::Json j = io::reportHead("view", &context_->facts());
@@ -86,17 +86,17 @@ void Viewer::report(double seconds) const {
   j["frames"] = framesDrawn_;
   j["frames_in_medians"] = cpu.size();
   j["wall_seconds"] = seconds;
-  j["median_frame_ms"] = median(cpu);
-  j["median_gpu_total_ms"] = median(gpuTotal);
+  j["median_frame_ms"] = io::median(cpu);
+  j["median_gpu_total_ms"] = io::median(gpuTotal);
   j["items_deformed"] = deformed;
   j["trees_refit"] = refit;
   j["trees_rebuilt"] = rebuilt;
   j["views_drawn"] = viewsDrawn;
   j["views_kept"] = viewsKept;
-  j["median_pixels_traced"] = median(pixels);
-  j["median_dispatches"] = median(dispatches);
+  j["median_pixels_traced"] = io::median(pixels);
+  j["median_dispatches"] = io::median(dispatches);
   io::Json passes = io::Json::object();
-  for (const auto& [name, v] : gpu) passes[name] = median(v);
+  for (const auto& [name, v] : gpu) passes[name] = io::median(v);
   j["median_pass_ms"] = passes;
   io::Json samples = io::Json::array();
   for (const MemorySample& m : memorySamples_) {

@@ -33,12 +33,6 @@ constexpr std::chrono::seconds kNoticeTime{4};
 
 }  // namespace
 
-double median(std::vector<double> v) {
-  if (v.empty()) return 0.0;
-  std::sort(v.begin(), v.end());
-  return v.size() % 2 ? v[v.size() / 2] : 0.5 * (v[v.size() / 2 - 1] + v[v.size() / 2]);
-}
-
 Viewer::Viewer(const ViewerOptions& options) : options_(options) {
   toggles_.split = options.split;
   toggles_.ui = !options.hideUi;

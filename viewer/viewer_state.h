@@ -73,9 +73,6 @@ struct MemorySample {
   std::string scene;
 };
 
-/// The median of `v` (0 when empty).
-double median(std::vector<double> v);
-
 class Viewer {
  public:
   explicit Viewer(const ViewerOptions& options);

@@ -68,7 +68,7 @@ int soakFrames(const vk::Context& context, const render::Renderer& renderer, Ren
     wallMs.push_back(wall);
     double now = std::chrono::duration<double>(Clock::now() - start).count();
     if (now < interval * double(samples.size() + 1)) continue;
-    Sample s{now, f - warmup, median(frameMs), median(wallMs), io::hostResidentBytes(), context.memoryInUse(),
+    Sample s{now, f - warmup, io::median(frameMs), io::median(wallMs), io::hostResidentBytes(), context.memoryInUse(),
              context.validationMessageCount()};
     samples.push_back(s);
     frameMs.clear();
@@ -197,17 +197,17 @@ int runFrame(const Options& o) {
   std::printf("%-16s %10s %10s %10s %7s\n", "pass", "median ms", "min ms", "max ms", "frames");
   for (const std::string& name : order) {
     const std::vector<double>& v = times[name];
-    std::printf("%-16s %10.4f %10.4f %10.4f %7zu\n", name.c_str(), median(v), *std::min_element(v.begin(), v.end()),
+    std::printf("%-16s %10.4f %10.4f %10.4f %7zu\n", name.c_str(), io::median(v), *std::min_element(v.begin(), v.end()),
                 *std::max_element(v.begin(), v.end()), v.size());
   }
-  std::printf("%-16s %10.4f   (median of each animated frame's passes)\n", "frame", median(totals));
+  std::printf("%-16s %10.4f   (median of each animated frame's passes)\n", "frame", io::median(totals));
   std::printf("%-16s %10.4f   (deform + trees + trace), %.2f%% of a 60 Hz frame\n", "refraction",
-              median(refractionTotals), 100.0 * median(refractionTotals) / (1000.0 / 60.0));
+              io::median(refractionTotals), 100.0 * io::median(refractionTotals) / (1000.0 / 60.0));
   std::printf("%-16s %10.4f   (host: recording, submit and wait for the frame; where passes overlap\n"
               "%-16s              or a CPU device defers work, the timestamps split it less surely)\n",
-              "wall", median(walls), "");
+              "wall", io::median(walls), "");
   std::printf("per frame (medians):");
-  for (const std::string& c : counterOrder) std::printf(" %s %.0f,", c.c_str(), median(counters[c]));
+  for (const std::string& c : counterOrder) std::printf(" %s %.0f,", c.c_str(), io::median(counters[c]));
   std::printf("\nGPU memory (geometry, deformation, trees, per-frame tables): %.2f MiB, trees %.1f bytes per triangle\n",
               double(renderer.memoryBytes()) / 1048576.0, renderer.treeBytesPerTriangle());
   if (!o.json.empty()) {
@@ -223,17 +223,17 @@ int runFrame(const Options& o) {
     for (const std::string& name : order) {
       const std::vector<double>& v = times[name];
       passes.push_back(io::Json{{"pass", name},
-                                {"median_ms", median(v)},
+                                {"median_ms", io::median(v)},
                                 {"min_ms", *std::min_element(v.begin(), v.end())},
                                 {"max_ms", *std::max_element(v.begin(), v.end())},
                                 {"frames", v.size()}});
     }
     j["passes"] = std::move(passes);
-    j["frame_median_ms"] = median(totals);
-    j["refraction_median_ms"] = median(refractionTotals);
-    j["wall_median_ms"] = median(walls);
+    j["frame_median_ms"] = io::median(totals);
+    j["refraction_median_ms"] = io::median(refractionTotals);
+    j["wall_median_ms"] = io::median(walls);
     io::Json countersMedian = io::Json::object();
-    for (const std::string& c : counterOrder) countersMedian[c] = median(counters[c]);
+    for (const std::string& c : counterOrder) countersMedian[c] = io::median(counters[c]);
     j["counters_median"] = std::move(countersMedian);
     io::writeJson(o.json, j);
   }

@@ -138,7 +138,7 @@ std::string chartSvg(const std::vector<MethodResult>& results, const std::string
   double minX = std::numeric_limits<double>::infinity(), maxX = 0, minY = minX, maxY = 0;
   for (const MethodResult& r : results) {
     if (!r.unsupported.empty()) continue;
-    double x = median(r.refractionMs), y = r.glass.rmse();
+    double x = io::median(r.refractionMs), y = r.glass.rmse();
     if (x > 0) minX = std::min(minX, x), maxX = std::max(maxX, x);
     if (y > 0) minY = std::min(minY, y), maxY = std::max(maxY, y);
   }
@@ -173,7 +173,7 @@ std::string chartSvg(const std::vector<MethodResult>& results, const std::string
     if (r.unsupported.empty()) sorted.push_back(&r);
   }
   std::sort(sorted.begin(), sorted.end(), [](const MethodResult* a, const MethodResult* b) {
-    double ta = median(a->refractionMs), tb = median(b->refractionMs);
+    double ta = io::median(a->refractionMs), tb = io::median(b->refractionMs);
     return ta != tb ? ta < tb : a->glass.rmse() < b->glass.rmse();
   });
   std::string front;
@@ -181,14 +181,14 @@ std::string chartSvg(const std::vector<MethodResult>& results, const std::string
   for (const MethodResult* r : sorted) {
     if (r->glass.rmse() >= best) continue;
     best = r->glass.rmse();
-    front += (front.empty() ? "" : " ") + std::to_string(px(median(r->refractionMs))) + "," +
+    front += (front.empty() ? "" : " ") + std::to_string(px(io::median(r->refractionMs))) + "," +
              std::to_string(py(r->glass.rmse()));
   }
   svg << "<polyline points=\"" << front << "\" fill=\"none\" stroke=\"#c33\" stroke-width=\"1.5\" stroke-dasharray=\"5,3\"/>\n";
   std::vector<std::pair<double, double>> placed;  // labels already drawn, so close points' labels stack
   for (const MethodResult& r : results) {
     if (!r.unsupported.empty()) continue;
-    double t = median(r.refractionMs), e = r.glass.rmse();
+    double t = io::median(r.refractionMs), e = r.glass.rmse();
     std::string label = r.name;
     if (t <= 0) label += " (no work)";
     if (e <= 0) label += " (exact)";
@@ -482,7 +482,7 @@ int runMethods(const Options& o) {
       continue;
     }
     std::printf("%-14s %10.4f %10.5f %8.3f%% %8.3f%% %5d %10.5f %8.3f%% %8.3f%% %11.3f%% %10.2f\n", r.name.c_str(),
-                median(r.refractionMs), r.glass.rmse(), 100 * r.glass.share(r.glass.over1),
+                io::median(r.refractionMs), r.glass.rmse(), 100 * r.glass.share(r.glass.over1),
                 100 * r.glass.share(r.glass.over8), r.glass.maximum, r.image.rmse(), 100 * r.image.share(r.image.over1),
                 100 * r.image.share(r.image.over8), 100 * r.worstFrameWithin1, double(r.memoryBytes) / 1048576.0);
   }
@@ -501,7 +501,7 @@ int runMethods(const Options& o) {
       auto first = r.firstFrameMs.find(entry.first);
       auto later = r.passMs.find(entry.first);
       std::printf(" %s %.4f / %.4f,", entry.first.c_str(), first == r.firstFrameMs.end() ? 0.0 : first->second,
-                  later == r.passMs.end() ? 0.0 : median(later->second));
+                  later == r.passMs.end() ? 0.0 : io::median(later->second));
     }
     if (r.hitsCompared) {
       std::printf("\n  first hits agreeing with trace's: %.4f%% of %llu pixels",
@@ -513,7 +513,7 @@ int runMethods(const Options& o) {
     // Each feature's price: the trace pass against the plain bend's, same frames, same run.
     auto traceMs = [](const MethodResult& r) {
       auto it = r.passMs.find("trace");
-      return it == r.passMs.end() ? 0.0 : median(it->second);
+      return it == r.passMs.end() ? 0.0 : io::median(it->second);
     };
     double plain = traceMs(results.at(0));
     std::printf("\n%-14s %10s %10s   %s\n", "optics", "trace ms", "x plain", "what the row adds");
@@ -552,7 +552,7 @@ int runMethods(const Options& o) {
   if (traced && driver) {
     auto traceMs = [](const MethodResult& r, const char* pass) {
       auto it = r.passMs.find(pass);
-      return it == r.passMs.end() ? 0.0 : median(it->second);
+      return it == r.passMs.end() ? 0.0 : io::median(it->second);
     };
     double ours = traceMs(*traced, "trace"), theirs = traceMs(*driver, "driver trace");
     std::printf("rays per second, trace against driver-rt on the same frames: %.3fx (trace %.4f ms, driver %.4f ms)\n",
@@ -582,7 +582,7 @@ int runMethods(const Options& o) {
         continue;
       }
       io::Json passes = io::Json::object(), firstFrame = io::Json::object();
-      for (const auto& [name, v] : r.passMs) passes[name] = median(v);
+      for (const auto& [name, v] : r.passMs) passes[name] = io::median(v);
       for (const auto& [name, v] : r.firstFrameMs) firstFrame[name] = v;
       io::Json row{{"method", r.name},
                    {"passes_median_ms", std::move(passes)},
@@ -590,7 +590,7 @@ int runMethods(const Options& o) {
                    {"first_hits_agreeing_with_trace",
                     r.hitsCompared ? double(r.hitsAgreeing) / double(r.hitsCompared) : -1.0},
                    {"summary", r.summary},
-                   {"refraction_median_ms", median(r.refractionMs)},
+                   {"refraction_median_ms", io::median(r.refractionMs)},
                    {"glass", errorJson(r.glass)},
                    {"image", errorJson(r.image)},
                    {"worst_frame_within_1", r.worstFrameWithin1},

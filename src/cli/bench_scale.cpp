@@ -144,10 +144,10 @@ CrowdRow measureCrowd(vk::Context& context, uint32_t characters, uint32_t width,
     refraction.push_back(work);
     pixels.push_back(double(result.stats.pixelsTraced));
   }
-  for (auto& [name, v] : passes) row.passMs[name] = median(v);
-  row.frameMs = median(totals);
-  row.refractionMs = median(refraction);
-  row.pixelsTraced = median(pixels);
+  for (auto& [name, v] : passes) row.passMs[name] = io::median(v);
+  row.frameMs = io::median(totals);
+  row.refractionMs = io::median(refraction);
+  row.pixelsTraced = io::median(pixels);
   row.memoryPerTriangle = double(renderer.memoryBytes()) / double(row.triangles);
   row.treeBytesPerTriangle = renderer.treeBytesPerTriangle();
   return row;
@@ -222,14 +222,14 @@ int runScale(const Options& o) {
           (p.name == "fast build" ? fb : p.name == "fast trace" ? ft : update).push_back(p.milliseconds);
         }
       }
-      row.driverFastBuildMs = median(fb);
-      row.driverFastTraceMs = median(ft);
-      row.driverUpdateMs = median(update);
+      row.driverFastBuildMs = io::median(fb);
+      row.driverFastTraceMs = io::median(ft);
+      row.driverUpdateMs = io::median(update);
       row.driverBytesPerTriangle = double(fastTrace.structureBytes()) / triangles;
     }
     row.triangles = triangles;
-    row.buildMs = median(build);
-    row.refitMs = median(refit);
+    row.buildMs = io::median(build);
+    row.refitMs = io::median(refit);
     row.bytesPerTriangle = double(bvh.treeBytes()) / triangles;
     row.scratchPerTriangle = double(builder.scratchBytes()) / triangles;
     if (triangles <= o.sahLimit) {

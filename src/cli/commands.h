@@ -34,7 +34,5 @@ uint32_t findTexturedMaterial(const std::string& command, const scene::Scene& sc
 /// `text` with &, <, > and " escaped for XML, SVG and HTML.
 std::string xmlEscape(const std::string& text);
 
-/// The median of `values` (0 when empty), for benchmark tables.
-double median(std::vector<double> values);
 
 }  // namespace snell::cli

@@ -2,6 +2,7 @@
 
 #include "io/image_file.h"
 
+#include <algorithm>
 #include <ctime>
 #include <vector>
 
@@ -75,5 +76,12 @@ std::string jsonText(const Json& json) {
 }
 
 void writeJson(const std::string& path, const Json& json) { writeTextFile(path, jsonText(json)); }
+
+double median(std::vector<double> values) {
+  if (values.empty()) return 0;
+  std::sort(values.begin(), values.end());
+  size_t n = values.size();
+  return n % 2 ? values[n / 2] : 0.5 * (values[n / 2 - 1] + values[n / 2]);
+}
 
 }  // namespace snell::io

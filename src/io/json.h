@@ -9,6 +9,7 @@
 #include <nlohmann/json.hpp>
 
 #include <string>
+#include <vector>
 
 namespace snell::io {
 
@@ -36,5 +37,8 @@ std::string jsonText(const Json& json);
 
 /// Writes `json` to `path`, complete or not at all (as writeTextFile).
 void writeJson(const std::string& path, const Json& json);
+
+/// The median of `values` (0 when empty): what every report and table quotes.
+double median(std::vector<double> values);
 
 }  // namespace snell::io
