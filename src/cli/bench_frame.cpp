@@ -259,7 +259,7 @@ void addBenchFrame(CLI::App& bench, Runner& run) {
   addSize(*sub, "--size", o->width, o->height, "image size (default 1920x1080)");
   CLI::Option* frames = sub->add_option("--frames", o->frames, "frames measured (default 30)")
                             ->type_name("N")
-                            ->check(CLI::Range(1u, std::numeric_limits<uint32_t>::max(), "POSITIVE"));
+                            ->check(positiveCount());
   sub->add_option("--warmup", o->warmup, "frames rendered first and not measured (default 5)")->type_name("N");
   // The procedural eye's own limits (scene::checkEyeOptions), named after these options.
   sub->add_option("--eye-resolution", o->eye.resolution, "segments of the procedural eye, 8-2048 (default 64)")

@@ -653,7 +653,7 @@ void addBenchMethods(CLI::App& bench, Runner& run) {
   addSize(*sub, "--size", o->width, o->height, "image size (default 320x240)");
   sub->add_option("--frames", o->frames, "frames of the sequence (default 24)")
       ->type_name("N")
-      ->check(CLI::Range(1u, std::numeric_limits<uint32_t>::max(), "POSITIVE"));
+      ->check(positiveCount());
   std::vector<std::string> names;
   for (const render::MethodInfo& m : render::methods()) names.push_back(m.name);
   // A list takes one word, so it never swallows the scene file after it.

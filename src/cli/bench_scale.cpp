@@ -346,7 +346,7 @@ void addBenchScale(CLI::App& bench, Runner& run) {
       ->check(countOrZero(1000000000));
   sub->add_option("--runs", o->runs, "timed builds and refits per size (default 10, after one warm-up)")
       ->type_name("N")
-      ->check(CLI::Range(1u, std::numeric_limits<uint32_t>::max(), "POSITIVE"));
+      ->check(positiveCount());
   sub->add_option("--restructure", o->restructure, "rounds of treelet restructuring after each build (default 0)")
       ->type_name("N");
   sub->add_option("--sah-limit", o->sahLimit, "price the tree against binned SAH up to this size (default 1000000)")
@@ -364,7 +364,7 @@ void addBenchScale(CLI::App& bench, Runner& run) {
   addSize(*sub, "--size", o->width, o->height, "viewport size of the crowd frames (default 3840x2160)");
   sub->add_option("--frames", o->frames, "animated frames measured per crowd (default 20, after 5)")
       ->type_name("N")
-      ->check(CLI::Range(1u, std::numeric_limits<uint32_t>::max(), "POSITIVE"));
+      ->check(positiveCount());
   sub->add_option("--json", o->json, "write the results as JSON too")->type_name("FILE");
   sub->callback([o, &run] { run = [o] { return runScale(*o); }; });
 }

@@ -10,6 +10,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <limits>
 #include <map>
 #include <sstream>
 
@@ -194,6 +195,11 @@ const CLI::Validator& finite() {
         return value.empty() || *end != '\0' || !std::isfinite(v) ? "expects a finite number, got '" + value + "'" : "";
       },
       "NUMBER");
+  return validator;
+}
+
+const CLI::Validator& positiveCount() {
+  static const CLI::Validator validator = CLI::Range(1u, std::numeric_limits<uint32_t>::max(), "POSITIVE");
   return validator;
 }
 

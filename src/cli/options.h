@@ -69,6 +69,8 @@ void note(const std::string& text);
 
 /// A check for number options: finite (CLI11 would take "nan" and "inf").
 const CLI::Validator& finite();
+/// A check for counts of frames or runs: 1 or more.
+const CLI::Validator& positiveCount();
 
 /// Options whose values are parsed here, with errors naming the option.
 CLI::Option* addSize(CLI::App& app, const std::string& name, uint32_t& width, uint32_t& height, const std::string& description);
