@@ -22,6 +22,7 @@
 #include <cmath>
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -60,6 +61,9 @@ struct DeviceOptions {
   /// OpenGL (creation fails if the device lacks it), and VK_KHR_external_semaphore_fd
   /// where the device has it (Device::exportsSemaphores).
   bool interop = false;
+  /// Enable the driver's ray tracing, for View::method "driver-rt" (the peer
+  /// snell measures itself against; creation fails if the device lacks it).
+  bool driverRayTracing = false;
 };
 
 /// A device a host application created, for snell to use and never destroy.
@@ -122,6 +126,8 @@ struct Material {
   Vec3 attenuationColor{1, 1, 1};
   float attenuationDistance = INFINITY;
   bool doubleSided = false;
+  Vec3 emissive{0, 0, 0};  ///< linear RGB the faces give off
+  float dispersion = 0;    ///< KHR_materials_dispersion: 20 / Abbe number; 0: none
 };
 
 /// An 8-bit sRGB RGBA texture, row 0 at the top, repeating.
@@ -160,20 +166,44 @@ struct Light {
   float innerConeAngle = 0, outerConeAngle = 0.7853982f;  ///< radians (spot)
 };
 
-/// A scene built from the host's own data. Positions and normals of every
-/// mesh are packed float triples (12 bytes a vertex) in two host VkBuffers
-/// made with VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, each mesh at its firstVertex:
-/// one buffer for all meshes, as an engine's skinning output usually is.
-/// snell reads them in place, never copies them, and never frees them.
+/// A camera of a HostScene, for View::sceneCamera.
+struct SceneCamera {
+  std::string name;
+  Mat4 transform = kIdentity;  ///< camera to world: it looks down its -Z axis, +Y up
+  bool orthographic = false;
+  float yfov = 0.6981317f;  ///< radians (perspective)
+  float ymag = 1;           ///< half the view's height (orthographic)
+};
+
+/// One mesh's vertices, for a HostScene whose vertices snell keeps.
+struct MeshVertices {
+  std::vector<float> positions;  ///< 3 floats a vertex
+  std::vector<float> normals;    ///< 3 floats a vertex, unit length
+};
+
+/// A scene built from the host's own data, with its vertices in one of two places:
+///
+/// - The host's GPU buffers (`positions` and `normals` set): packed float
+///   triples (12 bytes a vertex) in two VkBuffers made with
+///   VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, each mesh at its firstVertex: one
+///   buffer for all meshes, as an engine's skinning output usually is. snell
+///   reads them in place, never copies them, and never frees them.
+/// - snell's own buffers (`positions` and `normals` null): `vertices` gives
+///   each mesh's vertices (Mesh::vertexCount of them; firstVertex is
+///   ignored). Each Renderer keeps a copy on the GPU and a mapped one the host
+///   rewrites between frames (Renderer::vertices); a host without Vulkan (a
+///   script, a DCC) uses these.
 struct HostScene {
   std::string name = "host scene";  ///< for messages
   VkBuffer positions = VK_NULL_HANDLE, normals = VK_NULL_HANDLE;
   uint32_t vertexCapacity = 0;  ///< vertices each buffer holds
+  std::vector<MeshVertices> vertices;  ///< one per mesh, when snell keeps them
   std::vector<Mesh> meshes;
   std::vector<Material> materials;
   std::vector<Texture> textures;
   std::vector<Instance> instances;
   std::vector<Light> lights;
+  std::vector<SceneCamera> cameras;
 };
 
 /// What is drawn: a glTF file, or the host's data.
@@ -181,7 +211,8 @@ class Scene {
  public:
   /// Loads a glTF 2.0 file (.gltf or .glb); throws Error naming the file and the problem.
   static Scene load(const std::string& path);
-  /// Wraps the host's data; the host's buffers must outlive every Renderer of this scene.
+  /// Wraps the host's data; the host's buffers must outlive every Renderer of
+  /// this scene. Throws Error naming the mesh, material or instance at fault.
   static Scene fromHost(const HostScene& host);
   ~Scene();
   Scene(Scene&&) noexcept;
@@ -190,8 +221,12 @@ class Scene {
   std::string name() const;
   /// Meshes: glTF primitives, or HostScene::meshes (the index markDirty takes).
   size_t meshCount() const;
-  /// Cameras the file defines (View::sceneCamera).
+  /// Cameras the file (or HostScene::cameras) defines (View::sceneCamera).
   size_t cameraCount() const;
+  /// Mesh `mesh`'s vertex count (Scene::meshCount meshes).
+  uint32_t vertexCount(int mesh) const;
+  /// Whether snell keeps the vertices (a HostScene without buffers: Renderer::vertices).
+  bool keepsVertices() const;
   /// The longest animation, in seconds (0: static).
   double duration() const;
 
@@ -209,16 +244,41 @@ struct Camera {
   float yfov = 0.6981317f;  ///< radians (40 degrees)
 };
 
+/// A camera given as the host's own matrices (a DCC viewport's), OpenGL's conventions.
+struct CameraMatrices {
+  Mat4 view = kIdentity;  ///< world to camera: the camera looks down its -Z axis, +Y up
+  /// Camera to clip space: perspective (an off-centre frustum for lens
+  /// shift) or orthographic (the same with an offset), depth range
+  /// ignored. Its aspect (the width its x covers over the height its y
+  /// covers) must be the view's width / height: pixels are square.
+  Mat4 projection = kIdentity;
+};
+
 /// One picture of the scene.
 struct View {
   uint32_t width = 640, height = 480;
-  /// The scene's camera of this index; -1: `camera` below.
+  /// The scene's camera of this index; -1: `matrices`, else `camera` below.
   int sceneCamera = -1;
   Camera camera;
+  /// The host's matrices instead of `camera` (when sceneCamera is -1).
+  std::optional<CameraMatrices> matrices;
   enum class Output {
     Viewport,  ///< rasterised, with only the refracting pixels traced: the talk's viewport
     Trace,     ///< every pixel traced
   } output = Output::Viewport;
+  /// How glass is drawn: a method of `snell render --method` ("trace",
+  /// "trace-1", "iris-plane", "normal-offset", "refraction-map", "none",
+  /// "driver-rt"); empty: "trace". With Output::Viewport the traced
+  /// methods trace only the refracting pixels under the raster pass; a
+  /// raster method draws the viewport whatever `output` says.
+  /// "refraction-map" bakes its map with the trace at the first frame that
+  /// draws it (again when the view's size changes).
+  std::string method;
+  /// Refractive faces a ray may cross (at most 1024).
+  uint32_t maxInterfaces = 8;
+  bool fresnel = true;     ///< glass reflects as well as refracts: highlights, catch lights, the environment
+  bool dispersion = true;  ///< KHR_materials_dispersion splits the colours
+  bool volume = true;      ///< KHR_materials_volume tints light inside thick glass
   Vec3 background{0.02f, 0.02f, 0.025f};  ///< linear RGB where nothing is drawn
   /// Viewport only: alpha 0 (and black) where nothing is drawn, so the host
   /// composites the image over its own with premultiplied alpha.
@@ -258,12 +318,31 @@ struct RendererOptions {
   uint32_t framesInFlight = 2;
 };
 
+/// GPU time of one pass of a frame.
+struct PassTime {
+  std::string name;  ///< deform, blas build, blas refit, tlas, raster depth, trace list, trace, raster shading, ...
+  double milliseconds = 0;
+};
+
 /// What the last frame did (for the host's statistics overlay).
 struct FrameInfo {
   uint64_t frame = 0;
   uint32_t treesRefit = 0, treesBuilt = 0, treesSkipped = 0;
   uint64_t pixelsTraced = 0;
   bool skipped = false;  ///< nothing changed since the view was last drawn: the image was reused
+  uint32_t itemsDeformed = 0;   ///< glTF items whose morphs or skin snell deformed
+  uint32_t meshesUploaded = 0;  ///< kept meshes (Renderer::vertices) copied to the GPU
+  bool topLevelBuilt = false, topLevelRefit = false;
+  uint32_t dispatches = 0, draws = 0;
+  std::string method;            ///< how glass was drawn
+  std::vector<PassTime> passes;  ///< GPU time per pass, in order
+};
+
+/// Where the host rewrites a kept mesh's vertices (Renderer::vertices).
+struct Vertices {
+  float* positions = nullptr;  ///< count * 3 floats
+  float* normals = nullptr;    ///< count * 3 floats
+  uint32_t count = 0;
 };
 
 /// Draws views of one scene, updating only what changed between frames.
@@ -283,10 +362,16 @@ class Renderer {
   size_t instanceCount() const;
   /// Moves instance `instance` (mesh space to world); the next frame refits the top-level tree only.
   void setTransform(size_t instance, const Mat4& transform);
-  /// Says the host rewrote mesh `mesh`'s vertices in its buffers: the next
-  /// frame refits that mesh's tree and redraws. Write the buffers, then call
-  /// this, then render().
+  /// Says the host rewrote mesh `mesh`'s vertices (in its buffers, or in
+  /// those Renderer::vertices hands out): the next frame refits that mesh's
+  /// tree and redraws. Write the vertices, then call this, then render().
   void markDirty(int mesh);
+  /// A kept mesh's vertices (Scene::keepsVertices) in mapped host memory,
+  /// for the host to rewrite in place, then markDirty: the next frame
+  /// copies them to the GPU and bounds them anew. Waits for the frames in
+  /// flight, so the memory is the host's until the next render() or read();
+  /// the pointers stay valid for the Renderer's life.
+  Vertices vertices(int mesh);
 
   /// Renders `view` into `target`, submitted with `sync`; returns the frame's
   /// number. The host may record its own use of the target once `sync.signal`
@@ -296,6 +381,8 @@ class Renderer {
   void wait(uint64_t frame);
   /// Renders `view` and reads it back: linear RGBA floats, row 0 at the top (tests, thumbnails).
   std::vector<float> read(const View& view);
+  /// The same into the host's memory: view.width * view.height * 4 floats.
+  void read(const View& view, float* rgba);
   /// What the last frame did.
   FrameInfo lastFrame() const;
 

@@ -121,6 +121,8 @@
 //   opaque fragments with the primary ray's cone, so it and the trace agree.
 //   The environment map has no mips: reflected rays read it at full size.
 //   With kOpticsTextureLod off, traced rays read every texture at level 0.
+// With kOpticsDispersion off no material disperses (D = 0 everywhere); with
+// kOpticsVolume off no material attenuates (as if every one were thin-walled).
 #ifndef SNELL_TRACE_H
 #define SNELL_TRACE_H
 #include "scene.h"
@@ -159,6 +161,8 @@ SNELL_CONST kDefaultReflections = 1;  // true boundaries per path that send a re
 SNELL_CONST kOpticsFresnel = 1u;         // R and T at every boundary, reflections, highlights
 SNELL_CONST kOpticsEnvironmentMap = 2u;  // reflected rays read kTraceBindingEnvironment, not the studio gradient
 SNELL_CONST kOpticsTextureLod = 4u;      // textures at the ray cone's level of detail (off: level 0)
+SNELL_CONST kOpticsDispersion = 8u;      // dispersive materials split the colours (off: every channel at the base IOR)
+SNELL_CONST kOpticsVolume = 16u;         // volumes attenuate (off: every material thin-walled)
 
 // What a traced pixel ended on (TraceAov::outcome).
 SNELL_CONST kOutcomeMiss = 0;

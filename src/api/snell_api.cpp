@@ -4,6 +4,7 @@
 // below leaves as snell::Error.
 #include "snell/snell.h"
 
+#include "bake/refraction_bake.h"
 #include "render/method.h"
 #include "render/raster_pass.h"
 #include "render/renderer.h"
@@ -14,11 +15,15 @@
 #include "vk/context.h"
 #include "vk/error.h"
 
+#include <glm/gtc/packing.hpp>
 #include <glm/gtc/type_ptr.hpp>
 
+#include <algorithm>
+#include <cstring>
 #include <map>
 #include <mutex>
 #include <optional>
+#include <set>
 #include <utility>
 
 namespace snell {
@@ -73,6 +78,7 @@ Device Device::create(const DeviceOptions& options) {
     desc.deviceOverride = options.device;
     desc.validation = options.validation;
     desc.synchronizationValidation = options.synchronizationValidation;
+    desc.driverRayTracing = options.driverRayTracing;
     if (options.interop) {
       desc.deviceExtensions = {VK_KHR_EXTERNAL_MEMORY_FD_EXTENSION_NAME};
       desc.optionalDeviceExtensions = {VK_KHR_EXTERNAL_SEMAPHORE_FD_EXTENSION_NAME};  // lavapipe lacks it
@@ -125,7 +131,11 @@ void Device::waitIdle() {
 
 struct Scene::Impl {
   scene::Scene scene;
-  render::HostBuffers host;  ///< null handles for a glTF scene
+  render::HostBuffers host;  ///< null handles for a glTF scene or kept vertices
+  /// Kept vertices (HostScene::vertices), packed mesh after mesh: positions,
+  /// then normals, vertexCapacity * 3 floats each; each Renderer copies them.
+  std::vector<float> kept;
+  uint32_t keptVertices = 0;
 };
 
 Scene::Scene(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
@@ -151,8 +161,11 @@ scene::Material toMaterial(const Material& m, size_t textures, const std::string
   if (!(m.ior >= 1.0f) || !(m.transmission >= 0.0f && m.transmission <= 1.0f)) {
     throw Error(where + ": ior must be at least 1 and transmission within [0, 1]");
   }
+  if (!(m.dispersion >= 0.0f) || !std::isfinite(m.dispersion)) throw Error(where + ": dispersion must be 0 or more");
   scene::Material out;
   out.name = m.name;
+  out.emissiveFactor = toVec(m.emissive);
+  out.dispersion = m.dispersion;
   out.baseColorFactor = glm::make_vec4(m.baseColor.data());
   out.baseColorTexture.texture = m.baseColorTexture;
   out.transmission = m.transmission;
@@ -186,6 +199,47 @@ scene::Shape toShape(const Mesh& m, int index, size_t materials, const std::stri
   return shape;
 }
 
+// The box around `count` packed float triples; NaN and infinite vertices are
+// left out (the trees drop their triangles too).
+void boundsOf(const float* xyz, uint32_t count, glm::vec3& lo, glm::vec3& hi) {
+  lo = glm::vec3(INFINITY), hi = glm::vec3(-INFINITY);
+  for (uint32_t v = 0; v < count; ++v) {
+    glm::vec3 p(xyz[3 * v], xyz[3 * v + 1], xyz[3 * v + 2]);
+    if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) continue;
+    lo = glm::min(lo, p), hi = glm::max(hi, p);
+  }
+}
+
+// Packs HostScene::vertices into `impl`, numbering the meshes' vertices one after another.
+void keepVertices(const HostScene& host, Scene::Impl& impl) {
+  if (host.vertices.size() != host.meshes.size()) {
+    throw Error(host.name + ": " + std::to_string(host.vertices.size()) + " vertex lists for " +
+                std::to_string(host.meshes.size()) + " meshes (without host buffers, each mesh needs its vertices)");
+  }
+  uint64_t total = 0;
+  for (const Mesh& m : host.meshes) total += m.vertexCount;
+  if (total > (1u << 31) / 3) throw Error(host.name + ": " + std::to_string(total) + " vertices are too many for one scene");
+  impl.keptVertices = uint32_t(total);
+  impl.kept.assign(size_t(total) * 6, 0.0f);
+  uint32_t first = 0;
+  for (size_t i = 0; i < host.meshes.size(); ++i) {
+    const Mesh& m = host.meshes[i];
+    const MeshVertices& v = host.vertices[i];
+    std::string where = host.name + ": mesh " + std::to_string(i) + (m.name.empty() ? "" : " ('" + m.name + "')");
+    if (m.vertexCount == 0) throw Error(where + " has no vertices");
+    if (v.positions.size() != size_t(m.vertexCount) * 3 || v.normals.size() != size_t(m.vertexCount) * 3) {
+      throw Error(where + ": " + std::to_string(v.positions.size()) + " position and " + std::to_string(v.normals.size()) +
+                  " normal floats for " + std::to_string(m.vertexCount) + " vertices (3 each)");
+    }
+    std::copy(v.positions.begin(), v.positions.end(), impl.kept.begin() + ptrdiff_t(first) * 3);
+    std::copy(v.normals.begin(), v.normals.end(), impl.kept.begin() + ptrdiff_t(total + first) * 3);
+    scene::Shape& shape = impl.scene.shapes[i];
+    shape.host->first = first;
+    boundsOf(v.positions.data(), m.vertexCount, shape.host->lo, shape.host->hi);
+    first += m.vertexCount;
+  }
+}
+
 // A light's node: it shines down its -Z axis from `position`.
 glm::mat4 lightMatrix(const Light& light) {
   glm::vec3 back = -glm::normalize(toVec(light.direction));
@@ -202,7 +256,11 @@ Scene Scene::fromHost(const HostScene& host) {
     auto impl = std::make_unique<Impl>();
     scene::Scene& s = impl->scene;
     s.source = host.name;
-    if (!host.positions || !host.normals) throw Error(host.name + ": the host's positions and normals buffers are needed");
+    bool keep = !host.positions && !host.normals;
+    if (!keep && (!host.positions || !host.normals)) {
+      throw Error(host.name + ": give both the positions and normals buffers, or neither (snell keeps the vertices)");
+    }
+    if (!keep && !host.vertices.empty()) throw Error(host.name + ": vertex lists are for scenes without host buffers");
     for (size_t i = 0; i < host.textures.size(); ++i) {
       const Texture& t = host.textures[i];
       if (t.width == 0 || t.height == 0 || t.rgba.size() != size_t(t.width) * t.height * 4) {
@@ -251,7 +309,33 @@ Scene Scene::fromHost(const HostScene& host) {
       s.roots.push_back(int(s.nodes.size()));
       s.nodes.push_back(node);
     }
-    impl->host = {host.positions, host.normals, host.vertexCapacity};
+    for (size_t i = 0; i < host.cameras.size(); ++i) {
+      const SceneCamera& c = host.cameras[i];
+      std::string where = host.name + ": camera " + std::to_string(i);
+      if (c.orthographic ? !(c.ymag > 0.0f) : !(c.yfov > 0.0f && c.yfov < 3.14159f)) {
+        throw Error(where + (c.orthographic ? ": ymag must be positive" : ": yfov must be within (0, pi) radians"));
+      }
+      for (float f : c.transform) {
+        if (!std::isfinite(f)) throw Error(where + "'s transform is not finite");
+      }
+      scene::Camera camera;
+      camera.name = c.name;
+      camera.orthographic = c.orthographic;
+      camera.yfov = c.yfov;
+      camera.xmag = camera.ymag = c.ymag;
+      scene::Node node;
+      node.name = c.name.empty() ? "camera " + std::to_string(i) : c.name;
+      node.camera = int(s.cameras.size());
+      node.matrix = glm::make_mat4(c.transform.data());
+      s.cameras.push_back(camera);
+      s.roots.push_back(int(s.nodes.size()));
+      s.nodes.push_back(node);
+    }
+    if (keep) {
+      keepVertices(host, *impl);
+    } else {
+      impl->host = {host.positions, host.normals, host.vertexCapacity};
+    }
     return Scene(std::move(impl));
   });
 }
@@ -259,9 +343,78 @@ Scene Scene::fromHost(const HostScene& host) {
 std::string Scene::name() const { return impl_->scene.source; }
 size_t Scene::meshCount() const { return impl_->scene.shapes.size(); }
 size_t Scene::cameraCount() const { return impl_->scene.cameras.size(); }
+uint32_t Scene::vertexCount(int mesh) const {
+  if (mesh < 0 || size_t(mesh) >= impl_->scene.shapes.size()) {
+    throw Error("vertexCount: no mesh " + std::to_string(mesh) + " of " + std::to_string(impl_->scene.shapes.size()));
+  }
+  return uint32_t(impl_->scene.shapes[size_t(mesh)].vertexCount());
+}
+bool Scene::keepsVertices() const { return impl_->keptVertices > 0; }
 double Scene::duration() const { return scene::animationDuration(impl_->scene); }
 
 // ---------------------------------------------------------------- Renderer
+
+namespace {
+
+// A camera frame from a host's view and projection matrices (OpenGL's
+// conventions). The trace's ray through a pixel (shared/trace.h) has slopes
+// sx = ndc.x * halfHeight * aspect + shift.x, sy = ndc.y * halfHeight + shift.y;
+// an off-centre projection is exactly such a window of slopes (perspective)
+// or of offsets (orthographic).
+scene::View viewFromMatrices(const CameraMatrices& m, uint32_t width, uint32_t height) {
+  for (size_t i = 0; i < 16; ++i) {
+    if (!std::isfinite(m.view[i]) || !std::isfinite(m.projection[i])) throw Error("view: the camera matrices are not finite");
+  }
+  glm::dmat4 toWorld = glm::inverse(toMatrix(m.view));
+  glm::dmat4 p = toMatrix(m.projection);  // p[column][row]
+  scene::View v;
+  v.description = "the host's camera matrices";
+  v.right = glm::dvec3(toWorld[0]);
+  v.up = glm::dvec3(toWorld[1]);
+  v.forward = -glm::dvec3(toWorld[2]);
+  v.eye = glm::dvec3(toWorld[3]);
+  double lr = glm::length(v.right), lu = glm::length(v.up), lf = glm::length(v.forward);
+  if (!(lr > 0.0 && lu > 0.0 && lf > 0.0) || !std::isfinite(lr * lu * lf)) throw Error("view: the view matrix is singular");
+  v.right /= lr, v.up /= lu, v.forward /= lf;
+  if (std::abs(glm::dot(v.right, v.up)) > 1e-4 || std::abs(glm::dot(v.right, v.forward)) > 1e-4 ||
+      std::abs(glm::dot(v.up, v.forward)) > 1e-4) {
+    throw Error("view: the view matrix shears (its axes are not at right angles)");
+  }
+  if (p[0][3] != 0.0 || p[1][3] != 0.0 || p[0][1] != 0.0 || p[1][0] != 0.0) {
+    throw Error("view: the projection is not a perspective or orthographic one (it mixes x and y, or x and y into w)");
+  }
+  bool perspective = p[2][3] < 0.0 && p[3][3] == 0.0;
+  v.orthographic = p[2][3] == 0.0 && p[3][3] != 0.0;
+  if (!perspective && !v.orthographic) throw Error("view: the projection is neither perspective (w = -z) nor orthographic (w = 1)");
+  if (!(p[0][0] > 0.0 && p[1][1] > 0.0)) throw Error("view: the projection flips or collapses x or y");
+  double w = perspective ? -p[2][3] : p[3][3];  // clip w per unit of -z, or the constant w
+  double sx = p[0][0] / w, sy = p[1][1] / w;
+  double aspect = double(width) / double(height);
+  if (std::abs(sy / sx / aspect - 1.0) > 1e-3) {
+    throw Error("view: the projection's aspect " + std::to_string(sy / sx) + " is not the view's " +
+                std::to_string(width) + "x" + std::to_string(height) + " (" + std::to_string(aspect) +
+                "): snell's pixels are square");
+  }
+  v.halfHeight = 1.0 / sy;
+  if (perspective) {
+    v.shift = glm::dvec2(p[2][0] / p[0][0], p[2][1] / p[1][1]);
+  } else {
+    v.shift = glm::dvec2(-p[3][0] / p[0][0], -p[3][1] / p[1][1]);
+  }
+  return v;
+}
+
+}  // namespace
+
+// The GPU copies of a kept scene's vertices (Scene::keepsVertices): buffers
+// the frames read, and a mapped copy in cached host memory that the host
+// rewrites and snell reads back to bound it.
+struct KeptVertices {
+  vk::Buffer staging;  ///< positions, then normals
+  vk::Buffer positions, normals;
+  uint32_t count = 0;
+  std::set<int> pending;  ///< meshes to copy to the GPU at the next frame
+};
 
 struct Renderer::Impl {
   std::recursive_mutex& mutex;  ///< the Device's
@@ -269,8 +422,16 @@ struct Renderer::Impl {
   Scene::Impl& scene;
   scene::Pose pose;
   std::map<size_t, glm::dmat4> transforms;  ///< setTransform's, kept over setTime
+  std::optional<KeptVertices> kept;
+  /// Per mesh of a host scene: the box its vertices are in (kept: measured at markDirty).
+  std::vector<std::pair<glm::vec3, glm::vec3>> bounds;
   std::unique_ptr<render::Renderer> renderer;
+  /// The refraction-map method's map, baked at the first frame that draws it.
+  render::RefractionMapBuffer map;
   FrameInfo last;
+  std::string method;      ///< the last request's method
+  uint32_t uploading = 0;  ///< kept meshes the frame being recorded copies
+  bool composite = false;  ///< the last request draws the viewport composite (render() blits it)
 
   Impl(Device& device, Scene& s, const RendererOptions& options)
       : mutex(device.impl().mutex), context(*device.impl().context), scene(s.impl()),
@@ -279,44 +440,114 @@ struct Renderer::Impl {
     render::RendererOptions o;
     o.framesInFlight = options.framesInFlight;
     o.host = scene.host;
+    for (const scene::Shape& shape : scene.scene.shapes) {
+      if (shape.host) bounds.emplace_back(shape.host->lo, shape.host->hi);
+    }
+    if (scene.keptVertices > 0) {
+      KeptVertices& k = kept.emplace();
+      k.count = scene.keptVertices;
+      VkDeviceSize bytes = VkDeviceSize(k.count) * 12;
+      k.staging = vk::Buffer(context, {2 * bytes, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, vk::MemoryDomain::Readback,
+                                       scene.scene.source + " vertices (host copy)"});
+      std::memcpy(k.staging.mapped().data(), scene.kept.data(), 2 * bytes);
+      const VkBufferUsageFlags usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT;
+      k.positions = vk::Buffer(context, {bytes, usage, vk::MemoryDomain::Device, scene.scene.source + " positions"});
+      k.normals = vk::Buffer(context, {bytes, usage, vk::MemoryDomain::Device, scene.scene.source + " normals"});
+      for (size_t i = 0; i < scene.scene.shapes.size(); ++i) k.pending.insert(int(i));
+      o.host = {k.positions.handle(), k.normals.handle(), k.count};
+    }
     renderer = std::make_unique<render::Renderer>(context, scene.scene, pose, o);
   }
 
-  // The renderer's request for a view of the current pose.
-  render::ViewRequest request(const View& view) const {
-    scene::ViewRequest which;
-    if (view.sceneCamera >= 0) {
-      which.camera = view.sceneCamera;
-    } else {
-      const Camera& c = view.camera;
-      which.lookAt = scene::LookAt{glm::dvec3(toVec(c.eye)), glm::dvec3(toVec(c.target)), glm::dvec3(toVec(c.up))};
-      which.yfov = c.yfov;
+  // Records the copies of the kept meshes rewritten since the last frame.
+  void recordUploads(vk::Commands& commands) {
+    uploading = 0;
+    if (!kept || kept->pending.empty()) return;
+    const VkDeviceSize normalsAt = VkDeviceSize(kept->count) * 12;
+    for (int mesh : kept->pending) {
+      const scene::HostVertices& h = *scene.scene.shapes[size_t(mesh)].host;
+      VkDeviceSize at = VkDeviceSize(h.first) * 12, bytes = VkDeviceSize(h.count) * 12;
+      commands.copyBuffer(kept->staging, kept->positions, bytes, at, at);
+      commands.copyBuffer(kept->staging, kept->normals, bytes, normalsAt + at, at);
     }
+    uploading = uint32_t(kept->pending.size());
+    kept->pending.clear();
+  }
+
+  // The renderer's request for a view of the current pose.
+  render::ViewRequest request(const View& view) {
     render::FrameSettings settings;
     settings.width = view.width;
     settings.height = view.height;
-    settings.view = scene::resolveView(scene.scene, pose, which);
+    if (view.sceneCamera >= 0) {
+      scene::ViewRequest which;
+      which.camera = view.sceneCamera;
+      settings.view = scene::resolveView(scene.scene, pose, which);
+    } else if (view.matrices) {
+      settings.view = viewFromMatrices(*view.matrices, view.width, view.height);
+    } else {
+      const Camera& c = view.camera;
+      scene::ViewRequest which;
+      which.lookAt = scene::LookAt{glm::dvec3(toVec(c.eye)), glm::dvec3(toVec(c.target)), glm::dvec3(toVec(c.up))};
+      which.yfov = c.yfov;
+      settings.view = scene::resolveView(scene.scene, pose, which);
+    }
     settings.background = toVec(view.background);
+    if (view.maxInterfaces > 1024) throw Error("view: maxInterfaces " + std::to_string(view.maxInterfaces) + " is past 1024");
+    settings.maxInterfaces = view.maxInterfaces;
+    settings.optics.fresnel = view.fresnel;
+    settings.optics.dispersion = view.dispersion;
+    settings.optics.volume = view.volume;
+
+    std::string name = view.method.empty() ? "trace" : view.method;
+    std::optional<render::Method> chosen = render::methodFromName(name);
+    if (!chosen) throw Error("view: no method '" + name + "' (the methods: " + render::methodNames() + ")");
+    render::Method m = *chosen;
+    if (render::needsDriverRayTracing(m) && !context.caps().driverRayTracing) {
+      throw Error("view: method " + name + " needs a Device made with DeviceOptions::driverRayTracing on a device that has it");
+    }
+    bool viewport = view.output == View::Output::Viewport || render::drawsComposite(m);
+    if (viewport && (m == render::Method::Trace || m == render::Method::DriverRt)) m = render::Method::Masked;
+    method = render::methodName(m);
     render::RasterOptions raster;
-    bool viewport = view.output == View::Output::Viewport;
     if (viewport && view.transparentBackground) settings.background = glm::vec3(0.0f), settings.backgroundAlpha = 0.0f;
     if (viewport) fitDepth(settings.view, raster);
-    return render::methodView(viewport ? render::Method::Masked : render::Method::Trace, settings, raster);
+    if (m == render::Method::RefractionMap) {
+      bakeMap(settings);
+      raster.refractionMap = &map;
+    }
+    return viewport ? render::methodViewport(m, settings, raster) : render::methodView(m, settings, raster);
+  }
+
+  // The refraction-map method's map: the trace of this view at this pose,
+  // baked once per view size.
+  void bakeMap(const render::FrameSettings& settings) {
+    if (map.width == settings.width && map.height == settings.height) return;
+    if (kept && !kept->pending.empty()) {  // the bake's frame has no prologue: copy the vertices first
+      render::FrameRequest flush;
+      flush.pose = &pose;
+      flush.prologue = [this](vk::Commands& commands) { recordUploads(commands); };
+      renderer->wait(renderer->submit(flush));
+    }
+    render::FrameSettings traced = settings;
+    traced.backgroundAlpha = 1.0f;
+    map = bake::uploadRefractionMap(context, bake::bakeRefraction(context, *renderer, pose, traced));
+    renderer->invalidateViews();
   }
 
   // Near and far planes around the scene, every frame, so cheaply: a glTF
   // scene's rest boxes as its pose moves them (not its deformed vertices), a
-  // host scene's promised boxes (its vertices are on the GPU only).
+  // host scene's boxes (promised, or measured where snell keeps the vertices).
   void fitDepth(const scene::View& view, render::RasterOptions& raster) const {
     glm::dvec3 lo(INFINITY), hi(-INFINITY);
-    if (!scene.host.positions) {
+    if (bounds.empty()) {
       scene::approximateBounds(scene.scene, pose, lo, hi);
     } else {
       for (const scene::DrawItem& item : pose.items) {
-        const scene::HostVertices& h = *scene.scene.shapes[size_t(item.shape)].host;
-        if (!(h.lo.x <= h.hi.x)) return;  // a mesh promised no box: keep the wide default planes
+        const auto& [blo, bhi] = bounds[size_t(item.shape)];
+        if (!(blo.x <= bhi.x)) return;  // a mesh promised no box: keep the wide default planes
         for (int corner = 0; corner < 8; ++corner) {
-          glm::dvec3 p(corner & 1 ? h.hi.x : h.lo.x, corner & 2 ? h.hi.y : h.lo.y, corner & 4 ? h.hi.z : h.lo.z);
+          glm::dvec3 p(corner & 1 ? bhi.x : blo.x, corner & 2 ? bhi.y : blo.y, corner & 4 ? bhi.z : blo.z);
           p = glm::dvec3(item.world * glm::dvec4(p, 1.0));
           lo = glm::min(lo, p), hi = glm::max(hi, p);
         }
@@ -327,7 +558,17 @@ struct Renderer::Impl {
 
   void note(const render::FrameResult& result) {
     const render::FrameStats& s = result.stats;
-    last = FrameInfo{s.frame, s.treesRefit, s.treesBuilt, s.treesSkipped, s.pixelsTraced, s.viewsSkipped > 0};
+    last = FrameInfo{};
+    last.frame = s.frame;
+    last.treesRefit = s.treesRefit, last.treesBuilt = s.treesBuilt, last.treesSkipped = s.treesSkipped;
+    last.pixelsTraced = s.pixelsTraced;
+    last.skipped = s.viewsSkipped > 0;
+    last.itemsDeformed = s.itemsDeformed;
+    last.meshesUploaded = uploading;
+    last.topLevelBuilt = s.topLevelBuilt > 0, last.topLevelRefit = s.topLevelRefit > 0;
+    last.dispatches = s.dispatches, last.draws = s.draws;
+    last.method = method;
+    for (const vk::PassTime& p : result.passes) last.passes.push_back(PassTime{p.name, p.milliseconds});
   }
 };
 
@@ -364,7 +605,33 @@ void Renderer::setTransform(size_t instance, const Mat4& transform) {
 }
 
 void Renderer::markDirty(int mesh) {
-  guarded([&] { impl_->renderer->markDirty(mesh); });
+  guarded([&] {
+    std::lock_guard lock(impl_->mutex);
+    impl_->renderer->markDirty(mesh);
+    if (!impl_->kept) return;
+    // The kept copy is the truth now: copy it at the next frame, and bound it
+    // (the trees' culling and the depth range need the box).
+    impl_->kept->pending.insert(mesh);
+    const scene::HostVertices& h = *impl_->scene.scene.shapes[size_t(mesh)].host;
+    const auto* xyz = reinterpret_cast<const float*>(impl_->kept->staging.mapped().data());
+    auto& [lo, hi] = impl_->bounds[size_t(mesh)];
+    boundsOf(xyz + size_t(h.first) * 3, h.count, lo, hi);
+    impl_->renderer->setShapeBounds(mesh, glm::dvec3(lo), glm::dvec3(hi));
+  });
+}
+
+Vertices Renderer::vertices(int mesh) {
+  return guarded([&] {
+    std::lock_guard lock(impl_->mutex);
+    if (!impl_->kept) throw Error("vertices: the scene's vertices are the host's own (only a HostScene without buffers has kept ones)");
+    if (mesh < 0 || size_t(mesh) >= impl_->scene.scene.shapes.size()) {
+      throw Error("vertices: no mesh " + std::to_string(mesh) + " of " + std::to_string(impl_->scene.scene.shapes.size()));
+    }
+    impl_->renderer->finish();  // no frame in flight reads the copy the host is about to write
+    const scene::HostVertices& h = *impl_->scene.scene.shapes[size_t(mesh)].host;
+    auto* xyz = reinterpret_cast<float*>(impl_->kept->staging.mapped().data());
+    return Vertices{xyz + size_t(h.first) * 3, xyz + (size_t(impl_->kept->count) + h.first) * 3, h.count};
+  });
 }
 
 uint64_t Renderer::render(const View& view, const Target& target, const Sync& sync) {
@@ -375,14 +642,10 @@ uint64_t Renderer::render(const View& view, const Target& target, const Sync& sy
       throw Error("render: the target is " + std::to_string(target.width) + "x" + std::to_string(target.height) +
                   ", the view " + std::to_string(view.width) + "x" + std::to_string(view.height));
     }
-    render::FrameRequest frame;
-    frame.pose = &impl_->pose;
-    frame.views.push_back(impl_->request(view));
-    bool viewport = view.output == View::Output::Viewport;
     render::Renderer& renderer = *impl_->renderer;
-    frame.record = [&](vk::Commands& commands) {
+    auto blit = [&](vk::Commands& commands) {
       const render::ViewImages& images = renderer.viewImages(0);
-      const vk::Image& source = viewport ? images.composite : images.trace;
+      const vk::Image& source = images.composite.handle() && impl_->composite ? images.composite : images.trace;
       // The view's image lives in GENERAL; a blit reads best from TRANSFER_SRC_OPTIMAL.
       commands.imageBarrier(source.handle(), VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_LAYOUT_GENERAL,
                             VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT,
@@ -404,6 +667,12 @@ uint64_t Renderer::render(const View& view, const Target& target, const Sync& sy
                             target.layoutAfter, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT,
                             VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, VK_ACCESS_MEMORY_READ_BIT | VK_ACCESS_MEMORY_WRITE_BIT);
     };
+    render::FrameRequest frame;
+    frame.pose = &impl_->pose;
+    frame.views.push_back(impl_->request(view));
+    impl_->composite = frame.views.back().output == render::ViewOutput::Composite;
+    frame.prologue = [this](vk::Commands& commands) { impl_->recordUploads(commands); };
+    frame.record = blit;
     frame.waitSemaphore = sync.wait;
     frame.waitStage = sync.wait ? sync.waitStage : 0;
     frame.signalSemaphore = sync.signal;
@@ -419,21 +688,27 @@ void Renderer::wait(uint64_t frame) {
 }
 
 std::vector<float> Renderer::read(const View& view) {
-  return guarded([&] {
+  std::vector<float> out(size_t(view.width) * view.height * 4);
+  read(view, out.data());
+  return out;
+}
+
+void Renderer::read(const View& view, float* rgba) {
+  guarded([&] {
     std::lock_guard lock(impl_->mutex);
+    if (!rgba) throw Error("read: the output is null");
     render::FrameRequest frame;
     frame.pose = &impl_->pose;
     frame.views.push_back(impl_->request(view));
     frame.views.back().readback = true;
+    frame.views.back().halfReadback = true;  // converted once, straight into the host's memory
+    frame.prologue = [this](vk::Commands& commands) { impl_->recordUploads(commands); };
+    bool composite = frame.views.back().output == render::ViewOutput::Composite;
     const render::FrameResult& result = impl_->renderer->wait(impl_->renderer->submit(frame));
     impl_->note(result);
     const render::ViewPixels& pixels = result.views.at(0);
-    const std::vector<glm::vec4>& rgba = view.output == View::Output::Viewport ? pixels.composite : pixels.trace;
-    std::vector<float> out(rgba.size() * 4);
-    for (size_t i = 0; i < rgba.size(); ++i) {
-      for (int c = 0; c < 4; ++c) out[4 * i + size_t(c)] = rgba[i][c];
-    }
-    return out;
+    const std::vector<uint16_t>& halves = composite ? pixels.compositeHalf : pixels.traceHalf;
+    for (size_t i = 0; i < halves.size(); ++i) rgba[i] = glm::unpackHalf1x16(halves[i]);
   });
 }
 

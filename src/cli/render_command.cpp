@@ -300,6 +300,10 @@ void addOptions(CLI::App& render, Options& o) {
       ->type_name("N")
       ->check(CLI::Range(0u, 1024u));
   render.add_flag_callback("--no-fresnel", [&o] { o.optics.fresnel = false; }, "glass transmits everything and reflects nothing");
+  render.add_flag_callback("--no-dispersion", [&o] { o.optics.dispersion = false; },
+                           "dispersive glass (KHR_materials_dispersion) bends every colour alike");
+  render.add_flag_callback("--no-volume", [&o] { o.optics.volume = false; },
+                           "thick glass (KHR_materials_volume) tints nothing, as if thin-walled");
   render.add_flag("--viewport", o.viewport,
                   "write the viewport's composite instead of the trace\n"
                   "alone: every face rasterized and Phong-shaded, and\n"

@@ -786,7 +786,7 @@ struct Tracer {
         return true;
       }
       const int inside = media.current(prepared);
-      if (inside >= 0) {  // Beer-Lambert over the segment
+      if (inside >= 0 && settings.optics.volume) {  // Beer-Lambert over the segment
         const ResolvedMaterial& volume = prepared.material(media.material[inside]);
         if (volume.attenuationDistance > 0.0) {
           for (int c = 0; c < 3; ++c) throughput[c] *= std::pow(volume.attenuationColor[c], hit.t / volume.attenuationDistance);
@@ -823,7 +823,8 @@ struct Tracer {
       bool boundary;  // a true boundary: the medium changes here
       double n1, n2;
       auto dispersive = [&](int other) {
-        return material.dispersion > 0.0 || (other >= 0 && prepared.material(media.material[other]).dispersion > 0.0);
+        return settings.optics.dispersion &&
+               (material.dispersion > 0.0 || (other >= 0 && prepared.material(media.material[other]).dispersion > 0.0));
       };
       if (entering) {
         boundary = inside < 0 || prepared.material(media.material[inside]).priority <= material.priority;

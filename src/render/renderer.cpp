@@ -45,7 +45,8 @@ bool sameRequest(const ViewRequest& a, const ViewRequest& b) {
          r.refractionMap == q.refractionMap &&
          r.wireColor == q.wireColor && r.nearPlane == q.nearPlane && r.farPlane == q.farPlane &&
          s.optics.fresnel == t.optics.fresnel && s.optics.reflections == t.optics.reflections &&
-         s.optics.environment == t.optics.environment && s.optics.textureLod == t.optics.textureLod;
+         s.optics.environment == t.optics.environment && s.optics.textureLod == t.optics.textureLod &&
+         s.optics.dispersion == t.optics.dispersion && s.optics.volume == t.optics.volume;
 }
 
 std::vector<glm::vec4> unpackHalves(const std::byte* data, size_t pixels) {
@@ -105,6 +106,13 @@ struct Renderer::Update {
   bool buildTop = false, refitTop = false;
 };
 
+Renderer::Sphere Renderer::boundingSphere(const glm::dvec3& lo, const glm::dvec3& hi, bool host) {
+  Sphere sphere;
+  if (lo.x <= hi.x && lo.y <= hi.y && lo.z <= hi.z) sphere = {0.5 * (lo + hi), 0.5 * glm::length(hi - lo)};
+  if (host && !(lo.x <= hi.x)) sphere.radius = INFINITY;  // no promise: never culled
+  return sphere;
+}
+
 Renderer::Renderer(vk::Context& context, const scene::Scene& scene, const scene::Pose& layout, RendererOptions options)
     : context_(context), sceneModel_(scene), options_(options),
       scene_(uploadScene(context, scene, layout, options.host.positions ? &options.host : nullptr)) {
@@ -145,16 +153,13 @@ Renderer::Renderer(vk::Context& context, const scene::Scene& scene, const scene:
       hi = glm::max(hi, glm::dvec3(p));
     }
     if (shape.host) lo = glm::dvec3(shape.host->lo), hi = glm::dvec3(shape.host->hi);
-    Sphere sphere;
-    if (lo.x <= hi.x && lo.y <= hi.y && lo.z <= hi.z) sphere = {0.5 * (lo + hi), 0.5 * glm::length(hi - lo)};
-    if (shape.host && !(lo.x <= hi.x)) sphere.radius = INFINITY;  // no promise: never culled
+    shapeSpheres_.push_back(boundingSphere(lo, hi, shape.host.has_value()));
     std::vector<double> reach;
     for (const scene::MorphTarget& target : shape.targets) {
       double most = 0.0;
       for (const glm::vec3& d : target.positions) most = std::max(most, double(glm::length(d)));
       reach.push_back(most);
     }
-    shapeSpheres_.push_back(sphere);
     shapeMorphReach_.push_back(std::move(reach));
   }
   for (uint32_t i = 0; i < options_.framesInFlight; ++i) slots_.push_back(std::make_unique<Slot>(context, i));
@@ -182,6 +187,13 @@ void Renderer::markDirty(int shape) {
     if (scene_.geometries[g].shape == shape) geometryDirty_[g] = driverMoved_[g] = 1;
   }
   ++sceneVersion_;
+}
+
+void Renderer::setShapeBounds(int shape, const glm::dvec3& lo, const glm::dvec3& hi) {
+  if (shape < 0 || size_t(shape) >= sceneModel_.shapes.size() || !sceneModel_.shapes[size_t(shape)].host) {
+    throw std::invalid_argument("renderer: no host shape " + std::to_string(shape) + " to bound");
+  }
+  shapeSpheres_[size_t(shape)] = boundingSphere(lo, hi, true);
 }
 
 void Renderer::invalidateTrees() {
@@ -495,7 +507,9 @@ gpu::TracePush Renderer::tracePush(const ViewRequest& request, bool masked) cons
   push.shiftY = float(v.shift.y);
   push.optics = (settings.optics.fresnel ? gpu::kOpticsFresnel : 0u) |
                 (settings.optics.environment ? gpu::kOpticsEnvironmentMap : 0u) |
-                (settings.optics.textureLod ? gpu::kOpticsTextureLod : 0u);
+                (settings.optics.textureLod ? gpu::kOpticsTextureLod : 0u) |
+                (settings.optics.dispersion ? gpu::kOpticsDispersion : 0u) |
+                (settings.optics.volume ? gpu::kOpticsVolume : 0u);
   push.reflections = settings.optics.reflections;
   return push;
 }
@@ -758,6 +772,7 @@ uint64_t Renderer::submit(const FrameRequest& request) {
   Update update = planUpdate(pose, request.views, stats);
   vk::Commands& commands = slot.commands;
   commands.begin();
+  if (request.prologue) request.prologue(commands);
   // Frames in flight share the scene's GPU data: what this frame rewrites,
   // the one before may still be reading.
   commands.fullBarrier();

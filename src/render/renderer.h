@@ -102,6 +102,9 @@ struct FrameResult {
 struct FrameRequest {
   const scene::Pose* pose = nullptr;
   std::vector<ViewRequest> views;
+  /// Records work before the frame's own (a host's copy of new vertices into
+  /// the buffers the frame reads); the frame's first barrier makes it visible.
+  std::function<void(vk::Commands&)> prologue;
   /// Records more work after the views (a viewer's display pass and UI),
   /// once every view's images are written.
   std::function<void(vk::Commands&)> record;
@@ -158,6 +161,9 @@ class Renderer {
   /// The host rewrote shape `shape`'s vertices in its buffers (RendererOptions::host):
   /// the next frame refits its tree and redraws every view.
   void markDirty(int shape);
+  /// A host shape's vertices now lie in this box (its space), for culling;
+  /// an empty box (lo > hi) says nothing, and the shape is never culled.
+  void setShapeBounds(int shape, const glm::dvec3& lo, const glm::dvec3& hi);
 
   /// Forces the next frame that needs trees to rebuild every tree.
   void invalidateTrees();
@@ -252,6 +258,8 @@ class Renderer {
     glm::dvec3 centre{0.0};
     double radius = 0.0;
   };
+  /// The sphere around a box; a host shape's empty box (no promise) is never culled.
+  static Sphere boundingSphere(const glm::dvec3& lo, const glm::dvec3& hi, bool host);
   std::vector<Sphere> shapeSpheres_;
   std::vector<std::vector<double>> shapeMorphReach_;  ///< per shape, per target: its largest displacement
   std::vector<Sphere> itemSpheres_;

@@ -35,6 +35,8 @@ struct Optics {
   /// Textures); false reads level 0 everywhere, what the filtering is measured
   /// against (the raster pass filters either way).
   bool textureLod = true;
+  bool dispersion = true;  ///< dispersive materials split the colours (off: none does)
+  bool volume = true;      ///< volumes attenuate (off: every material is thin-walled)
 };
 
 }  // namespace snell::scene

@@ -176,7 +176,7 @@ bool tracePath(vec3 origin, vec3 dir, float width, float spread, int channel, ou
       return false;
     }
     int inside = currentMedium();
-    if (inside >= 0) {  // Beer-Lambert over the segment
+    if (inside >= 0 && (pc.optics & kOpticsVolume) != 0u) {  // Beer-Lambert over the segment
       GpuMaterial volume = materials[media[inside]];
       if (volume.attenuationDistance > 0.0) {
         throughput *= pow(volume.attenuationColor.rgb, vec3(hit.t / volume.attenuationDistance));
@@ -223,7 +223,8 @@ bool tracePath(vec3 origin, vec3 dir, float width, float spread, int channel, ou
       if (outside >= 0) other = media[outside];
     }
     float otherIor = other == kNoHit ? 1.0 : mediumIor(other, channel);
-    bool dispersive = m.dispersion > 0.0 || (other != kNoHit && materials[other].dispersion > 0.0);
+    bool dispersive = (pc.optics & kOpticsDispersion) != 0u &&
+                      (m.dispersion > 0.0 || (other != kNoHit && materials[other].dispersion > 0.0));
     if (boundary && channel < 0 && dispersive) return true;
     float n1 = entering ? otherIor : surface, n2 = entering ? surface : otherIor;
     // Past maxBends the ray crosses glass straight (an approximation's path, not physics).
