@@ -1,0 +1,249 @@
+"""Type stubs for snell's compiled module (python/snell_module.cpp), so editors complete its names."""
+
+from types import TracebackType
+from typing import Any, Optional, Sequence
+
+import numpy as np
+import numpy.typing as npt
+
+Matrix = npt.ArrayLike  # 4x4, numpy (row, column) order, as mathutils.Matrix
+
+class Error(RuntimeError):
+    """Every failure snell reports; the message names the file, array or option at fault."""
+
+def version() -> str:
+    """snell's version, 'major.minor.patch'."""
+
+class Device:
+    """The GPU snell runs on (a Vulkan device of its own)."""
+
+    def __init__(
+        self,
+        device: str = "",
+        validation: bool = False,
+        interop: bool = False,
+        driver_ray_tracing: bool = False,
+    ) -> None: ...
+    @property
+    def name(self) -> str: ...
+    @property
+    def validation_messages(self) -> int: ...
+    @property
+    def exports_semaphores(self) -> bool: ...
+    def close(self) -> None: ...
+    def __enter__(self) -> "Device": ...
+    def __exit__(
+        self,
+        kind: Optional[type],
+        value: Optional[BaseException],
+        traceback: Optional[TracebackType],
+    ) -> None: ...
+
+class Material:
+    """A glTF metallic-roughness material with transmission, IOR and volume (colours linear)."""
+
+    name: str
+    base_color: Sequence[float]
+    base_color_texture: int
+    transmission: float
+    ior: float
+    roughness: float
+    thickness: float
+    attenuation_color: Sequence[float]
+    attenuation_distance: float
+    double_sided: bool
+    emissive: Sequence[float]
+    dispersion: float
+    def __init__(
+        self,
+        name: str = "",
+        base_color: Sequence[float] = (1, 1, 1, 1),
+        base_color_texture: int = -1,
+        transmission: float = 0.0,
+        ior: float = 1.5,
+        roughness: float = 1.0,
+        thickness: float = 0.0,
+        attenuation_color: Sequence[float] = (1, 1, 1),
+        attenuation_distance: float = float("inf"),
+        double_sided: bool = False,
+        emissive: Sequence[float] = (0, 0, 0),
+        dispersion: float = 0.0,
+    ) -> None: ...
+
+class Light:
+    """A punctual light: candela for point and spot lights, lux for directional."""
+
+    type: str
+    color: Sequence[float]
+    intensity: float
+    position: Sequence[float]
+    direction: Sequence[float]
+    inner_cone_angle: float
+    outer_cone_angle: float
+    def __init__(
+        self,
+        type: str = "point",
+        color: Sequence[float] = (1, 1, 1),
+        intensity: float = 1.0,
+        position: Sequence[float] = (0, 0, 0),
+        direction: Sequence[float] = (0, 0, -1),
+        inner_cone_angle: float = 0.0,
+        outer_cone_angle: float = 0.7853982,
+    ) -> None: ...
+
+class Camera:
+    """A camera of a scene made from arrays (View(camera=index) picks it)."""
+
+    orthographic: bool
+    yfov: float
+    ymag: float
+    name: str
+    def __init__(
+        self,
+        transform: Optional[Matrix] = None,
+        orthographic: bool = False,
+        yfov: float = 0.6981317,
+        ymag: float = 1.0,
+        name: str = "",
+    ) -> None: ...
+    @property
+    def transform(self) -> npt.NDArray[np.float64]: ...
+
+class Mesh:
+    """A triangle mesh from numpy arrays, for Scene.from_arrays."""
+
+    material: int
+    name: str
+    def __init__(
+        self,
+        positions: npt.NDArray[np.float32],
+        normals: npt.NDArray[np.float32],
+        indices: npt.NDArray[np.uint32],
+        uvs: Optional[npt.NDArray[np.float32]] = None,
+        material: int = -1,
+        name: str = "",
+    ) -> None: ...
+    @property
+    def positions(self) -> npt.NDArray[np.float32]: ...
+    @property
+    def normals(self) -> npt.NDArray[np.float32]: ...
+    @property
+    def indices(self) -> npt.NDArray[np.uint32]: ...
+    @property
+    def uvs(self) -> Optional[npt.NDArray[np.float32]]: ...
+
+class Instance:
+    """A mesh placed in the world (transform: mesh space to world)."""
+
+    mesh: int
+    def __init__(self, mesh: int, transform: Optional[Matrix] = None) -> None: ...
+    @property
+    def transform(self) -> Optional[Matrix]: ...
+
+class Texture:
+    """An 8-bit sRGB RGBA texture, (height, width, 4) uint8, row 0 at the top."""
+
+    name: str
+    def __init__(self, rgba: npt.NDArray[np.uint8], name: str = "") -> None: ...
+    @property
+    def rgba(self) -> npt.NDArray[np.uint8]: ...
+
+class Scene:
+    """What is drawn: a glTF file, or meshes from numpy arrays."""
+
+    @staticmethod
+    def load(path: str) -> "Scene": ...
+    @staticmethod
+    def from_arrays(
+        meshes: Sequence[Mesh],
+        materials: Sequence[Material] = (),
+        textures: Sequence[Texture] = (),
+        instances: Optional[Sequence[Instance]] = None,
+        lights: Sequence[Light] = (),
+        cameras: Sequence[Camera] = (),
+        name: str = "arrays",
+    ) -> "Scene": ...
+    @property
+    def name(self) -> str: ...
+    @property
+    def mesh_count(self) -> int: ...
+    @property
+    def camera_count(self) -> int: ...
+    @property
+    def duration(self) -> float: ...
+    def vertex_count(self, mesh: int) -> int: ...
+    def close(self) -> None: ...
+    def __enter__(self) -> "Scene": ...
+    def __exit__(self, *args: Any) -> None: ...
+
+class View:
+    """One picture of the scene: its size, camera, method and optics."""
+
+    width: int
+    height: int
+    camera: int
+    viewport: bool
+    method: str
+    max_interfaces: int
+    fresnel: bool
+    dispersion: bool
+    volume: bool
+    background: Sequence[float]
+    transparent_background: bool
+    def __init__(
+        self,
+        width: int = 640,
+        height: int = 480,
+        camera: int = -1,
+        view_matrix: Optional[Matrix] = None,
+        projection: Optional[Matrix] = None,
+        eye: Sequence[float] = (0, 0, 3),
+        target: Sequence[float] = (0, 0, 0),
+        up: Sequence[float] = (0, 1, 0),
+        yfov: float = 0.6981317,
+        viewport: bool = False,
+        method: str = "trace",
+        max_interfaces: int = 8,
+        fresnel: bool = True,
+        dispersion: bool = True,
+        volume: bool = True,
+        background: Sequence[float] = (0.02, 0.02, 0.025),
+        transparent_background: bool = False,
+    ) -> None: ...
+    def set_matrices(self, view_matrix: Matrix, projection: Matrix) -> None: ...
+
+class SharedImage:
+    """An RGBA16F Vulkan image OpenGL imports (GL_EXT_memory_object_fd)."""
+
+    def __init__(self, device: Device, width: int, height: int) -> None: ...
+    def export_memory(self) -> int: ...
+    @property
+    def memory_size(self) -> int: ...
+    @property
+    def dedicated(self) -> bool: ...
+    def close(self) -> None: ...
+
+class Renderer:
+    """Draws views of one scene, updating only what changed between frames."""
+
+    def __init__(self, device: Device, scene: Scene, frames_in_flight: int = 2) -> None: ...
+    @property
+    def instance_count(self) -> int: ...
+    def set_time(self, seconds: float) -> None: ...
+    def set_transform(self, instance: int, transform: Matrix) -> None: ...
+    def mark_dirty(self, mesh: int) -> None: ...
+    def positions(self, mesh: int) -> npt.NDArray[np.float32]: ...
+    def normals(self, mesh: int) -> npt.NDArray[np.float32]: ...
+    def set_vertices(
+        self,
+        mesh: int,
+        positions: npt.NDArray[np.float32],
+        normals: Optional[npt.NDArray[np.float32]] = None,
+    ) -> None: ...
+    def render(self, view: View) -> npt.NDArray[np.float32]: ...
+    def render_into(self, view: View, out: npt.NDArray[np.float32]) -> None: ...
+    def render_to(self, view: View, image: SharedImage) -> None: ...
+    def last_frame(self) -> dict[str, Any]: ...
+    def close(self) -> None: ...
+    def __enter__(self) -> "Renderer": ...
+    def __exit__(self, *args: Any) -> None: ...

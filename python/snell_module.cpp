@@ -1,0 +1,649 @@
+// snell._snell: the public C++ API (include/snell/snell.h) for Python, and
+// nothing below it. Arrays cross as numpy arrays, checked here so a wrong
+// shape, dtype or index is a snell.Error naming the array and what is wrong.
+// The GIL is released while snell waits for the GPU, so the host's other
+// Python threads (a DCC's UI, a farm's heartbeat) keep running.
+#include <snell/snell.h>
+
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include <cmath>
+#include <cstring>
+#include <memory>
+#include <optional>
+#include <string>
+#include <unistd.h>
+#include <vector>
+
+namespace py = pybind11;
+using namespace pybind11::literals;
+
+namespace {
+
+// ------------------------------------------------------------ arrays
+
+// The dtype's name as numpy prints it ("float64").
+std::string dtypeName(const py::array& a) { return py::str(a.dtype()).cast<std::string>(); }
+
+// `value` as a C-contiguous numpy array of `T` with `columns` columns (0: one
+// dimension), or a snell.Error naming `what`: its dtype must be T's already
+// (a silent float64 -> float32 cast would hide a host's mistake).
+template <typename T>
+py::array_t<T, py::array::c_style> checked(const py::handle& value, const std::string& what, size_t columns,
+                                           const char* dtype) {
+  if (!py::isinstance<py::array>(value)) {
+    throw snell::Error(what + " must be a numpy array of " + dtype + ", got " +
+                       py::str(py::type::of(value).attr("__name__")).cast<std::string>());
+  }
+  py::array a = py::reinterpret_borrow<py::array>(value);
+  if (!py::isinstance<py::array_t<T>>(a)) {
+    throw snell::Error(what + " must be " + dtype + ", got " + dtypeName(a) + " (convert with .astype(numpy." + dtype +
+                       "))");
+  }
+  bool shaped = columns == 0 ? a.ndim() == 1 : a.ndim() == 2 && size_t(a.shape(1)) == columns;
+  if (!shaped) {
+    std::string shape = "(";
+    for (py::ssize_t d = 0; d < a.ndim(); ++d) shape += (d ? ", " : "") + std::to_string(a.shape(d));
+    shape += a.ndim() == 1 ? ",)" : ")";
+    throw snell::Error(what + " must have shape " + (columns == 0 ? "(n,)" : "(n, " + std::to_string(columns) + ")") +
+                       ", got " + shape);
+  }
+  return py::array_t<T, py::array::c_style>::ensure(a);
+}
+
+template <typename T>
+std::vector<T> flat(const py::array_t<T, py::array::c_style>& a) {
+  return std::vector<T>(a.data(), a.data() + a.size());
+}
+
+// A 4x4 matrix in numpy's (row, column) order, as printed and as Blender's
+// mathutils.Matrix gives it, to snell's column-major Mat4.
+snell::Mat4 toMat4(const py::handle& value, const std::string& what) {
+  py::array_t<double, py::array::c_style | py::array::forcecast> a;
+  try {
+    a = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(py::array::ensure(value));
+  } catch (const py::error_already_set&) {
+  }
+  if (!a || a.ndim() != 2 || a.shape(0) != 4 || a.shape(1) != 4) throw snell::Error(what + " must be a 4x4 matrix");
+  snell::Mat4 m{};
+  for (int row = 0; row < 4; ++row) {
+    for (int column = 0; column < 4; ++column) {
+      double v = a.at(row, column);
+      if (!std::isfinite(v)) throw snell::Error(what + " is not finite");
+      m[size_t(column * 4 + row)] = float(v);
+    }
+  }
+  return m;
+}
+
+py::array_t<double> fromMat4(const snell::Mat4& m) {
+  py::array_t<double> a({4, 4});
+  for (int row = 0; row < 4; ++row) {
+    for (int column = 0; column < 4; ++column) a.mutable_at(row, column) = m[size_t(column * 4 + row)];
+  }
+  return a;
+}
+
+snell::Vec3 toVec3(const std::vector<float>& v, const std::string& what) {
+  if (v.size() != 3) throw snell::Error(what + " needs 3 numbers, got " + std::to_string(v.size()));
+  return {v[0], v[1], v[2]};
+}
+
+// ------------------------------------------------------------ the objects
+
+// What Python holds: shared, so a renderer keeps its device and scene alive,
+// and a numpy view of kept vertices keeps its renderer alive, whatever order
+// Python drops or closes them in.
+struct PyDevice {
+  std::shared_ptr<snell::Device> device;
+  snell::Device& get() const {
+    if (!device) throw snell::Error("the device is closed");
+    return *device;
+  }
+};
+
+struct PyScene {
+  std::shared_ptr<snell::Scene> scene;
+  snell::Scene& get() const {
+    if (!scene) throw snell::Error("the scene is closed");
+    return *scene;
+  }
+};
+
+struct RendererState {
+  std::shared_ptr<snell::Device> device;
+  std::shared_ptr<snell::Scene> scene;
+  snell::Renderer renderer;
+};
+
+struct PyRenderer {
+  std::shared_ptr<RendererState> state;
+  RendererState& get() const {
+    if (!state) throw snell::Error("the renderer is closed");
+    return *state;
+  }
+};
+
+struct PySharedImage {
+  std::shared_ptr<snell::Device> device;
+  std::unique_ptr<snell::SharedImage> image;
+  snell::SharedImage& get() const {
+    if (!image) throw snell::Error("the shared image is closed");
+    return *image;
+  }
+};
+
+// One mesh of Scene.from_arrays, kept as the caller's arrays until the scene is made.
+struct PyMesh {
+  py::object positions, normals, indices, uvs;
+  int material = -1;
+  std::string name;
+};
+
+struct PyInstance {
+  int mesh = 0;
+  py::object transform;
+};
+
+struct PyTexture {
+  py::object rgba;
+  std::string name;
+};
+
+snell::Light::Type lightType(const std::string& name) {
+  if (name == "point") return snell::Light::Type::Point;
+  if (name == "directional" || name == "sun") return snell::Light::Type::Directional;
+  if (name == "spot") return snell::Light::Type::Spot;
+  throw snell::Error("light type '" + name + "' is not point, directional or spot");
+}
+
+const char* lightTypeName(snell::Light::Type type) {
+  switch (type) {
+    case snell::Light::Type::Directional: return "directional";
+    case snell::Light::Type::Spot: return "spot";
+    default: return "point";
+  }
+}
+
+snell::Scene sceneFromArrays(const std::vector<PyMesh>& meshes, const std::vector<snell::Material>& materials,
+                             const std::vector<PyTexture>& textures, const std::optional<std::vector<PyInstance>>& instances,
+                             const std::vector<snell::Light>& lights, const std::vector<snell::SceneCamera>& cameras,
+                             const std::string& name) {
+  snell::HostScene host;
+  host.name = name;
+  host.materials = materials;
+  host.lights = lights;
+  host.cameras = cameras;
+  for (size_t i = 0; i < textures.size(); ++i) {
+    std::string what = name + ": texture " + std::to_string(i) + " rgba";
+    if (!py::isinstance<py::array>(textures[i].rgba)) throw snell::Error(what + " must be a numpy array of uint8");
+    py::array a = py::reinterpret_borrow<py::array>(textures[i].rgba);
+    if (!py::isinstance<py::array_t<uint8_t>>(a)) throw snell::Error(what + " must be uint8, got " + dtypeName(a));
+    if (a.ndim() != 3 || a.shape(2) != 4 || a.shape(0) == 0 || a.shape(1) == 0) {
+      throw snell::Error(what + " must have shape (height, width, 4)");
+    }
+    auto pixels = py::array_t<uint8_t, py::array::c_style>::ensure(a);
+    host.textures.push_back(snell::Texture{textures[i].name, uint32_t(a.shape(1)), uint32_t(a.shape(0)),
+                                           std::vector<uint8_t>(pixels.data(), pixels.data() + pixels.size())});
+  }
+  for (size_t i = 0; i < meshes.size(); ++i) {
+    const PyMesh& m = meshes[i];
+    std::string what = name + ": mesh " + std::to_string(i) + (m.name.empty() ? "" : " ('" + m.name + "')");
+    auto positions = checked<float>(m.positions, what + " positions", 3, "float32");
+    auto normals = checked<float>(m.normals, what + " normals", 3, "float32");
+    auto indices = checked<uint32_t>(m.indices, what + " indices", 3, "uint32");
+    size_t n = size_t(positions.shape(0));
+    if (size_t(normals.shape(0)) != n) {
+      throw snell::Error(what + ": " + std::to_string(normals.shape(0)) + " normals for " + std::to_string(n) +
+                         " positions");
+    }
+    if (n == 0 || indices.shape(0) == 0) throw snell::Error(what + " has no vertices or no triangles");
+    snell::Mesh mesh;
+    mesh.name = m.name;
+    mesh.vertexCount = uint32_t(n);
+    mesh.material = m.material;
+    mesh.indices = flat(indices);
+    for (size_t k = 0; k < mesh.indices.size(); ++k) {
+      if (mesh.indices[k] >= n) {
+        throw snell::Error(what + " indices: triangle " + std::to_string(k / 3) + " names vertex " +
+                           std::to_string(mesh.indices[k]) + " of " + std::to_string(n));
+      }
+    }
+    if (!m.uvs.is_none()) {
+      auto uvs = checked<float>(m.uvs, what + " uvs", 2, "float32");
+      if (size_t(uvs.shape(0)) != n) {
+        throw snell::Error(what + ": " + std::to_string(uvs.shape(0)) + " uvs for " + std::to_string(n) + " positions");
+      }
+      mesh.texcoords = flat(uvs);
+    }
+    host.meshes.push_back(std::move(mesh));
+    host.vertices.push_back(snell::MeshVertices{flat(positions), flat(normals)});
+  }
+  if (instances) {
+    for (size_t i = 0; i < instances->size(); ++i) {
+      const PyInstance& in = (*instances)[i];
+      snell::Mat4 transform = in.transform.is_none()
+                                  ? snell::kIdentity
+                                  : toMat4(in.transform, name + ": instance " + std::to_string(i) + " transform");
+      host.instances.push_back(snell::Instance{in.mesh, transform});
+    }
+  } else {
+    for (size_t i = 0; i < meshes.size(); ++i) host.instances.push_back(snell::Instance{int(i), snell::kIdentity});
+  }
+  return snell::Scene::fromHost(host);
+}
+
+// The view's pixels as the frame's (h, w, 4) float32 array.
+void checkOutput(const py::array_t<float, py::array::c_style>& out, const snell::View& view) {
+  if (out.ndim() != 3 || out.shape(0) != py::ssize_t(view.height) || out.shape(1) != py::ssize_t(view.width) ||
+      out.shape(2) != 4) {
+    throw snell::Error("render_into: out must have shape (" + std::to_string(view.height) + ", " +
+                       std::to_string(view.width) + ", 4), the view's size");
+  }
+}
+
+py::dict frameDict(const snell::FrameInfo& f) {
+  py::dict passes;
+  double total = 0.0;
+  for (const snell::PassTime& p : f.passes) {
+    passes[py::str(p.name)] = p.milliseconds;
+    total += p.milliseconds;
+  }
+  return py::dict("frame"_a = f.frame, "method"_a = f.method, "skipped"_a = f.skipped,
+                  "items_deformed"_a = f.itemsDeformed, "meshes_uploaded"_a = f.meshesUploaded,
+                  "trees_built"_a = f.treesBuilt, "trees_refit"_a = f.treesRefit, "trees_skipped"_a = f.treesSkipped,
+                  "top_level_built"_a = f.topLevelBuilt, "top_level_refit"_a = f.topLevelRefit,
+                  "pixels_traced"_a = f.pixelsTraced, "dispatches"_a = f.dispatches, "draws"_a = f.draws,
+                  "pass_ms"_a = passes, "gpu_ms"_a = total);
+}
+
+// A writable (count, 3) float32 view of kept vertices whose base keeps the renderer alive.
+py::array vertexView(const std::shared_ptr<RendererState>& state, float* data, uint32_t count) {
+  auto* owner = new std::shared_ptr<RendererState>(state);
+  py::capsule base(owner, [](void* p) { delete static_cast<std::shared_ptr<RendererState>*>(p); });
+  return py::array_t<float>({py::ssize_t(count), py::ssize_t(3)}, data, base);
+}
+
+}  // namespace
+
+PYBIND11_MODULE(_snell, m) {
+  m.doc() = "snell: refraction through deforming meshes, ray traced by Vulkan compute.";
+  py::register_exception<snell::Error>(m, "Error", PyExc_RuntimeError);
+  m.def("version", &snell::version, "snell's version, 'major.minor.patch'.");
+
+  py::class_<PyDevice>(m, "Device", "The GPU snell runs on (a Vulkan device of its own).")
+      .def(py::init([](const std::string& device, bool validation, bool interop, bool driverRayTracing) {
+             snell::DeviceOptions options;
+             options.device = device;
+             options.validation = validation;
+             options.interop = interop;
+             options.driverRayTracing = driverRayTracing;
+             py::gil_scoped_release release;
+             return PyDevice{std::make_shared<snell::Device>(snell::Device::create(options))};
+           }),
+           "device"_a = "", "validation"_a = false, "interop"_a = false, "driver_ray_tracing"_a = false,
+           "Picks a device: `device` is an index or a substring of its name (empty: the SNELL_DEVICE\n"
+           "environment variable, else the first that meets snell's needs). `validation` turns on the\n"
+           "Khronos validation layer; `interop` lets SharedImage hand images to OpenGL;\n"
+           "`driver_ray_tracing` allows the 'driver-rt' method.")
+      .def_property_readonly("name", [](const PyDevice& d) { return d.get().name(); }, "The device's name.")
+      .def_property_readonly("validation_messages", [](const PyDevice& d) { return d.get().validationMessages(); },
+                             "Messages the validation layer reported so far.")
+      .def_property_readonly("exports_semaphores", [](const PyDevice& d) { return d.get().exportsSemaphores(); })
+      .def("close", [](PyDevice& d) { d.device.reset(); },
+           "Lets go of the device; it is destroyed once its renderers are.")
+      .def("__enter__", [](PyDevice& d) -> PyDevice& { return d; })
+      .def("__exit__", [](PyDevice& d, const py::args&) { d.device.reset(); })
+      .def("__repr__", [](const PyDevice& d) {
+        return d.device ? "<snell.Device '" + d.device->name() + "'>" : std::string("<snell.Device (closed)>");
+      });
+
+  py::class_<snell::Material>(m, "Material", "A glTF metallic-roughness material with transmission, IOR and volume.")
+      .def(py::init([](const std::string& name, const std::vector<float>& baseColor, int baseColorTexture,
+                       float transmission, float ior, float roughness, float thickness,
+                       const std::vector<float>& attenuationColor, float attenuationDistance, bool doubleSided,
+                       const std::vector<float>& emissive, float dispersion) {
+             snell::Material mat;
+             mat.name = name;
+             if (baseColor.size() != 3 && baseColor.size() != 4) throw snell::Error("base_color needs 3 or 4 numbers");
+             for (size_t c = 0; c < baseColor.size(); ++c) mat.baseColor[c] = baseColor[c];
+             mat.baseColorTexture = baseColorTexture;
+             mat.transmission = transmission;
+             mat.ior = ior;
+             mat.roughness = roughness;
+             mat.thickness = thickness;
+             mat.attenuationColor = toVec3(attenuationColor, "attenuation_color");
+             mat.attenuationDistance = attenuationDistance;
+             mat.doubleSided = doubleSided;
+             mat.emissive = toVec3(emissive, "emissive");
+             mat.dispersion = dispersion;
+             return mat;
+           }),
+           "name"_a = "", "base_color"_a = std::vector<float>{1, 1, 1, 1}, "base_color_texture"_a = -1,
+           "transmission"_a = 0.0f, "ior"_a = 1.5f, "roughness"_a = 1.0f, "thickness"_a = 0.0f,
+           "attenuation_color"_a = std::vector<float>{1, 1, 1}, "attenuation_distance"_a = INFINITY,
+           "double_sided"_a = false, "emissive"_a = std::vector<float>{0, 0, 0}, "dispersion"_a = 0.0f,
+           "Colours are linear RGB(A). transmission > 0 makes the faces refract; thickness > 0 with\n"
+           "a finite attenuation_distance gives the glass a volume; base_color_texture indexes\n"
+           "Scene.from_arrays' textures.")
+      .def_readwrite("name", &snell::Material::name)
+      .def_readwrite("base_color", &snell::Material::baseColor)
+      .def_readwrite("base_color_texture", &snell::Material::baseColorTexture)
+      .def_readwrite("transmission", &snell::Material::transmission)
+      .def_readwrite("ior", &snell::Material::ior)
+      .def_readwrite("roughness", &snell::Material::roughness)
+      .def_readwrite("thickness", &snell::Material::thickness)
+      .def_readwrite("attenuation_color", &snell::Material::attenuationColor)
+      .def_readwrite("attenuation_distance", &snell::Material::attenuationDistance)
+      .def_readwrite("double_sided", &snell::Material::doubleSided)
+      .def_readwrite("emissive", &snell::Material::emissive)
+      .def_readwrite("dispersion", &snell::Material::dispersion);
+
+  py::class_<snell::Light>(m, "Light", "A punctual light: candela for point and spot lights, lux for directional.")
+      .def(py::init([](const std::string& type, const std::vector<float>& color, float intensity,
+                       const std::vector<float>& position, const std::vector<float>& direction, float inner,
+                       float outer) {
+             snell::Light light;
+             light.type = lightType(type);
+             light.color = toVec3(color, "color");
+             light.intensity = intensity;
+             light.position = toVec3(position, "position");
+             light.direction = toVec3(direction, "direction");
+             light.innerConeAngle = inner;
+             light.outerConeAngle = outer;
+             return light;
+           }),
+           "type"_a = "point", "color"_a = std::vector<float>{1, 1, 1}, "intensity"_a = 1.0f,
+           "position"_a = std::vector<float>{0, 0, 0}, "direction"_a = std::vector<float>{0, 0, -1},
+           "inner_cone_angle"_a = 0.0f, "outer_cone_angle"_a = 0.7853982f,
+           "type: 'point', 'directional' or 'spot'; direction: where it shines (directional, spot);\n"
+           "cone angles in radians (spot).")
+      .def_property("type", [](const snell::Light& l) { return lightTypeName(l.type); },
+                    [](snell::Light& l, const std::string& t) { l.type = lightType(t); })
+      .def_readwrite("color", &snell::Light::color)
+      .def_readwrite("intensity", &snell::Light::intensity)
+      .def_readwrite("position", &snell::Light::position)
+      .def_readwrite("direction", &snell::Light::direction)
+      .def_readwrite("inner_cone_angle", &snell::Light::innerConeAngle)
+      .def_readwrite("outer_cone_angle", &snell::Light::outerConeAngle);
+
+  py::class_<snell::SceneCamera>(m, "Camera", "A camera of a scene made from arrays (View(camera=index) picks it).")
+      .def(py::init([](const py::object& transform, bool orthographic, float yfov, float ymag, const std::string& name) {
+             snell::SceneCamera c;
+             if (!transform.is_none()) c.transform = toMat4(transform, "camera transform");
+             c.orthographic = orthographic;
+             c.yfov = yfov;
+             c.ymag = ymag;
+             c.name = name;
+             return c;
+           }),
+           "transform"_a = py::none(), "orthographic"_a = false, "yfov"_a = 0.6981317f, "ymag"_a = 1.0f,
+           "name"_a = "",
+           "transform: camera to world (4x4, it looks down its -Z, +Y up); yfov in radians\n"
+           "(perspective); ymag: half the view's height (orthographic).")
+      .def_property_readonly("transform", [](const snell::SceneCamera& c) { return fromMat4(c.transform); })
+      .def_readwrite("orthographic", &snell::SceneCamera::orthographic)
+      .def_readwrite("yfov", &snell::SceneCamera::yfov)
+      .def_readwrite("ymag", &snell::SceneCamera::ymag)
+      .def_readwrite("name", &snell::SceneCamera::name);
+
+  py::class_<PyMesh>(m, "Mesh", "A triangle mesh from numpy arrays, for Scene.from_arrays.")
+      .def(py::init([](py::object positions, py::object normals, py::object indices, py::object uvs, int material,
+                       const std::string& name) {
+             return PyMesh{std::move(positions), std::move(normals), std::move(indices), std::move(uvs), material, name};
+           }),
+           "positions"_a, "normals"_a, "indices"_a, "uvs"_a = py::none(), "material"_a = -1, "name"_a = "",
+           "positions and normals: (n, 3) float32; indices: (m, 3) uint32, counted from 0;\n"
+           "uvs: (n, 2) float32 or None; material: an index into the scene's materials (-1: grey).")
+      .def_readonly("positions", &PyMesh::positions)
+      .def_readonly("normals", &PyMesh::normals)
+      .def_readonly("indices", &PyMesh::indices)
+      .def_readonly("uvs", &PyMesh::uvs)
+      .def_readwrite("material", &PyMesh::material)
+      .def_readwrite("name", &PyMesh::name);
+
+  py::class_<PyInstance>(m, "Instance", "A mesh placed in the world.")
+      .def(py::init([](int mesh, py::object transform) { return PyInstance{mesh, std::move(transform)}; }), "mesh"_a,
+           "transform"_a = py::none(), "transform: mesh space to world (4x4; None: the identity).")
+      .def_readwrite("mesh", &PyInstance::mesh)
+      .def_readonly("transform", &PyInstance::transform);
+
+  py::class_<PyTexture>(m, "Texture", "An 8-bit sRGB RGBA texture, row 0 at the top, repeating.")
+      .def(py::init([](py::object rgba, const std::string& name) { return PyTexture{std::move(rgba), name}; }),
+           "rgba"_a, "name"_a = "", "rgba: (height, width, 4) uint8.")
+      .def_readonly("rgba", &PyTexture::rgba)
+      .def_readwrite("name", &PyTexture::name);
+
+  py::class_<PyScene>(m, "Scene", "What is drawn: a glTF file, or meshes from numpy arrays.")
+      .def_static(
+          "load",
+          [](const std::string& path) {
+            py::gil_scoped_release release;
+            return PyScene{std::make_shared<snell::Scene>(snell::Scene::load(path))};
+          },
+          "path"_a, "Loads a glTF 2.0 file (.gltf or .glb); raises snell.Error naming the file and the problem.")
+      .def_static(
+          "from_arrays",
+          [](const std::vector<PyMesh>& meshes, const std::vector<snell::Material>& materials,
+             const std::vector<PyTexture>& textures, const std::optional<std::vector<PyInstance>>& instances,
+             const std::vector<snell::Light>& lights, const std::vector<snell::SceneCamera>& cameras,
+             const std::string& name) {
+            return PyScene{std::make_shared<snell::Scene>(
+                sceneFromArrays(meshes, materials, textures, instances, lights, cameras, name))};
+          },
+          "meshes"_a, "materials"_a = std::vector<snell::Material>{}, "textures"_a = std::vector<PyTexture>{},
+          "instances"_a = py::none(), "lights"_a = std::vector<snell::Light>{},
+          "cameras"_a = std::vector<snell::SceneCamera>{}, "name"_a = "arrays",
+          "A scene of Mesh arrays (copied). instances: Instance list (None: each mesh once, in place).\n"
+          "No lights: a headlight. Each Renderer keeps the vertices, and takes new ones each frame\n"
+          "(Renderer.set_vertices, or writes into Renderer.positions/normals then mark_dirty).")
+      .def_property_readonly("name", [](const PyScene& s) { return s.get().name(); })
+      .def_property_readonly("mesh_count", [](const PyScene& s) { return s.get().meshCount(); })
+      .def_property_readonly("camera_count", [](const PyScene& s) { return s.get().cameraCount(); })
+      .def_property_readonly("duration", [](const PyScene& s) { return s.get().duration(); },
+                             "The longest animation in seconds (0: static).")
+      .def("vertex_count", [](const PyScene& s, int mesh) { return s.get().vertexCount(mesh); }, "mesh"_a)
+      .def("close", [](PyScene& s) { s.scene.reset(); })
+      .def("__enter__", [](PyScene& s) -> PyScene& { return s; })
+      .def("__exit__", [](PyScene& s, const py::args&) { s.scene.reset(); })
+      .def("__repr__", [](const PyScene& s) {
+        return s.scene ? "<snell.Scene '" + s.scene->name() + "', " + std::to_string(s.scene->meshCount()) + " meshes>"
+                       : std::string("<snell.Scene (closed)>");
+      });
+
+  py::class_<snell::View>(m, "View", "One picture of the scene: its size, camera, method and optics.")
+      .def(py::init([](uint32_t width, uint32_t height, int camera, const py::object& viewMatrix,
+                       const py::object& projection, const std::vector<float>& eye, const std::vector<float>& target,
+                       const std::vector<float>& up, float yfov, bool viewport, const std::string& method,
+                       uint32_t maxInterfaces, bool fresnel, bool dispersion, bool volume,
+                       const std::vector<float>& background, bool transparentBackground) {
+             snell::View v;
+             if (width == 0 || height == 0) throw snell::Error("a view needs a size, got " + std::to_string(width) + "x" + std::to_string(height));
+             v.width = width;
+             v.height = height;
+             v.sceneCamera = camera;
+             if (viewMatrix.is_none() != projection.is_none()) throw snell::Error("give view_matrix and projection together");
+             if (!viewMatrix.is_none()) {
+               v.matrices = snell::CameraMatrices{toMat4(viewMatrix, "view_matrix"), toMat4(projection, "projection")};
+             }
+             v.camera.eye = toVec3(eye, "eye");
+             v.camera.target = toVec3(target, "target");
+             v.camera.up = toVec3(up, "up");
+             v.camera.yfov = yfov;
+             v.output = viewport ? snell::View::Output::Viewport : snell::View::Output::Trace;
+             v.method = method;
+             v.maxInterfaces = maxInterfaces;
+             v.fresnel = fresnel;
+             v.dispersion = dispersion;
+             v.volume = volume;
+             v.background = toVec3(background, "background");
+             v.transparentBackground = transparentBackground;
+             return v;
+           }),
+           "width"_a = 640, "height"_a = 480, "camera"_a = -1, "view_matrix"_a = py::none(), "projection"_a = py::none(),
+           "eye"_a = std::vector<float>{0, 0, 3}, "target"_a = std::vector<float>{0, 0, 0},
+           "up"_a = std::vector<float>{0, 1, 0}, "yfov"_a = 0.6981317f, "viewport"_a = false, "method"_a = "trace",
+           "max_interfaces"_a = 8, "fresnel"_a = true, "dispersion"_a = true, "volume"_a = true,
+           "background"_a = std::vector<float>{0.02f, 0.02f, 0.025f}, "transparent_background"_a = false,
+           "The camera: the scene's camera `camera` (an index), else view_matrix (world to camera)\n"
+           "with projection (OpenGL: perspective or orthographic, off-centre for lens shift; its\n"
+           "aspect must be width/height), else a look-at from eye to target with yfov radians.\n"
+           "viewport=True draws the viewport composite: rasterised, with only the glass traced.\n"
+           "method: trace, trace-1, iris-plane, normal-offset, refraction-map, none or driver-rt.")
+      .def_readwrite("width", &snell::View::width)
+      .def_readwrite("height", &snell::View::height)
+      .def_readwrite("camera", &snell::View::sceneCamera)
+      .def_property(
+          "viewport", [](const snell::View& v) { return v.output == snell::View::Output::Viewport; },
+          [](snell::View& v, bool on) { v.output = on ? snell::View::Output::Viewport : snell::View::Output::Trace; })
+      .def_readwrite("method", &snell::View::method)
+      .def_readwrite("max_interfaces", &snell::View::maxInterfaces)
+      .def_readwrite("fresnel", &snell::View::fresnel)
+      .def_readwrite("dispersion", &snell::View::dispersion)
+      .def_readwrite("volume", &snell::View::volume)
+      .def_readwrite("background", &snell::View::background)
+      .def_readwrite("transparent_background", &snell::View::transparentBackground)
+      .def(
+          "set_matrices",
+          [](snell::View& v, const py::object& viewMatrix, const py::object& projection) {
+            v.matrices = snell::CameraMatrices{toMat4(viewMatrix, "view_matrix"), toMat4(projection, "projection")};
+            v.sceneCamera = -1;
+          },
+          "view_matrix"_a, "projection"_a, "Points the view by the host's matrices (a DCC viewport's).");
+
+  py::class_<PySharedImage>(m, "SharedImage",
+                            "A Vulkan image OpenGL imports (GL_EXT_memory_object_fd): a zero-copy viewport.")
+      .def(py::init([](const PyDevice& device, uint32_t width, uint32_t height) {
+             py::gil_scoped_release release;
+             return PySharedImage{device.device,
+                                  std::make_unique<snell::SharedImage>(device.get(), width, height,
+                                                                       VK_FORMAT_R16G16B16A16_SFLOAT)};
+           }),
+           "device"_a, "width"_a, "height"_a,
+           "An RGBA16F image (GL_RGBA16F, optimal tiling) on a Device made with interop=True.")
+      .def("export_memory", [](const PySharedImage& s) { return s.get().exportMemory(); },
+           "A new file descriptor of the image's memory, for glImportMemoryFdEXT (which owns it after).")
+      .def_property_readonly("memory_size", [](const PySharedImage& s) { return s.get().memorySize(); })
+      .def_property_readonly("dedicated", [](const PySharedImage& s) { return s.get().dedicated(); })
+      .def("close", [](PySharedImage& s) { s.image.reset(); });
+
+  py::class_<PyRenderer>(m, "Renderer", "Draws views of one scene, updating only what changed between frames.")
+      .def(py::init([](const PyDevice& device, const PyScene& scene, uint32_t framesInFlight) {
+             snell::RendererOptions options;
+             options.framesInFlight = framesInFlight;
+             std::shared_ptr<snell::Device> d = device.device;
+             std::shared_ptr<snell::Scene> s = scene.scene;
+             if (!d) throw snell::Error("the device is closed");
+             if (!s) throw snell::Error("the scene is closed");
+             py::gil_scoped_release release;
+             snell::Renderer r(*d, *s, options);
+             return PyRenderer{std::make_shared<RendererState>(RendererState{d, s, std::move(r)})};
+           }),
+           "device"_a, "scene"_a, "frames_in_flight"_a = 2, "Uploads the scene to the device.")
+      .def("set_time", [](PyRenderer& r, double seconds) { r.get().renderer.setTime(seconds); }, "seconds"_a,
+           "Poses a glTF scene at `seconds` (animations, morphs, skins).")
+      .def_property_readonly("instance_count", [](const PyRenderer& r) { return r.get().renderer.instanceCount(); })
+      .def(
+          "set_transform",
+          [](PyRenderer& r, size_t instance, const py::object& matrix) {
+            r.get().renderer.setTransform(instance, toMat4(matrix, "transform"));
+          },
+          "instance"_a, "transform"_a, "Moves an instance (4x4, mesh space to world): only the top-level tree is refit.")
+      .def("mark_dirty", [](PyRenderer& r, int mesh) { r.get().renderer.markDirty(mesh); }, "mesh"_a,
+           "Says mesh `mesh`'s vertices were rewritten (positions()/normals() views): the next frame\n"
+           "copies them to the GPU and refits that mesh's tree alone.")
+      .def(
+          "positions",
+          [](PyRenderer& r, int mesh) {
+            snell::Vertices v = r.get().renderer.vertices(mesh);
+            return vertexView(r.state, v.positions, v.count);
+          },
+          "mesh"_a,
+          "A writable (n, 3) float32 view of a kept mesh's positions in snell's mapped memory:\n"
+          "write them in place (numpy.take(..., out=) included), then mark_dirty(mesh).")
+      .def(
+          "normals",
+          [](PyRenderer& r, int mesh) {
+            snell::Vertices v = r.get().renderer.vertices(mesh);
+            return vertexView(r.state, v.normals, v.count);
+          },
+          "mesh"_a, "The same for the normals (unit length).")
+      .def(
+          "set_vertices",
+          [](PyRenderer& r, int mesh, const py::object& positions, const py::object& normals) {
+            RendererState& state = r.get();
+            snell::Vertices v = state.renderer.vertices(mesh);
+            std::string what = "set_vertices: mesh " + std::to_string(mesh);
+            auto p = checked<float>(positions, what + " positions", 3, "float32");
+            if (size_t(p.shape(0)) != v.count) {
+              throw snell::Error(what + " positions: " + std::to_string(p.shape(0)) + " rows for the mesh's " +
+                                 std::to_string(v.count) + " vertices");
+            }
+            std::optional<py::array_t<float, py::array::c_style>> n;
+            if (!normals.is_none()) {
+              n = checked<float>(normals, what + " normals", 3, "float32");
+              if (size_t(n->shape(0)) != v.count) {
+                throw snell::Error(what + " normals: " + std::to_string(n->shape(0)) + " rows for the mesh's " +
+                                   std::to_string(v.count) + " vertices");
+              }
+            }
+            {
+              py::gil_scoped_release release;
+              std::memcpy(v.positions, p.data(), size_t(v.count) * 12);
+              if (n) std::memcpy(v.normals, n->data(), size_t(v.count) * 12);
+            }
+            state.renderer.markDirty(mesh);
+          },
+          "mesh"_a, "positions"_a, "normals"_a = py::none(),
+          "Copies new (n, 3) float32 positions (and normals) of a kept mesh into snell and marks it dirty.")
+      .def(
+          "render",
+          [](PyRenderer& r, const snell::View& view) {
+            RendererState& state = r.get();
+            py::array_t<float> out({py::ssize_t(view.height), py::ssize_t(view.width), py::ssize_t(4)});
+            float* data = out.mutable_data();
+            py::gil_scoped_release release;
+            state.renderer.read(view, data);
+            return out;
+          },
+          "view"_a,
+          "Renders `view` and returns it as a (height, width, 4) float32 array: scene-linear Rec.709\n"
+          "RGBA, row 0 at the top.")
+      .def(
+          "render_into",
+          [](PyRenderer& r, const snell::View& view, const py::object& out) {
+            RendererState& state = r.get();
+            if (!py::isinstance<py::array_t<float>>(out)) {
+              throw snell::Error("render_into: out must be a numpy float32 array");
+            }
+            py::array a = py::reinterpret_borrow<py::array>(out);
+            if (!a.writeable() || !(a.flags() & py::array::c_style)) {
+              throw snell::Error("render_into: out must be writable and C-contiguous");
+            }
+            auto target = py::reinterpret_borrow<py::array_t<float, py::array::c_style>>(out);
+            checkOutput(target, view);
+            float* data = target.mutable_data();
+            py::gil_scoped_release release;
+            state.renderer.read(view, data);
+          },
+          "view"_a, "out"_a, "Renders `view` into a preallocated (height, width, 4) float32 array.")
+      .def(
+          "render_to",
+          [](PyRenderer& r, const snell::View& view, const PySharedImage& image) {
+            RendererState& state = r.get();
+            snell::SharedImage& shared = image.get();
+            snell::Target target = shared.target(VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
+            py::gil_scoped_release release;
+            state.renderer.wait(state.renderer.render(view, target));
+          },
+          "view"_a, "image"_a,
+          "Renders `view` into a SharedImage and waits for the GPU: the pixels never visit the host.")
+      .def("last_frame", [](const PyRenderer& r) { return frameDict(r.get().renderer.lastFrame()); },
+           "What the last frame did: counters and per-pass GPU milliseconds (pass_ms, gpu_ms).")
+      .def("close", [](PyRenderer& r) { r.state.reset(); },
+           "Lets go of the renderer's GPU memory (once no vertex view holds it).")
+      .def("__enter__", [](PyRenderer& r) -> PyRenderer& { return r; })
+      .def("__exit__", [](PyRenderer& r, const py::args&) { r.state.reset(); });
+}
