@@ -1,0 +1,75 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
+"""The add-on's settings: per scene (how glass is drawn) and per user (where snell is)."""
+
+from __future__ import annotations
+
+import bpy
+
+METHODS = [
+    ("trace", "Trace", "Ray traced through the deformed mesh, every refraction (the talk's approach)"),
+    ("trace-1", "Trace, one bend", "Ray traced, bending at the first glass face only"),
+    ("iris-plane", "Iris plane", "Refracted once onto the plane behind the glass; no trace"),
+    ("normal-offset", "Normal offset", "The picture behind the glass displaced by the normal; no trace"),
+    ("refraction-map", "Refraction map", "A map baked by the trace once, read as the scene moves"),
+    ("none", "None", "Glass seen straight through"),
+]
+
+
+class SnellSceneSettings(bpy.types.PropertyGroup):
+    """How snell draws a scene's glass (Render Properties > snell)."""
+
+    method: bpy.props.EnumProperty(name="Method", items=METHODS, default="trace",
+                                   description="How refraction through glass is drawn")
+    max_interfaces: bpy.props.IntProperty(name="Max Interfaces", default=8, min=0, max=1024,
+                                          description="Glass faces a ray may cross before it ends as a miss")
+    fresnel: bpy.props.BoolProperty(name="Fresnel", default=True,
+                                    description="Glass reflects as well as refracts: highlights, catch lights")
+    dispersion: bpy.props.BoolProperty(name="Dispersion", default=True,
+                                       description="Dispersive glass splits the colours")
+    volume: bpy.props.BoolProperty(name="Volume", default=True,
+                                   description="Volume Absorption tints the light inside thick glass")
+    display: bpy.props.EnumProperty(
+        name="Display", default="AUTO",
+        items=[("AUTO", "Interop if possible", "OpenGL imports snell's image (GL_EXT_memory_object_fd): no copy"),
+               ("UPLOAD", "Upload", "Pixels come back to the host and go up as a texture (always works)")],
+        description="How the viewport gets snell's image")
+    overlay: bpy.props.BoolProperty(name="Overlay", default=True,
+                                    description="A line in the viewport says how the image was drawn and what it cost")
+
+
+class SnellPreferences(bpy.types.AddonPreferences):
+    """Where the `snell` Python module is, when it is not installed for Blender's Python."""
+
+    bl_idname = __package__
+
+    module_path: bpy.props.StringProperty(
+        name="snell module folder", subtype="DIR_PATH", default="",
+        description="The folder holding the snell package (e.g. <checkout>/build/release/python); "
+                    "empty: the Python module installed with `cmake --install`")
+    device: bpy.props.StringProperty(
+        name="Device", default="",
+        description="A Vulkan device index or name substring; empty: SNELL_DEVICE, else the first that fits")
+
+    def draw(self, context) -> None:
+        from . import runtime
+
+        self.layout.prop(self, "module_path")
+        self.layout.prop(self, "device")
+        status = runtime.status()
+        self.layout.label(text=status, icon="INFO" if runtime.problem() is None else "ERROR")
+
+
+def settings(scene) -> SnellSceneSettings:
+    return scene.snell
+
+
+def register() -> None:
+    bpy.utils.register_class(SnellSceneSettings)
+    bpy.utils.register_class(SnellPreferences)
+    bpy.types.Scene.snell = bpy.props.PointerProperty(type=SnellSceneSettings)
+
+
+def unregister() -> None:
+    del bpy.types.Scene.snell
+    bpy.utils.unregister_class(SnellPreferences)
+    bpy.utils.unregister_class(SnellSceneSettings)

@@ -1,0 +1,275 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
+"""Blender's evaluated scene as a snell scene and renderer, kept in step.
+
+The topology (which objects, their triangles, materials, lights) goes to
+snell once; after that a frame sends only the evaluated (deformed: armature,
+shape keys, modifiers) positions and normals of the objects Blender
+re-evaluated, written straight into snell's mapped vertex memory, and the
+transforms that moved. Anything else that changes (a material, a light,
+the number of vertices) rebuilds the snell scene.
+
+Vertices are Blender's face corners (loops), as the glTF exporter splits
+them: a corner carries its vertex's position, its split normal (smooth,
+flat or custom, what the viewport shows) and its UV. Each material slot of
+an object is one snell mesh.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+from typing import Optional
+
+import numpy as np
+
+from . import convert
+
+
+@dataclass
+class MeshPart:
+    """The triangles of one object that use one material: one snell mesh."""
+
+    mesh: int                 # snell mesh index
+    loops: np.ndarray         # the object's loops this part uses (its vertices, in order)
+    vertex_of_loop: np.ndarray  # their Blender vertex indices
+    positions: Optional[np.ndarray] = None  # snell's mapped (n, 3) views, once a renderer exists
+    normals: Optional[np.ndarray] = None
+
+
+@dataclass
+class ObjectGeometry:
+    """One evaluated object's geometry as snell meshes."""
+
+    name: str
+    vertex_count: int
+    loop_count: int
+    parts: list = field(default_factory=list)
+    co: Optional[np.ndarray] = None           # (vertices, 3) scratch for foreach_get
+    loop_normals: Optional[np.ndarray] = None  # (loops, 3) scratch
+
+
+class TopologyChanged(Exception):
+    """The scene changed in a way new vertices cannot say: build it again."""
+
+
+def _instance_key(instance) -> tuple:
+    """A stable key for a depsgraph object instance."""
+    if instance.is_instance:
+        return (instance.parent.original.name, instance.object.original.name, tuple(instance.persistent_id))
+    return (instance.object.original.name,)
+
+
+# Blender's world is Z-up, snell's (glTF's) Y-up: the studio gradient that glass
+# reflects has its sky at +Y. Everything goes to snell through this rotation,
+# the glTF exporter's own: (x, y, z) -> (x, z, -y).
+Y_UP = np.array([[1, 0, 0, 0], [0, 0, 1, 0], [0, -1, 0, 0], [0, 0, 0, 1]], np.float64)
+
+
+def _matrix(m) -> np.ndarray:
+    """A Blender matrix in snell's Y-up world."""
+    return Y_UP @ np.array([list(row) for row in m], np.float64)
+
+
+def _read_mesh(obj):
+    """The evaluated object's mesh with loop triangles and split normals computed (to_mesh_clear after)."""
+    mesh = obj.to_mesh()
+    if mesh is None:
+        return None
+    mesh.calc_loop_triangles()
+    mesh.calc_normals_split()
+    return mesh
+
+
+class SceneSync:
+    """A snell scene and renderer built from a depsgraph, updated from its later states."""
+
+    def __init__(self, device, depsgraph) -> None:
+        import snell
+
+        started = time.perf_counter()
+        self.device = device
+        self.geometry: dict[str, ObjectGeometry] = {}
+        self.instances: dict[tuple, tuple] = {}  # key -> (object name, [snell instance per part], matrix)
+        self.notes: set[str] = set()
+        meshes, materials, textures, lights = [], [], [], []
+        material_index: dict[str, int] = {}
+        image_cache: dict[str, int] = {}
+        placed = []  # (mesh, transform)
+
+        for instance in depsgraph.object_instances:
+            obj = instance.object
+            matrix = _matrix(instance.matrix_world)
+            if obj.type == "LIGHT":
+                light, note = convert.light_of(obj, _matrix(instance.matrix_world))
+                lights.append(light)
+                if note:
+                    self.notes.add(note)
+                continue
+            if obj.type not in ("MESH", "CURVE", "SURFACE", "META", "FONT"):
+                continue
+            name = obj.original.name
+            geometry = self.geometry.get(name)
+            if geometry is None:
+                geometry = self._topology(obj, meshes, materials, material_index, image_cache, textures)
+                if geometry is None:
+                    continue
+                self.geometry[name] = geometry
+            key = _instance_key(instance)
+            first = len(placed)
+            for part in geometry.parts:
+                placed.append((part.mesh, matrix))
+            self.instances[key] = (name, list(range(first, len(placed))), matrix)
+
+        scene = depsgraph.scene
+        self.background = convert.background_of(scene.world)
+        self.empty = not meshes
+        if self.empty:  # snell needs a mesh: a degenerate one draws nothing
+            zero = np.zeros((3, 3), np.float32)
+            meshes.append(snell.Mesh(zero, np.tile(np.float32([0, 0, 1]), (3, 1)), np.uint32([[0, 1, 2]])))
+            placed.append((0, np.eye(4)))
+        instances = [snell.Instance(mesh, matrix) for mesh, matrix in placed]
+        # What went to snell, for tools that replay the feed elsewhere (bench/record_blender_feed.py).
+        self.arrays = {"meshes": meshes, "materials": materials, "textures": textures, "lights": lights,
+                       "instances": instances}
+        self.scene = snell.Scene.from_arrays(meshes, materials=materials, textures=textures, lights=lights,
+                                             instances=instances, name=scene.name)
+        self.renderer = snell.Renderer(device, self.scene)
+        for geometry in self.geometry.values():
+            for part in geometry.parts:
+                part.positions = self.renderer.positions(part.mesh)
+                part.normals = self.renderer.normals(part.mesh)
+        self.build_seconds = time.perf_counter() - started
+
+    def _topology(self, obj, meshes, materials, material_index, image_cache, textures) -> Optional[ObjectGeometry]:
+        """Adds an object's meshes (one per material slot it uses) with their current vertices."""
+        import snell
+
+        mesh = _read_mesh(obj)
+        if mesh is None or len(mesh.loop_triangles) == 0:
+            if mesh is not None:
+                obj.to_mesh_clear()
+            return None
+        try:
+            triangles = len(mesh.loop_triangles)
+            tri_loops = np.empty(triangles * 3, np.int32)
+            mesh.loop_triangles.foreach_get("loops", tri_loops)
+            tri_loops = tri_loops.reshape(-1, 3)
+            tri_material = np.empty(triangles, np.int32)
+            mesh.loop_triangles.foreach_get("material_index", tri_material)
+            loop_vertex = np.empty(len(mesh.loops), np.int32)
+            mesh.loops.foreach_get("vertex_index", loop_vertex)
+            uvs = None
+            if mesh.uv_layers.active is not None:
+                uvs = np.empty(len(mesh.loops) * 2, np.float32)
+                mesh.uv_layers.active.data.foreach_get("uv", uvs)
+                uvs = uvs.reshape(-1, 2)
+                uvs[:, 1] = 1.0 - uvs[:, 1]  # glTF's v runs down the image
+            geometry = ObjectGeometry(obj.original.name, len(mesh.vertices), len(mesh.loops))
+            co, loop_normals = self._read_vertices(mesh, geometry)
+            for slot in np.unique(tri_material):
+                loops, remapped = np.unique(tri_loops[tri_material == slot], return_inverse=True)
+                blender_material = obj.material_slots[slot].material if slot < len(obj.material_slots) else None
+                key = blender_material.name if blender_material is not None else ""
+                if key not in material_index:
+                    materials.append(convert.material_of(blender_material, image_cache, textures))
+                    material_index[key] = len(materials) - 1
+                part = MeshPart(len(meshes), loops.astype(np.int32), loop_vertex[loops])
+                meshes.append(snell.Mesh(
+                    np.ascontiguousarray(co[part.vertex_of_loop]), np.ascontiguousarray(loop_normals[loops]),
+                    remapped.reshape(-1, 3).astype(np.uint32),
+                    None if uvs is None else np.ascontiguousarray(uvs[loops]),
+                    material=material_index[key], name=f"{obj.original.name}/{key}"))
+                geometry.parts.append(part)
+            return geometry
+        finally:
+            obj.to_mesh_clear()
+
+    @staticmethod
+    def _read_vertices(mesh, geometry: ObjectGeometry) -> tuple:
+        """The mesh's vertex positions and loop normals into the object's scratch arrays."""
+        if geometry.co is None:
+            geometry.co = np.empty((geometry.vertex_count, 3), np.float32)
+            geometry.loop_normals = np.empty((geometry.loop_count, 3), np.float32)
+        mesh.vertices.foreach_get("co", geometry.co.reshape(-1))
+        mesh.loops.foreach_get("normal", geometry.loop_normals.reshape(-1))
+        return geometry.co, geometry.loop_normals
+
+    def send_vertices(self, obj) -> None:
+        """Writes an evaluated object's new vertices into snell's memory and marks its meshes dirty."""
+        geometry = self.geometry[obj.original.name]
+        mesh = _read_mesh(obj)
+        try:
+            if mesh is None or len(mesh.vertices) != geometry.vertex_count or len(mesh.loops) != geometry.loop_count:
+                raise TopologyChanged(f"{obj.original.name}'s topology changed")
+            co, loop_normals = self._read_vertices(mesh, geometry)
+        finally:
+            obj.to_mesh_clear()
+        for part in geometry.parts:
+            np.take(co, part.vertex_of_loop, axis=0, out=part.positions)
+            np.take(loop_normals, part.loops, axis=0, out=part.normals)
+            self.renderer.mark_dirty(part.mesh)
+
+    def send_every_mesh(self, depsgraph) -> list:
+        """Sends every object's evaluated vertices, whatever changed (a frame of a render; no update list)."""
+        sent = []
+        for instance in depsgraph.object_instances:
+            name = instance.object.original.name
+            if name in self.geometry and name not in sent and not instance.is_instance:
+                self.send_vertices(instance.object)
+                sent.append(name)
+        self._update_transforms(depsgraph)
+        return sent
+
+    def update(self, depsgraph) -> dict:
+        """Brings the renderer up to the depsgraph's state; returns what was sent.
+
+        Raises TopologyChanged when only a rebuild can say what changed.
+        """
+        started = time.perf_counter()
+        sent = []
+        for update in depsgraph.updates:
+            data = update.id
+            kind = type(data).__name__
+            if kind in ("Material", "Light", "World", "Image", "NodeTree"):
+                raise TopologyChanged(f"{kind} {data.name} changed")
+            if kind == "Object" and data.type == "LIGHT" and (update.is_updated_geometry or update.is_updated_transform):
+                raise TopologyChanged(f"light {data.name} changed")  # lights are part of snell's scene
+            if kind == "Object" and update.is_updated_geometry:
+                obj = data
+                if obj.original.name in self.geometry:
+                    self.send_vertices(obj)
+                    sent.append(obj.original.name)
+        moved = self._update_transforms(depsgraph)
+        return {"meshes_sent": sent, "instances_moved": moved, "feed_ms": (time.perf_counter() - started) * 1000}
+
+    def _update_transforms(self, depsgraph) -> int:
+        """Sets the transforms of instances that moved; a light that moved, or a new instance, rebuilds."""
+        moved, seen = 0, 0
+        for instance in depsgraph.object_instances:
+            obj = instance.object
+            if obj.type == "LIGHT":
+                continue  # light positions are in the scene: a moved light comes as a Light/Object update
+            key = _instance_key(instance)
+            entry = self.instances.get(key)
+            if entry is None:
+                if obj.type in ("MESH", "CURVE", "SURFACE", "META", "FONT"):
+                    raise TopologyChanged(f"{obj.name} appeared")
+                continue
+            seen += 1
+            matrix = _matrix(instance.matrix_world)
+            name, placed, old = entry
+            if not np.array_equal(matrix, old):
+                for index in placed:
+                    self.renderer.set_transform(index, matrix)
+                self.instances[key] = (name, placed, matrix)
+                moved += 1
+        if seen != len(self.instances):
+            raise TopologyChanged("an object was hidden or deleted")
+        return moved
+
+    def close(self) -> None:
+        for geometry in self.geometry.values():
+            for part in geometry.parts:
+                part.positions = part.normals = None
+        self.renderer.close()
+        self.scene.close()

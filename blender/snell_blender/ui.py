@@ -1,0 +1,70 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
+"""The Render Properties panel: how glass is drawn, and whether snell is ready."""
+
+from __future__ import annotations
+
+import bpy
+
+from . import runtime
+from .runtime import AREA_LIGHT_NOTE
+
+
+class SNELL_PT_render(bpy.types.Panel):
+    """Render Properties > snell."""
+
+    bl_label = "snell"
+    bl_space_type = "PROPERTIES"
+    bl_region_type = "WINDOW"
+    bl_context = "render"
+    COMPAT_ENGINES = {"SNELL"}
+
+    @classmethod
+    def poll(cls, context) -> bool:
+        return context.engine in cls.COMPAT_ENGINES
+
+    def draw(self, context) -> None:
+        layout = self.layout
+        layout.use_property_split = True
+        options = context.scene.snell
+        problem = runtime.problem()
+        layout.label(text=runtime.status(), icon="ERROR" if problem else "INFO")
+        layout.prop(options, "method")
+        layout.prop(options, "max_interfaces")
+        column = layout.column(heading="Optics")
+        column.prop(options, "fresnel")
+        column.prop(options, "dispersion")
+        column.prop(options, "volume")
+        layout.prop(options, "display")
+        layout.prop(options, "overlay")
+        if any(o.type == "LIGHT" and o.data.type == "AREA" for o in context.scene.objects):
+            layout.label(text=AREA_LIGHT_NOTE.capitalize(), icon="LIGHT_AREA")
+        if problem:
+            layout.operator("snell.retry", icon="FILE_REFRESH")
+
+
+class SNELL_OT_retry(bpy.types.Operator):
+    """Look for the snell module and a Vulkan device again"""
+
+    bl_idname = "snell.retry"
+    bl_label = "Try Again"
+
+    def execute(self, context):
+        runtime.retry()
+        if runtime.device() is None:
+            self.report({"ERROR"}, f"snell: {runtime.problem()}")
+            return {"CANCELLED"}
+        self.report({"INFO"}, runtime.status())
+        return {"FINISHED"}
+
+
+classes = (SNELL_PT_render, SNELL_OT_retry)
+
+
+def register() -> None:
+    for cls in classes:
+        bpy.utils.register_class(cls)
+
+
+def unregister() -> None:
+    for cls in reversed(classes):
+        bpy.utils.unregister_class(cls)

@@ -1,0 +1,88 @@
+"""Shared by the add-on's tests, which run inside Blender (tests/CMakeLists.txt starts them).
+
+ctest sets SNELL_BINARY (the command line), SNELL_PYTHON_DIR (the built
+module's folder) and SNELL_TEST_DIR (a scratch folder of the test's own).
+"""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import bpy
+import numpy as np
+
+SOURCE = Path(__file__).resolve().parents[2]
+SCRATCH = Path(os.environ.get("SNELL_TEST_DIR", "/tmp/snell_blender_test"))
+SNELL = os.environ.get("SNELL_BINARY", str(SOURCE / "build" / "release" / "snell"))
+sys.path.insert(0, str(SOURCE / "blender"))
+
+import demo_eye_rig  # noqa: E402  (from the checkout's blender/ folder, put on the path above)
+
+
+def enable_addon(module_path: str | None = None) -> None:
+    """The add-on from the checkout, with the snell module from the build (or `module_path`)."""
+    import addon_utils
+
+    addon_utils.enable("snell_blender", default_set=True)
+    prefs = bpy.context.preferences.addons["snell_blender"].preferences
+    prefs.module_path = module_path if module_path is not None else os.environ.get("SNELL_PYTHON_DIR", "")
+    from snell_blender import runtime
+
+    runtime.retry()
+
+
+def demo_scene(width: int, height: int):
+    """The demo rig in the current scene, rendered by snell at width x height."""
+    enable_addon()
+    rig = demo_eye_rig.build()
+    scene = bpy.context.scene
+    scene.render.engine = "SNELL"
+    scene.render.resolution_x, scene.render.resolution_y = width, height
+    scene.render.resolution_percentage = 100
+    scene.view_settings.view_transform = "Standard"
+    scene.view_settings.look = "None"
+    scene.render.dither_intensity = 0.0
+    return scene, rig
+
+
+def pixels(path: Path) -> np.ndarray:
+    """An image file as Blender reads it: (height, width, 4) floats, row 0 at the top."""
+    image = bpy.data.images.load(str(path), check_existing=False)
+    width, height = image.size
+    values = np.empty(width * height * 4, np.float32)
+    image.pixels.foreach_get(values)
+    bpy.data.images.remove(image)
+    return values.reshape(height, width, 4)[::-1]
+
+
+def srgb(linear: np.ndarray) -> np.ndarray:
+    """Linear RGB to sRGB-encoded values in [0, 1] (what a display shows)."""
+    c = np.clip(linear[..., :3].astype(np.float64), 0.0, 1.0)
+    return np.where(c <= 0.0031308, 12.92 * c, 1.055 * np.power(c, 1.0 / 2.4) - 0.055)
+
+
+def render_f12(path: Path) -> np.ndarray:
+    """F12 at the scene's current frame, saved as a 32-bit EXR (linear) and read back."""
+    scene = bpy.context.scene
+    scene.render.image_settings.file_format = "OPEN_EXR"
+    scene.render.image_settings.color_depth = "32"
+    bpy.ops.render.render(write_still=False)
+    bpy.data.images["Render Result"].save_render(str(path))
+    return pixels(path)
+
+
+def snell(*args) -> None:
+    """Runs snell's command line; a failure fails the test with its message."""
+    done = subprocess.run([SNELL, "--quiet", *map(str, args)], capture_output=True, text=True, timeout=300)
+    if done.returncode != 0:
+        raise AssertionError(f"snell {' '.join(map(str, args))} exited {done.returncode}: {done.stderr}")
+
+
+def check(condition: bool, message: str) -> None:
+    """Fails the test (the script's exception makes Blender exit 1) unless `condition`."""
+    print(("ok: " if condition else "FAILED: ") + message, flush=True)
+    if not condition:
+        raise AssertionError(message)
