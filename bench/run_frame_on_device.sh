@@ -12,6 +12,9 @@
 #   bench/run_frame_on_device.sh maps    # refraction-map beside the trace and the raster methods (1920x1080), drift table
 #   bench/run_frame_on_device.sh robust  # the long runs: bench frame --soak (validation on) on the GPU while the
 #                                        # libFuzzer targets (carried in .fuzz/) run on the other cores
+#   bench/run_frame_on_device.sh python  # the Python module, built there for its python3 against the carried
+#                                        # install (.carry/prefix), replaying the Blender feed in .carry/feed
+#                                        # (bench/record_blender_feed.py), beside bench frame of the rig's glTF
 # Results land in $OUT.
 set -uo pipefail
 for f in .gl/*.deb; do dpkg -x "$f" /; done
@@ -120,4 +123,18 @@ if [[ $step == all || $step == textures ]]; then
   for m in .assets/gltf/LightsPunctualLamp/glTF/LightsPunctualLamp.gltf .assets/gltf/GlassVaseFlowers/glTF-Binary/*.glb; do
     for run in 1 2 3; do .carry/snell info "$m" --timings | grep -E "texture memory|load times"; done
   done 2>&1 | tee "$OUT/textures.log"
+fi
+if [[ $step == python ]]; then
+  {
+    python3 --version
+    # pip's pybind11 and the machine's own CPython: the module is rebuilt there from python/.
+    cmake -S python -B /tmp/pybuild -G Ninja -DCMAKE_BUILD_TYPE=Release -DPython_EXECUTABLE="$(command -v python3)" \
+      -Dsnell_DIR="$PWD/.carry/prefix/lib/cmake/snell" -Dpybind11_DIR="$(python3 -m pybind11 --cmakedir)" >/tmp/pybuild.log 2>&1 &&
+      cmake --build /tmp/pybuild >>/tmp/pybuild.log 2>&1 || { echo "the module did not build:"; tail -30 /tmp/pybuild.log; }
+    echo "== the module replaying the Blender add-on's feed, 1920x1080 viewport composite"
+    PYTHONPATH=/tmp/pybuild/python PYTHONUNBUFFERED=1 python3 bench/python_frame.py .carry/feed --frames 48 \
+      --json "$OUT/python-frame.json"
+    echo "== snell bench frame of Blender's glTF export of the same rig, same size"
+    .carry/snell bench frame .carry/feed/rig.glb --viewport --size 1920x1080 --warmup 200 --frames 48 --json "$OUT/frame-rig.json"
+  } 2>&1 | tee "$OUT/python.log"
 fi

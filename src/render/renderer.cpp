@@ -76,10 +76,12 @@ struct Renderer::Slot {
   struct ViewReadback {
     size_t view = 0;
     uint32_t width = 0, height = 0;
-    bool composite = false, aov = false, half = false;
-    vk::Buffer pixels;  ///< trace image, then composite, then AOV
+    bool trace = true, composite = false, aov = false, half = false;
+    vk::Buffer pixels;  ///< trace image (when asked for), then composite, then AOV
   };
   std::vector<ViewReadback> readbacks;
+  /// Readback buffers of earlier frames, reused: a fresh mapped allocation each frame costs the host more than the copy.
+  std::vector<vk::Buffer> spareReadbacks;
   std::vector<size_t> maskedViews;  ///< views whose pixel count the GPU counted (index into the frame's views)
 };
 
@@ -670,18 +672,27 @@ void Renderer::recordView(vk::Commands& commands, Slot& slot, size_t index, cons
   rb.width = settings.width;
   rb.height = settings.height;
   rb.composite = request.output == ViewOutput::Composite;
+  rb.trace = !rb.composite || request.readbackTrace;
   rb.aov = request.aov;
   rb.half = request.halfReadback;
   VkDeviceSize pixels = VkDeviceSize(settings.width) * settings.height;
-  VkDeviceSize bytes = pixels * 8 * (rb.composite ? 2 : 1) + (rb.aov ? pixels * sizeof(gpu::TraceAov) : 0);
-  rb.pixels = vk::Buffer(context_, {bytes, VK_BUFFER_USAGE_TRANSFER_DST_BIT, vk::MemoryDomain::Readback,
-                                    "view " + std::to_string(index) + " readback"});
+  VkDeviceSize images = pixels * 8 * ((rb.trace ? 1 : 0) + (rb.composite ? 1 : 0));
+  VkDeviceSize bytes = images + (rb.aov ? pixels * sizeof(gpu::TraceAov) : 0);
+  auto spare = std::find_if(slot.spareReadbacks.begin(), slot.spareReadbacks.end(),
+                            [&](const vk::Buffer& b) { return b.size() >= bytes; });
+  if (spare != slot.spareReadbacks.end()) {
+    rb.pixels = std::move(*spare);
+    slot.spareReadbacks.erase(spare);
+  } else {
+    rb.pixels = vk::Buffer(context_, {bytes, VK_BUFFER_USAGE_TRANSFER_DST_BIT, vk::MemoryDomain::Readback,
+                                      "view " + std::to_string(index) + " readback"});
+  }
   commands.barrier(VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT,
                    VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_COLOR_ATTACHMENT_WRITE_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT,
                    VK_ACCESS_TRANSFER_READ_BIT);
-  commands.copyImageToBuffer(view.images.trace, rb.pixels, 0);
-  if (rb.composite) commands.copyImageToBuffer(view.images.composite, rb.pixels, pixels * 8);
-  if (rb.aov) commands.copyBuffer(view.images.aov, rb.pixels, pixels * sizeof(gpu::TraceAov), 0, pixels * 8 * (rb.composite ? 2 : 1));
+  if (rb.trace) commands.copyImageToBuffer(view.images.trace, rb.pixels, 0);
+  if (rb.composite) commands.copyImageToBuffer(view.images.composite, rb.pixels, rb.trace ? pixels * 8 : 0);
+  if (rb.aov) commands.copyBuffer(view.images.aov, rb.pixels, pixels * sizeof(gpu::TraceAov), 0, images);
   slot.readbacks.push_back(std::move(rb));
 }
 
@@ -855,25 +866,33 @@ void Renderer::collect(Slot& slot) {
   }
   for (size_t k = 0; k < slot.maskedViews.size(); ++k) result.stats.pixelsTraced += word(slot.pixelCountsAt + 4 * k);
   result.views.clear();
-  for (const Slot::ViewReadback& rb : slot.readbacks) {
+  for (Slot::ViewReadback& rb : slot.readbacks) {
     ViewPixels v;
     v.width = rb.width;
     v.height = rb.height;
     size_t pixels = size_t(rb.width) * rb.height;
     const std::byte* bytes = rb.pixels.mapped().data();
+    const std::byte* composite = bytes + (rb.trace ? pixels * 8 : 0);
     if (rb.half) {
       const auto* halves = reinterpret_cast<const uint16_t*>(bytes);
-      v.traceHalf.assign(halves, halves + 4 * pixels);
-      if (rb.composite) v.compositeHalf.assign(halves + 4 * pixels, halves + 8 * pixels);
+      if (rb.trace) v.traceHalf.assign(halves, halves + 4 * pixels);
+      const auto* compositeHalves = reinterpret_cast<const uint16_t*>(composite);
+      if (rb.composite) v.compositeHalf.assign(compositeHalves, compositeHalves + 4 * pixels);
     } else {
-      v.trace = unpackHalves(bytes, pixels);
-      if (rb.composite) v.composite = unpackHalves(bytes + pixels * 8, pixels);
+      if (rb.trace) v.trace = unpackHalves(bytes, pixels);
+      if (rb.composite) v.composite = unpackHalves(composite, pixels);
     }
     if (rb.aov) {
       v.aov.resize(pixels);
-      std::memcpy(v.aov.data(), bytes + pixels * 8 * (rb.composite ? 2 : 1), pixels * sizeof(gpu::TraceAov));
+      std::memcpy(v.aov.data(), composite + (rb.composite ? pixels * 8 : 0), pixels * sizeof(gpu::TraceAov));
     }
     result.views.push_back(std::move(v));
+    slot.spareReadbacks.push_back(std::move(rb.pixels));
+  }
+  // Views that changed size leave buffers nothing reuses: keep the latest few.
+  constexpr size_t kSpareReadbacks = 4;
+  if (slot.spareReadbacks.size() > kSpareReadbacks) {
+    slot.spareReadbacks.erase(slot.spareReadbacks.begin(), slot.spareReadbacks.end() - kSpareReadbacks);
   }
   slot.readbacks.clear();
 }

@@ -62,6 +62,8 @@ struct ViewRequest {
   /// With readback: keep the images as the GPU's half floats (ViewPixels::*Half),
   /// for writers that convert them once, straight to the file's encoding.
   bool halfReadback = false;
+  /// With readback of a composite: bring the trace image back too (off: the composite alone).
+  bool readbackTrace = true;
 };
 
 /// What one frame did and skipped.
