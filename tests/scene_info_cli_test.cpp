@@ -48,6 +48,13 @@ TEST(SceneInfoCommand, ReportsTextureMemoryWithMipsAndLoadTimes) {
   EXPECT_NE(run.output.find("image decode"), std::string::npos) << run.output;
 }
 
+TEST(SceneInfoCommand, TimingsReportTheFirstFramesPipelineCompile) {
+  CommandRun run = snell("info " + shellQuoted(model("TransmissionTest/glTF-Binary/TransmissionTest.glb")) + " --timings");
+  EXPECT_EQ(run.exitCode, 0) << run.output;
+  EXPECT_NE(run.output.find("first frame: "), std::string::npos) << run.output;
+  EXPECT_NE(run.output.find(" pipelines (pipeline cache: "), std::string::npos) << run.output;
+}
+
 TEST(SceneInfoCommand, ATextureBudgetLoadsLowerMipsAndSaysSo) {
   CommandRun run = snell("info " + shellQuoted(model("LightsPunctualLamp/glTF/LightsPunctualLamp.gltf")) +
                          " --texture-budget 16");

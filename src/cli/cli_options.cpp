@@ -24,7 +24,9 @@ const char* const kHelpFooter = R"(exit codes: 0 done, 1 failed (the message say
 environment:
   SNELL_DEVICE=INDEX|NAME  the device to use (as --device; 'snell info --devices' lists them)
   SNELL_VALIDATION=1       turn on the Khronos validation layer; any message it
-                           reports makes the exit code 1)";
+                           reports makes the exit code 1
+  SNELL_PIPELINE_CACHE=DIR where compiled pipelines are kept for the next run
+                           (default $XDG_CACHE_HOME/snell, else ~/.cache/snell; off: none))";
 
 namespace {
 

@@ -4,11 +4,14 @@
 
 #include "io/image_file.h"
 #include "io/json.h"
+#include "render/method.h"
+#include "render/renderer.h"
 #include "render/scene_gpu.h"
 #include "scene/evaluate.h"
 #include "scene/gltf_loader.h"
 #include "scene/scene_summary.h"
 #include "scene/texture_mips.h"
+#include "scene/view.h"
 #include "vk/context.h"
 #include "vk/error.h"
 
@@ -217,6 +220,37 @@ int describeScene(const Options& o) {
                  {"texture_upload_ms", gpu.textureUploadSeconds * 1e3},
                  {"texture_bytes", gpu.textureBytes},
                  {"staging_ring_bytes", render::kTextureStagingRingBytes}};
+    // The pipelines a first frame of this scene compiles: a trace and a viewport, small.
+    start = std::chrono::steady_clock::now();
+    double compileBefore = context->compileSeconds();
+    uint64_t pipelinesBefore = context->pipelinesCreated();
+    {
+      render::Renderer renderer(*context, scene, pose);
+      render::FrameSettings settings;
+      settings.width = settings.height = 64;
+      settings.view = scene::resolveView(scene, pose, {});
+      render::FrameRequest frame;
+      frame.pose = &pose;
+      frame.views = {render::methodView(render::Method::Trace, settings, {}),
+                     render::methodView(render::Method::Masked, settings, {})};
+      renderer.wait(renderer.submit(frame));
+    }
+    double firstFrame = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    double compile = context->compileSeconds() - compileBefore;
+    uint64_t pipelines = context->pipelinesCreated() - pipelinesBefore;
+    const vk::PipelineCache* cache = context->diskCache();
+    std::string cacheLine = !cache || cache->path().empty() ? std::string("off (SNELL_PIPELINE_CACHE=off)")
+                            : cache->loadedBytes() ? cache->path().string() + ", " + std::to_string(cache->loadedBytes() >> 10) + " KiB loaded"
+                                                   : cache->path().string() + ", empty";
+    if (text) {
+      std::printf("  first frame: %.1f ms, of which %.1f ms compiling %llu pipelines (pipeline cache: %s)\n",
+                  firstFrame * 1e3, compile * 1e3, static_cast<unsigned long long>(pipelines), cacheLine.c_str());
+    }
+    loadTimes["first_frame_ms"] = firstFrame * 1e3;
+    loadTimes["compile_ms"] = compile * 1e3;
+    loadTimes["pipelines_compiled"] = pipelines;
+    loadTimes["pipeline_cache"] = cache && !cache->path().empty() ? io::Json(cache->path().string()) : io::Json();
+    loadTimes["pipeline_cache_loaded_bytes"] = cache ? cache->loadedBytes() : 0;
     device = context->facts();
     exitCode = validationExitCode(*context);
   } else if (!o.json.empty()) {
@@ -254,7 +288,8 @@ void addInfo(CLI::App& parent, Runner& run) {
   CLI::Option* budget = addTextureBudget(*sub, o->load.textureBudget);
   CLI::Option* timings = sub->add_flag("--timings", o->timings,
                                        "also upload the scene to the GPU and print where loading\n"
-                                       "spent its time: parse, image decode (all cores), upload");
+                                       "spent its time: parse, image decode (all cores), upload,\n"
+                                       "and a first frame's pipeline compile (with the pipeline cache)");
   sub->add_option("--json", o->json,
                   "also write the report as JSON; '-': the JSON on standard\noutput instead of the text")
       ->type_name("FILE");

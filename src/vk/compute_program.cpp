@@ -65,7 +65,8 @@ ComputeProgram::ComputeProgram(Context& context, const ComputeProgramDesc& desc)
   if (caps.pipelineStatistics) pipelineInfo.flags = VK_PIPELINE_CREATE_CAPTURE_STATISTICS_BIT_KHR;
   pipelineInfo.stage = stage;
   pipelineInfo.layout = pipelineLayout_;
-  VK_CHECK(vkCreateComputePipelines(device, VK_NULL_HANDLE, 1, &pipelineInfo, nullptr, &pipeline_));
+  VK_CHECK(context.compile(
+      [&] { return vkCreateComputePipelines(device, context.pipelineCache(), 1, &pipelineInfo, nullptr, &pipeline_); }));
   context.setName(VK_OBJECT_TYPE_PIPELINE, pipeline_, name_);
 }
 

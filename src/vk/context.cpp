@@ -384,12 +384,18 @@ void Context::initialise(VkPhysicalDevice physicalDevice, const DeviceFacts& fac
   }
   setName(VK_OBJECT_TYPE_DEVICE, device_, "snell device");
   setName(VK_OBJECT_TYPE_QUEUE, queue_, "snell queue");
+  pipelineCache_ = std::make_unique<PipelineCache>(device_, physicalDevice);
+  if (!pipelineCache_->warning().empty()) std::fprintf(stderr, "snell: note: %s\n", pipelineCache_->warning().c_str());
 }
 
 Context::~Context() {
   if (device_) vkDeviceWaitIdle(device_);  // the host's device too: our handles die with us
   for (Retired& r : retired_) r.destroy();
   retired_.clear();
+  if (pipelineCache_) {
+    if (std::string failed = pipelineCache_->save(); !failed.empty()) std::fprintf(stderr, "snell: note: %s\n", failed.c_str());
+    pipelineCache_.reset();
+  }
   if (!owned_) return;
   if (device_) vkDestroyDevice(device_, nullptr);
   if (messenger_) {

@@ -3,10 +3,12 @@
 #pragma once
 
 #include "vk/device_selection.h"
+#include "vk/pipeline_cache.h"
 
 #include <vulkan/vulkan.h>
 
 #include <atomic>
+#include <chrono>
 #include <cstdint>
 #include <functional>
 #include <memory>
@@ -166,6 +168,24 @@ class Context {
   /// naming `what` with the bytes needed and available.
   void checkFits(uint64_t bytes, const std::string& what) const;
 
+  /// The pipeline cache every pipeline is made through, kept on disk between processes.
+  VkPipelineCache pipelineCache() const { return pipelineCache_ ? pipelineCache_->handle() : VK_NULL_HANDLE; }
+  const PipelineCache* diskCache() const { return pipelineCache_.get(); }
+  /// Pipeline creation time, summed over every program made on this context
+  /// (on several threads, the sum of their times).
+  void noteCompile(double seconds) { compileMicroseconds_.fetch_add(uint64_t(seconds * 1e6)); }
+  double compileSeconds() const { return double(compileMicroseconds_.load()) * 1e-6; }
+  uint64_t pipelinesCreated() const { return pipelinesCreated_.load(); }
+  /// Runs `create` (a vkCreate*Pipelines call through pipelineCache()) and counts its time.
+  template <typename Create>
+  VkResult compile(Create&& create) {
+    auto started = std::chrono::steady_clock::now();
+    VkResult result = create();
+    noteCompile(std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count());
+    pipelinesCreated_.fetch_add(1);
+    return result;
+  }
+
  private:
   Context() = default;
   void initialise(VkPhysicalDevice physicalDevice, const DeviceFacts& facts, bool dynamicRendering,
@@ -202,6 +222,9 @@ class Context {
   std::atomic<uint64_t> memoryInUse_{0}, memoryPeak_{0};
   std::mutex memoryMutex_;
   std::unordered_map<VkDeviceMemory, uint64_t> counted_;  ///< device-local allocations and their sizes
+
+  std::unique_ptr<PipelineCache> pipelineCache_;
+  std::atomic<uint64_t> compileMicroseconds_{0}, pipelinesCreated_{0};
 };
 
 }  // namespace snell::vk

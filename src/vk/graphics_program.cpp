@@ -133,7 +133,8 @@ GraphicsProgram::GraphicsProgram(Context& context, const GraphicsProgramDesc& de
   info.pColorBlendState = &blend;
   info.pDynamicState = &dynamic;
   info.layout = pipelineLayout_;
-  VK_CHECK(vkCreateGraphicsPipelines(device, VK_NULL_HANDLE, 1, &info, nullptr, &pipeline_));
+  VK_CHECK(context.compile(
+      [&] { return vkCreateGraphicsPipelines(device, context.pipelineCache(), 1, &info, nullptr, &pipeline_); }));
   context.setName(VK_OBJECT_TYPE_PIPELINE, pipeline_, name_);
 }
 

@@ -77,7 +77,8 @@ RayTracingProgram::RayTracingProgram(Context& context, const RayTracingProgramDe
       vkGetDeviceProcAddr(device, "vkGetRayTracingShaderGroupHandlesKHR"));
   traceRays_ = reinterpret_cast<PFN_vkCmdTraceRaysKHR>(vkGetDeviceProcAddr(device, "vkCmdTraceRaysKHR"));
   if (!create || !handlesOf || !traceRays_) throw VulkanError("program '" + name_ + "': no ray tracing entry points");
-  VK_CHECK(create(device, VK_NULL_HANDLE, VK_NULL_HANDLE, 1, &pipelineInfo, nullptr, &pipeline_));
+  VK_CHECK(context.compile(
+      [&] { return create(device, VK_NULL_HANDLE, context.pipelineCache(), 1, &pipelineInfo, nullptr, &pipeline_); }));
   context.setName(VK_OBJECT_TYPE_PIPELINE, pipeline_, name_);
 
   // The shader binding table: one record per group, each region aligned as the device asks.
