@@ -53,7 +53,7 @@ io::Rgb8Image drawWithMap(vk::Context& context, const scene::Scene& s, const sce
   render::FrameRequest request;
   request.pose = &pose;
   request.views.push_back(render::methodView(render::Method::RefractionMap, settings, raster));
-  request.views.back().readback = true;
+  request.views.back().readback.enabled = true;
   const render::FrameResult& result = renderer.wait(renderer.submit(request));
   return io::toSrgb8({settings.width, settings.height, result.views.at(0).composite});
 }

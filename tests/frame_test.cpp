@@ -203,7 +203,7 @@ TEST_F(GpuTest, TheMaskedCompositeMatchesTheFullTraceComposite) {
     ViewRequest v = compositeView(s, pose, view, masked);
     v.settings.width = 192;
     v.settings.height = 144;
-    v.readback = true;
+    v.readback.enabled = true;
     return frame(renderer, pose, {v}).views.at(0).composite;
   };
   std::vector<glm::vec4> masked = composite(true), full = composite(false);
@@ -249,7 +249,7 @@ TEST_F(GpuTest, TwoFramesInFlightEachDrawTheirOwnPose) {
   auto alone = [&](const scene::Pose& pose) {
     Renderer renderer(context(), s, pose);
     ViewRequest v = traceView(view);
-    v.readback = true;
+    v.readback.enabled = true;
     return frame(renderer, pose, {v}).views.at(0).trace;
   };
   std::vector<glm::vec4> wantA = alone(a), wantB = alone(b);
@@ -257,7 +257,7 @@ TEST_F(GpuTest, TwoFramesInFlightEachDrawTheirOwnPose) {
 
   Renderer renderer(context(), s, a);
   ViewRequest v = traceView(view);
-  v.readback = true;
+  v.readback.enabled = true;
   FrameRequest first, second;
   first.pose = &a;
   second.pose = &b;

@@ -316,6 +316,8 @@ struct Sync {
 struct RendererOptions {
   /// Frames recorded ahead of the GPU; render() waits for the frame this many frames back.
   uint32_t framesInFlight = 2;
+  /// GPU timestamps around each pass, for FrameInfo::passes; off, frames record none.
+  bool passTimes = true;
 };
 
 /// GPU time of one pass of a frame.

@@ -2,7 +2,7 @@
 // (non-zero where the visible face is transmissive); this pass lists those
 // pixels, tile by tile, so the trace runs one invocation per pixel that
 // refracts and none elsewhere. Each subgroup that lists pixels raises the
-// trace's indirect workgroup count to cover them: no workgroup waits for another.
+// trace's indirect workgroup rows to cover them: no workgroup waits for another.
 #version 460
 #extension GL_GOOGLE_include_directive : require
 #extension GL_KHR_shader_subgroup_basic : require
@@ -33,7 +33,8 @@ void main() {
     uint base = 0u;
     if (subgroupElect()) {
       base = atomicAdd(list.count, n);
-      atomicMax(list.dispatchX, (base + n + pc.pixelsPerGroup - 1u) / pc.pixelsPerGroup);
+      uint groups = (base + n + gl_WorkGroupSize.x - 1u) / gl_WorkGroupSize.x;  // the trace's, 64 invocations each
+      atomicMax(list.dispatchY, (groups + kTraceListGroupsX - 1u) / kTraceListGroupsX);
     }
     base = subgroupBroadcastFirst(base);
     if (take) listed[base + subgroupBallotExclusiveBitCount(ballot)] = pixel.x | (pixel.y << 16);

@@ -203,6 +203,12 @@ SNELL_CONST kTraceFlagOrthographic = 2u;
 SNELL_CONST kTraceFlagRayList = 4u;  // primary rays from kTraceBindingRays, not the camera
 SNELL_CONST kTraceFlagPixelList = 8u;  // only the pixels kTraceBindingPixels lists (the masked trace)
 SNELL_CONST kTraceTile = 8;  // pixels per side of one workgroup's tile
+// Specialisation constants of the trace: the kOptics* and kTraceFlag* bits a
+// pipeline is made for. A bit off compiles its code out; TracePush's optics
+// and flags still say what a dispatch draws (a pipeline made without them,
+// the driver-rt peer's, follows the push constant alone).
+SNELL_CONST kTraceSpecOptics = 0;
+SNELL_CONST kTraceSpecFlags = 1;
 // Nodes one ray segment may visit before it gives up: a corrupted tree ends here.
 SNELL_CONST kTraceMaxVisits = 1u << 20;
 
@@ -243,7 +249,7 @@ struct TracePush {
   uint tilesX;      // 4: tiles per row
   float shiftX;     // 4: the film back's offset (View::shift)
   float shiftY;     // 4
-  uint pixelsPerGroup;  // 4: with kTraceFlagPixelList, listed pixels per workgroup
+  uint pad0;        // 4
   uint maxBends;    // 4: interfaces that refract; later ones are crossed straight (kAllBends: every one)
   uint optics;      // 4: kOptics* bits
   uint reflections; // 4: true boundaries per path that send a reflected ray
@@ -251,20 +257,24 @@ struct TracePush {
 
 // The masked trace's pixel list (shaders/comp/trace_compact.comp writes it,
 // the trace reads it): a header, then one packed pixel (x | y << 16) per entry.
-// The header's dispatch fields are a VkDispatchIndirectCommand for the trace;
-// the host writes the header (count 0, dispatch 0 x 1 x 1) before compacting.
+// The header's dispatch fields are a VkDispatchIndirectCommand for the trace,
+// one invocation per listed pixel: kTraceListGroupsX workgroups a row, as many
+// rows as the list needs (the compaction raises dispatchY), so even a list of
+// every pixel of a large image stays within the device's workgroup limits.
+// The host writes the header (count 0, dispatch kTraceListGroupsX x 0 x 1) before compacting.
 // 32 bytes, total: 32 bytes
 struct TracePixelListHeader {
   uint count;      // 4: pixels listed
   uint pad0;       // 4
-  uint dispatchX;  // 4: trace workgroups (atomicMax as pixels are listed)
-  uint dispatchY;  // 4: 1
+  uint dispatchX;  // 4: kTraceListGroupsX
+  uint dispatchY;  // 4: rows of workgroups (atomicMax as pixels are listed)
   uint dispatchZ;  // 4: 1
   uint pad1;       // 4
   uint pad2;       // 4
   uint pad3;       // 4
 };
 SNELL_CONST kTracePixelListDispatchOffset = 8;  // bytes into the list: the indirect arguments
+SNELL_CONST kTraceListGroupsX = 256;  // the masked trace's workgroups per dispatch row
 // Tiles of kTraceTile x kTraceTile pixels each compaction workgroup lists, one after another.
 SNELL_CONST kTraceCompactTiles = 16;
 
@@ -273,7 +283,7 @@ struct TraceCompactPush {
   uint width;           // 4
   uint height;          // 4
   uint tilesX;          // 4: kTraceTile-wide tiles per row
-  uint pixelsPerGroup;  // 4: listed pixels one trace workgroup takes (its dispatch stays within the device's limit)
+  uint pad0;            // 4
 };
 
 SNELL_GPU_END

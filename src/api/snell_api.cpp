@@ -416,6 +416,10 @@ scene::View viewFromMatrices(const CameraMatrices& m, uint32_t width, uint32_t h
 
 }  // namespace
 
+namespace {
+std::function<void(vk::Commands&)> uploadsOf(Renderer::Impl& impl);
+}  // namespace
+
 // The GPU copies of a kept scene's vertices (Scene::keepsVertices): buffers
 // the frames read, and a mapped copy in cached host memory that the host
 // rewrites and snell reads back to bound it.
@@ -449,6 +453,7 @@ struct Renderer::Impl {
     std::lock_guard lock(mutex);
     render::RendererOptions o;
     o.framesInFlight = options.framesInFlight;
+    o.passTimes = options.passTimes;
     o.host = scene.host;
     for (const scene::Shape& shape : scene.scene.shapes) {
       if (shape.host) bounds.emplace_back(shape.host->lo, shape.host->hi);
@@ -536,7 +541,7 @@ struct Renderer::Impl {
     if (kept && !kept->pending.empty()) {  // the bake's frame has no prologue: copy the vertices first
       render::FrameRequest flush;
       flush.pose = &pose;
-      flush.prologue = [this](vk::Commands& commands) { recordUploads(commands); };
+      flush.prologue = uploadsOf(*this);
       renderer->wait(renderer->submit(flush));
     }
     render::FrameSettings traced = settings;
@@ -581,6 +586,16 @@ struct Renderer::Impl {
     for (const vk::PassTime& p : result.passes) last.passes.push_back(PassTime{p.name, p.milliseconds});
   }
 };
+
+namespace {
+
+// A frame's prologue: the kept vertices' copies. Made here, in an unnamed
+// namespace, so its type stays out of libsnell.so's exported symbols.
+std::function<void(vk::Commands&)> uploadsOf(Renderer::Impl& impl) {
+  return [&impl](vk::Commands& commands) { impl.recordUploads(commands); };
+}
+
+}  // namespace
 
 Renderer::Renderer(Device& device, Scene& scene, const RendererOptions& options)
     : impl_(guarded([&] { return std::make_unique<Impl>(device, scene, options); })) {}
@@ -681,7 +696,7 @@ uint64_t Renderer::render(const View& view, const Target& target, const Sync& sy
     frame.pose = &impl_->pose;
     frame.views.push_back(impl_->request(view));
     impl_->composite = frame.views.back().output == render::ViewOutput::Composite;
-    frame.prologue = [this](vk::Commands& commands) { impl_->recordUploads(commands); };
+    frame.prologue = uploadsOf(*impl_);
     frame.record = blit;
     frame.waitSemaphore = sync.wait;
     frame.waitStage = sync.wait ? sync.waitStage : 0;
@@ -710,10 +725,10 @@ void Renderer::read(const View& view, float* rgba) {
     render::FrameRequest frame;
     frame.pose = &impl_->pose;
     frame.views.push_back(impl_->request(view));
-    frame.views.back().readback = true;
-    frame.views.back().halfReadback = true;  // converted once, straight into the host's memory
-    frame.views.back().readbackTrace = false;  // a composite's own picture is all the host asked for
-    frame.prologue = [this](vk::Commands& commands) { impl_->recordUploads(commands); };
+    frame.views.back().readback.enabled = true;
+    frame.views.back().readback.half = true;  // converted once, straight into the host's memory
+    frame.views.back().readback.trace = false;  // a composite's own picture is all the host asked for
+    frame.prologue = uploadsOf(*impl_);
     bool composite = frame.views.back().output == render::ViewOutput::Composite;
     const render::FrameResult& result = impl_->renderer->wait(impl_->renderer->submit(frame));
     impl_->note(result);

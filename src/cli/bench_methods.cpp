@@ -399,7 +399,7 @@ int runMethods(const Options& o) {
     render::RasterOptions raster = frame.raster;
     raster.refractionMap = row.map.get();
     render::ViewRequest view = render::methodView(row.info.method, settings, raster);
-    view.readback = readback;
+    view.readback.enabled = readback;
     view.aov = readback && hitsOf(row.info.method);
     render::FrameRequest r;
     r.pose = &frame.pose;

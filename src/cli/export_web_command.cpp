@@ -229,7 +229,7 @@ int runExportWeb(const Options& o) {
   render::fitDepthRange(view, lo, hi, raster);
   raster.refractionMap = &map;
   render::ViewRequest request = render::methodView(render::Method::RefractionMap, settings, raster);
-  request.readback = true;
+  request.readback.enabled = true;
   render::FrameRequest frame;
   frame.pose = &pose;
   frame.views.push_back(request);

@@ -401,7 +401,9 @@ int runRender(Options& o) {
     } catch (const std::invalid_argument& e) {
       throw UsageError{std::string("render: ") + e.what()};
     }
-    renderer = std::make_unique<render::Renderer>(*context, scene, layout);
+    render::RendererOptions options;
+    options.passTimes = o.stats;  // timestamps only where someone reads them
+    renderer = std::make_unique<render::Renderer>(*context, scene, layout, options);
   }
   const std::string device = o.reference ? "CPU reference" : context->facts().name;
 
@@ -460,8 +462,8 @@ int runRender(Options& o) {
       scene::sceneBounds(scene, pose, lo, hi);
       render::fitDepthRange(view, lo, hi, raster);
       render::ViewRequest request = render::methodView(*o.method, settings, raster);
-      request.readback = true;
-      request.halfReadback = true;
+      request.readback.enabled = true;
+      request.readback.half = true;
       request.aov = request.aov || wantAov;
       render::FrameRequest frame;
       frame.pose = &pose;

@@ -28,6 +28,7 @@ struct FrameSettings {
   scene::Optics optics;
   /// The composite's alpha where nothing is drawn (0: a host composites the image over its own).
   float backgroundAlpha = 1.0f;
+  friend bool operator==(const FrameSettings&, const FrameSettings&) = default;
 };
 
 }  // namespace snell::render

@@ -55,13 +55,13 @@ static_assert(sizeof(TraceAov) == 64 && offsetof(TraceAov, nodeVisits) == 20 && 
               offsetof(TraceAov, landingMaterial) == 32 && offsetof(TraceAov, shineR) == 40 && offsetof(TraceAov, weightB) == 60);
 static_assert(sizeof(GpuRay) == 32 && offsetof(GpuRay, direction) == 16);
 static_assert(sizeof(TracePixelListHeader) == 32 && offsetof(TracePixelListHeader, dispatchX) == kTracePixelListDispatchOffset);
-static_assert(sizeof(TraceCompactPush) == 16 && offsetof(TraceCompactPush, pixelsPerGroup) == 12);
+static_assert(sizeof(TraceCompactPush) == 16 && offsetof(TraceCompactPush, pad0) == 12);
 static_assert(sizeof(PresentPush) == 48 && offsetof(PresentPush, gate) == 16 && offsetof(PresentPush, flags) == 32);
 static_assert(sizeof(RasterPush) == 112 && offsetof(RasterPush, offsetStrength) == 96 && offsetof(RasterPush, flags) == 80 && offsetof(RasterPush, lightCount) == 84);
 static_assert(sizeof(RasterPush) == 112 && offsetof(RasterPush, mapWidth) == 100);
 static_assert(sizeof(RefractionTexel) == 48 && offsetof(RefractionTexel, weight) == 16 && offsetof(RefractionTexel, material) == 40);
 static_assert(sizeof(TracePush) == 128 && offsetof(TracePush, eye) == 64 && offsetof(TracePush, width) == 80 &&
-              offsetof(TracePush, tilesX) == 100 && offsetof(TracePush, pixelsPerGroup) == 112 &&
+              offsetof(TracePush, tilesX) == 100 && offsetof(TracePush, pad0) == 112 &&
               offsetof(TracePush, optics) == 120);
 
 }  // namespace snell::gpu

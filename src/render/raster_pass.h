@@ -61,6 +61,7 @@ struct RasterOptions {
   /// Perspective: the near plane's distance. Orthographic: the depth range
   /// along the view's forward axis. fitDepthRange() picks them from the scene.
   double nearPlane = 1e-3, farPlane = 1e3;
+  friend bool operator==(const RasterOptions&, const RasterOptions&) = default;
 };
 
 /// Near and far planes that hold everything within [lo, hi] seen from `view`

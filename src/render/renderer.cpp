@@ -4,9 +4,6 @@
 
 #include "vk/error.h"
 
-#include "trace.spv.h"
-#include "trace_compact.spv.h"
-
 #include <glm/gtc/packing.hpp>
 
 #include <algorithm>
@@ -23,30 +20,6 @@ constexpr VkBufferUsageFlags kStorage =
 
 void rows(const glm::dmat4& m, glm::vec4 out[3]) {
   for (int r = 0; r < 3; ++r) out[r] = glm::vec4(glm::dvec4(m[0][r], m[1][r], m[2][r], m[3][r]));
-}
-
-double maxScale(const glm::dmat4& m) {
-  return std::max({glm::length(glm::dvec3(m[0])), glm::length(glm::dvec3(m[1])), glm::length(glm::dvec3(m[2]))});
-}
-
-bool sameView(const scene::View& a, const scene::View& b) {
-  return a.eye == b.eye && a.right == b.right && a.up == b.up && a.forward == b.forward &&
-         a.orthographic == b.orthographic && a.halfHeight == b.halfHeight && a.shift == b.shift;
-}
-
-// Whether a view asks for exactly what it asked for last time (ray lists always count as new).
-bool sameRequest(const ViewRequest& a, const ViewRequest& b) {
-  const FrameSettings &s = a.settings, &t = b.settings;
-  const RasterOptions &r = a.raster, &q = b.raster;
-  return s.width == t.width && s.height == t.height && sameView(s.view, t.view) && s.background == t.background &&
-         s.backgroundAlpha == t.backgroundAlpha && s.maxInterfaces == t.maxInterfaces && s.rays.empty() && t.rays.empty() && a.output == b.output &&
-         s.maxBends == t.maxBends && a.driverTrace == b.driverTrace && a.masked == b.masked && a.aov == b.aov && r.refraction == q.refraction &&
-         r.screenSpace == q.screenSpace && r.offsetStrength == q.offsetStrength && r.wireframe == q.wireframe &&
-         r.refractionMap == q.refractionMap &&
-         r.wireColor == q.wireColor && r.nearPlane == q.nearPlane && r.farPlane == q.farPlane &&
-         s.optics.fresnel == t.optics.fresnel && s.optics.reflections == t.optics.reflections &&
-         s.optics.environment == t.optics.environment && s.optics.textureLod == t.optics.textureLod &&
-         s.optics.dispersion == t.optics.dispersion && s.optics.volume == t.optics.volume;
 }
 
 std::vector<glm::vec4> unpackHalves(const std::byte* data, size_t pixels) {
@@ -108,16 +81,10 @@ struct Renderer::Update {
   bool buildTop = false, refitTop = false;
 };
 
-Renderer::Sphere Renderer::boundingSphere(const glm::dvec3& lo, const glm::dvec3& hi, bool host) {
-  Sphere sphere;
-  if (lo.x <= hi.x && lo.y <= hi.y && lo.z <= hi.z) sphere = {0.5 * (lo + hi), 0.5 * glm::length(hi - lo)};
-  if (host && !(lo.x <= hi.x)) sphere.radius = INFINITY;  // no promise: never culled
-  return sphere;
-}
-
 Renderer::Renderer(vk::Context& context, const scene::Scene& scene, const scene::Pose& layout, RendererOptions options)
     : context_(context), sceneModel_(scene), options_(options),
-      scene_(uploadScene(context, scene, layout, options.host.positions ? &options.host : nullptr)) {
+      scene_(uploadScene(context, scene, layout, options.host.positions ? &options.host : nullptr)), bounds_(scene),
+      rebuilds_(scene_.geometries.size(), options.rebuildGrowth) {
   if (options_.framesInFlight == 0) throw std::invalid_argument("renderer: framesInFlight must be at least 1");
   deform_ = std::make_unique<DeformPass>(context, scene, layout, [&](int item) {
     for (const GeometryRange& g : scene_.geometries) {
@@ -126,6 +93,7 @@ Renderer::Renderer(vk::Context& context, const scene::Scene& scene, const scene:
     throw std::logic_error("deforming item without a geometry");
   });
   raster_ = std::make_unique<RasterPass>(context);
+  trace_ = std::make_unique<TracePass>(context, scene, scene_);
   std::string name = scene.source.empty() ? std::string("scene") : scene.source;
   size_t lightNodes = 0;
   for (const scene::Node& node : scene.nodes) lightNodes += node.light >= 0 ? 1 : 0;
@@ -134,8 +102,6 @@ Renderer::Renderer(vk::Context& context, const scene::Scene& scene, const scene:
                                     name + " instances"});
   lights_ = vk::Buffer(context, {std::max<size_t>(lightNodes, 1) * sizeof(gpu::GpuLight), kStorage,
                                  vk::MemoryDomain::Device, name + " lights"});
-  placeholder_ = vk::Buffer(context, {sizeof(gpu::TracePixelListHeader), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
-                                      vk::MemoryDomain::Device, "placeholder"});
   for (char r : scene_.itemRefractive) refractive_ = refractive_ || r;
 
   items_.resize(layout.items.size());
@@ -144,26 +110,6 @@ Renderer::Renderer(vk::Context& context, const scene::Scene& scene, const scene:
     itemDeformOutput_[size_t(deform_->outputs()[o].item)] = static_cast<uint32_t>(o);
   }
   geometryDirty_.assign(scene_.geometries.size(), 1);
-  driverMoved_.assign(scene_.geometries.size(), 0);
-  baselineSah_.assign(scene_.geometries.size(), 0.0);
-  queued_.assign(scene_.geometries.size(), 0);
-  // Rest-pose bounding spheres per shape, and how far each morph target can move a vertex.
-  for (const scene::Shape& shape : scene.shapes) {
-    glm::dvec3 lo(INFINITY), hi(-INFINITY);
-    for (const glm::vec3& p : shape.positions) {
-      lo = glm::min(lo, glm::dvec3(p));
-      hi = glm::max(hi, glm::dvec3(p));
-    }
-    if (shape.host) lo = glm::dvec3(shape.host->lo), hi = glm::dvec3(shape.host->hi);
-    shapeSpheres_.push_back(boundingSphere(lo, hi, shape.host.has_value()));
-    std::vector<double> reach;
-    for (const scene::MorphTarget& target : shape.targets) {
-      double most = 0.0;
-      for (const glm::vec3& d : target.positions) most = std::max(most, double(glm::length(d)));
-      reach.push_back(most);
-    }
-    shapeMorphReach_.push_back(std::move(reach));
-  }
   for (uint32_t i = 0; i < options_.framesInFlight; ++i) slots_.push_back(std::make_unique<Slot>(context, i));
 }
 
@@ -186,7 +132,9 @@ void Renderer::markDirty(int shape) {
     throw std::invalid_argument("renderer: no shape " + std::to_string(shape) + " to mark dirty");
   }
   for (size_t g = 0; g < scene_.geometries.size(); ++g) {
-    if (scene_.geometries[g].shape == shape) geometryDirty_[g] = driverMoved_[g] = 1;
+    if (scene_.geometries[g].shape != shape) continue;
+    geometryDirty_[g] = 1;
+    trace_->noteGeometryMoved(uint32_t(g));
   }
   ++sceneVersion_;
 }
@@ -195,7 +143,7 @@ void Renderer::setShapeBounds(int shape, const glm::dvec3& lo, const glm::dvec3&
   if (shape < 0 || size_t(shape) >= sceneModel_.shapes.size() || !sceneModel_.shapes[size_t(shape)].host) {
     throw std::invalid_argument("renderer: no host shape " + std::to_string(shape) + " to bound");
   }
-  shapeSpheres_[size_t(shape)] = boundingSphere(lo, hi, true);
+  bounds_.setShapeBox(shape, lo, hi);
 }
 
 void Renderer::invalidateTrees() {
@@ -212,9 +160,6 @@ void Renderer::prepareTrees() {
   blas_ = std::make_unique<Bvh>(builder_->makeBvh(counts, BvhLeaves::Triangles, name + " bottom level"));
   tlas_ = std::make_unique<Bvh>(builder_->makeBvh({static_cast<uint32_t>(scene_.itemGeometry.size())},
                                                   BvhLeaves::Instances, name + " top level"));
-  trace_ = std::make_unique<vk::ComputeProgram>(context_, vk::ComputeProgramDesc{"trace", kSpvTrace, {}, false});
-  compact_ = std::make_unique<vk::ComputeProgram>(context_,
-                                                  vk::ComputeProgramDesc{"trace compact", kSpvTraceCompact, {}, false});
 }
 
 uint64_t Renderer::memoryBytes() const {
@@ -222,7 +167,7 @@ uint64_t Renderer::memoryBytes() const {
   if (blas_) {
     bytes += blas_->treeBytes() + tlas_->treeBytes() + blas_->workBytes() + tlas_->workBytes() + builder_->scratchBytes();
   }
-  if (driver_) bytes += driver_->bytes();
+  bytes += trace_->bytes();
   return bytes;
 }
 
@@ -237,32 +182,8 @@ bool Renderer::viewNeedsTrees(const ViewRequest& request) const {
          transmissiveInView(request.settings);
 }
 
-// A bounding sphere per refractive item against the view's frustum: no glass
-// in the frustum, no trace. Conservative: a sphere that may touch it counts.
 bool Renderer::transmissiveInView(const FrameSettings& settings) const {
-  if (itemSpheres_.size() != scene_.itemRefractive.size()) return true;  // no frame placed the items yet
-  const scene::View& v = settings.view;
-  double aspect = double(settings.width) / double(std::max(settings.height, 1u));
-  double sx = v.halfHeight * aspect, sy = v.halfHeight;
-  for (size_t i = 0; i < scene_.itemRefractive.size() && i < itemSpheres_.size(); ++i) {
-    if (!scene_.itemRefractive[i]) continue;
-    const Sphere& s = itemSpheres_[i];
-    glm::dvec3 d = s.centre - v.eye;
-    double x = glm::dot(d, v.right), y = glm::dot(d, v.up), z = glm::dot(d, v.forward);
-    if (v.orthographic) {
-      if (std::abs(x - v.shift.x) <= sx + s.radius && std::abs(y - v.shift.y) <= sy + s.radius) return true;
-      continue;
-    }
-    if (z < -s.radius) continue;
-    // Distance to each side plane of the window [shift - s, shift + s] in slope space.
-    auto inside = [&](double a, double slopeLo, double slopeHi) {
-      double hiDist = (a - slopeHi * z) / std::sqrt(1.0 + slopeHi * slopeHi);
-      double loDist = (slopeLo * z - a) / std::sqrt(1.0 + slopeLo * slopeLo);
-      return hiDist <= s.radius && loDist <= s.radius;
-    };
-    if (inside(x, v.shift.x - sx, v.shift.x + sx) && inside(y, v.shift.y - sy, v.shift.y + sy)) return true;
-  }
-  return false;
+  return bounds_.anyInView(settings, scene_.itemRefractive);
 }
 
 Renderer::Update Renderer::planUpdate(const scene::Pose& pose, const std::vector<ViewRequest>& views,
@@ -272,43 +193,9 @@ Renderer::Update Renderer::planUpdate(const scene::Pose& pose, const std::vector
   if (!u.work) return u;
 
   // Where every item is (bounding spheres), for culling and the origin.
-  itemSpheres_.resize(pose.items.size());
-  for (size_t i = 0; i < pose.items.size(); ++i) {
-    const scene::DrawItem& item = pose.items[i];
-    glm::dvec3 centre = shapeSpheres_[size_t(item.shape)].centre;
-    double radius = shapeSpheres_[size_t(item.shape)].radius;
-    const std::vector<double>& reach = shapeMorphReach_[size_t(item.shape)];
-    for (size_t k = 0; k < reach.size() && k < item.weights.size(); ++k) radius += std::abs(item.weights[k]) * reach[k];
-    if (item.skinned && !item.jointMatrices.empty()) {
-      // Skinned vertices are convex blends of joint-moved rest positions, so
-      // the joint-moved rest spheres hold them all.
-      glm::dvec3 mean(0.0);
-      for (const glm::dmat4& m : item.jointMatrices) mean += glm::dvec3(m * glm::dvec4(centre, 1.0));
-      mean /= double(item.jointMatrices.size());
-      double farthest = 0.0;
-      for (const glm::dmat4& m : item.jointMatrices) {
-        farthest = std::max(farthest, glm::length(glm::dvec3(m * glm::dvec4(centre, 1.0)) - mean) + radius * maxScale(m));
-      }
-      itemSpheres_[i] = {mean, farthest};
-    } else {
-      itemSpheres_[i] = {glm::dvec3(item.world * glm::dvec4(centre, 1.0)), radius * maxScale(item.world)};
-    }
-  }
-
-  // The origin follows the first view's camera, but only once the camera is
-  // farther from it than from the nearest item: coordinates near the camera
-  // then lose at most a bit to it, and orbiting mostly moves no tree.
-  glm::dvec3 eye = views.front().settings.view.eye;
-  double nearest = INFINITY, extent = 0.0;
-  for (const Sphere& s : itemSpheres_) {
-    nearest = std::min(nearest, std::max(0.0, glm::length(s.centre - eye) - s.radius));
-    extent = std::max(extent, glm::length(s.centre - eye) + s.radius);
-  }
-  if (!originSet_ || glm::length(eye - origin_) > std::max(nearest, 1e-9 * extent)) {
-    stats.rebased = originSet_;
-    origin_ = eye;
-    originSet_ = true;
-  }
+  bounds_.place(pose);
+  stats.rebased = origin_.follow(views.front().settings.view.eye, bounds_);
+  const glm::dvec3 origin = origin_.origin();
 
   // Deform what changed.
   for (size_t i = 0; i < pose.items.size(); ++i) {
@@ -325,7 +212,9 @@ Renderer::Update Renderer::planUpdate(const scene::Pose& pose, const std::vector
     u.deform.push_back(itemDeformOutput_[i]);
     ++stats.itemsDeformed;
     for (size_t g = 0; g < scene_.geometries.size(); ++g) {
-      if (scene_.geometries[g].item == int(i)) geometryDirty_[g] = driverMoved_[g] = 1;
+      if (scene_.geometries[g].item != int(i)) continue;
+      geometryDirty_[g] = 1;
+      trace_->noteGeometryMoved(uint32_t(g));
     }
   }
 
@@ -337,7 +226,7 @@ Renderer::Update Renderer::planUpdate(const scene::Pose& pose, const std::vector
     // Skinned positions come out of the deform pass relative to the item's anchor.
     glm::dmat4 toWorld = item.world;
     if (item.skinned) toWorld = glm::dmat4(1.0), toWorld[3] = glm::dvec4(DeformPass::anchorOf(item), 1.0);
-    toWorld[3] -= glm::dvec4(origin_, 0.0);
+    toWorld[3] -= glm::dvec4(origin, 0.0);
     gpu::GpuInstance inst{};
     rows(toWorld, inst.objectToWorld);
     rows(glm::inverse(toWorld), inst.worldToObject);
@@ -357,7 +246,7 @@ Renderer::Update Renderer::planUpdate(const scene::Pose& pose, const std::vector
     uint32_t type = light.type == scene::LightType::Directional ? gpu::kLightDirectional
                     : light.type == scene::LightType::Point     ? gpu::kLightPoint
                                                                 : gpu::kLightSpot;
-    g.positionType = glm::vec4(glm::vec3(glm::dvec3(world[3]) - origin_), float(type));
+    g.positionType = glm::vec4(glm::vec3(glm::dvec3(world[3]) - origin), float(type));
     glm::dvec3 direction = -glm::normalize(glm::dvec3(world[2]));
     g.direction = glm::vec4(glm::vec3(direction), std::isfinite(light.range) ? light.range : 0.0f);
     g.radiance = glm::vec4(light.color * light.intensity, 0.0f);
@@ -376,20 +265,12 @@ Renderer::Update Renderer::planUpdate(const scene::Pose& pose, const std::vector
   bool bottomChanged = false;
   if (!treesBuilt_) {
     for (uint32_t g = 0; g < scene_.geometries.size(); ++g) u.build.push_back(g);
-    rebuildQueue_.clear();
-    std::fill(queued_.begin(), queued_.end(), 0);
+    rebuilds_.clear();
   } else {
     // Rebuilds the SAH asked for, within the budget (at least one a frame).
-    uint64_t budget = 0;
-    while (!rebuildQueue_.empty()) {
-      uint32_t g = rebuildQueue_.front();
-      uint64_t size = scene_.geometries[g].triangleCount;
-      if (!u.build.empty() && budget + size > options_.rebuildBudget) break;
-      rebuildQueue_.pop_front();
-      queued_[g] = 0;
-      budget += size;
-      u.build.push_back(g);
-    }
+    std::vector<uint32_t> triangles;
+    for (const GeometryRange& g : scene_.geometries) triangles.push_back(g.triangleCount);
+    u.build = rebuilds_.take(options_.rebuildBudget, triangles);
   }
   for (uint32_t g : u.build) geometryDirty_[g] = 0;
   u.refit = u.build;  // a refit right after a build measures the new tree's SAH
@@ -406,10 +287,9 @@ Renderer::Update Renderer::planUpdate(const scene::Pose& pose, const std::vector
   for (size_t k = u.build.size(); k < u.refit.size(); ++k) stats.trianglesRefit += scene_.geometries[u.refit[k]].triangleCount;
   treesBuilt_ = true;
 
-  if (!topBuilt_ || topRebuildDue_) {
+  if (rebuilds_.takeTopRebuild() || !topBuilt_) {
     u.buildTop = u.refitTop = true;
     topBuilt_ = true;
-    topRebuildDue_ = false;
     topDirty_ = false;
   } else if (topDirty_ || u.instancesChanged || bottomChanged) {
     u.refitTop = true;
@@ -442,22 +322,9 @@ void Renderer::recordUpdate(vk::Commands& commands, Slot& slot, const scene::Pos
     commands.endPass();
   }
   if (u.driver) {
-    if (!driver_) {
-      std::vector<peer::DriverGeometry> geometries;
-      for (const GeometryRange& g : scene_.geometries) geometries.push_back({g.firstTriangle, g.triangleCount});
-      driver_ = std::make_unique<peer::DriverTracer>(context_, scene_.positions, scene_.vertexCount, scene_.indices,
-                                                     geometries, static_cast<uint32_t>(u.instances.size()));
-      std::fill(driverMoved_.begin(), driverMoved_.end(), 0);  // the first build sees them as they are
-    }
-    std::vector<uint32_t> moved;
-    for (uint32_t g = 0; g < driverMoved_.size(); ++g) {
-      if (driverMoved_[g]) moved.push_back(g);
-      driverMoved_[g] = 0;
-    }
-    driver_->recordUpdate(commands, slot.arena, u.instances, u.instancesChanged || driverInstancesStale_, moved);
-    driverInstancesStale_ = false;
-  } else {
-    driverInstancesStale_ = driverInstancesStale_ || u.instancesChanged;
+    trace_->recordDriverUpdate(commands, slot.arena, scene_, u.instances, u.instancesChanged);
+  } else if (u.instancesChanged) {
+    trace_->noteInstancesMoved();
   }
   if (!u.trees) return;
   BvhInputs triangles{&scene_.positions, &scene_.indices, nullptr, nullptr};
@@ -487,134 +354,16 @@ void Renderer::recordUpdate(vk::Commands& commands, Slot& slot, const scene::Pos
   slot.topBuilt = u.buildTop;
 }
 
-gpu::TracePush Renderer::tracePush(const ViewRequest& request, bool masked) const {
-  const FrameSettings& settings = request.settings;
-  const scene::View& v = settings.view;
-  double aspect = double(settings.width) / double(settings.height);
-  gpu::TracePush push{};
-  push.right = glm::vec4(glm::vec3(v.right), float(v.halfHeight * aspect));
-  push.up = glm::vec4(glm::vec3(v.up), float(v.halfHeight));
-  push.forward = glm::vec4(glm::vec3(v.forward), 0.0f);
-  push.background = glm::vec4(settings.background, 1.0f);
-  push.eye = glm::vec4(glm::vec3(v.eye - origin_), 0.0f);
-  push.width = settings.width;
-  push.height = settings.height;
-  push.maxInterfaces = settings.maxInterfaces;
-  push.maxBends = settings.maxBends;
-  push.lightCount = lightCount_;
-  push.flags = (request.aov ? gpu::kTraceFlagAov : 0u) | (v.orthographic ? gpu::kTraceFlagOrthographic : 0u) |
-               (settings.rays.empty() ? 0u : gpu::kTraceFlagRayList) | (masked ? gpu::kTraceFlagPixelList : 0u);
-  push.tilesX = (settings.width + gpu::kTraceTile - 1) / gpu::kTraceTile;
-  push.shiftX = float(v.shift.x);
-  push.shiftY = float(v.shift.y);
-  push.optics = (settings.optics.fresnel ? gpu::kOpticsFresnel : 0u) |
-                (settings.optics.environment ? gpu::kOpticsEnvironmentMap : 0u) |
-                (settings.optics.textureLod ? gpu::kOpticsTextureLod : 0u) |
-                (settings.optics.dispersion ? gpu::kOpticsDispersion : 0u) |
-                (settings.optics.volume ? gpu::kOpticsVolume : 0u);
-  push.reflections = settings.optics.reflections;
-  return push;
-}
-
-const vk::Buffer& Renderer::environmentBuffer(const scene::Optics& optics) const {
-  if (!optics.environment) return placeholder_;
-  auto found = environments_.find(optics.environment.get());
-  if (found == environments_.end()) {
-    throw std::logic_error("renderer: an environment reached a trace before submit() uploaded it");
-  }
-  return found->second.buffer;
-}
-
-void Renderer::uploadEnvironments(const std::vector<ViewRequest>& views) {
-  for (const ViewRequest& v : views) {
-    const std::shared_ptr<const scene::Environment>& env = v.settings.optics.environment;
-    if (!env || environments_.count(env.get())) continue;
-    if (env->width == 0 || env->height == 0 || env->texels.size() != size_t(env->width) * env->height) {
-      throw std::invalid_argument("renderer: environment " + env->source + " has no texels");
-    }
-    // Header (width, height), then the texels; kept while the environment is alive.
-    std::vector<glm::vec4> data;
-    data.reserve(env->texels.size() + 1);
-    data.emplace_back(float(env->width), float(env->height), 0.0f, 0.0f);
-    for (const glm::vec3& t : env->texels) data.emplace_back(t, 0.0f);
-    VkDeviceSize bytes = data.size() * sizeof(glm::vec4);
-    if (bytes > context_.caps().maxStorageBufferRange) {
-      throw std::runtime_error(env->source + ": the environment needs " + std::to_string(bytes >> 20) +
-                               " MiB; the device binds at most " +
-                               std::to_string(context_.caps().maxStorageBufferRange >> 20) + " MiB in one buffer");
-    }
-    vk::Buffer buffer(context_, {bytes, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
-                                 vk::MemoryDomain::Device, "environment " + env->source});
-    vk::upload(context_, buffer, data.data(), bytes);
-    environments_.emplace(env.get(), Environment{env, std::move(buffer)});
-  }
-}
-
-std::vector<vk::BufferBinding> Renderer::pathBindings(const ViewRequest& request, View& view) const {
-  const FrameSettings& settings = request.settings;
-  std::vector<vk::BufferBinding> bindings = {
-      {gpu::kTraceBindingEnvironment, &environmentBuffer(settings.optics)},
-      {gpu::kTraceBindingImage, nullptr, &view.images.trace},
-      {gpu::kTraceBindingAov, request.aov ? &view.images.aov : &placeholder_},
-      {gpu::kTraceBindingRays, settings.rays.empty() ? &placeholder_ : &view.rays}};
-  scene_.appendBindings(bindings, instances_, lights_);
-  return bindings;
-}
-
-void Renderer::recordDriverTrace(vk::Commands& commands, const ViewRequest& request, View& view, FrameStats& stats) {
-  const FrameSettings& settings = request.settings;
-  commands.computeToCompute();
-  std::vector<vk::BufferBinding> bindings = pathBindings(request, view);
-  bindings.push_back({gpu::kTraceBindingGeometryFirst, &driver_->geometryFirst()});
-  driver_->recordTrace(commands, bindings, tracePush(request, false));
-  stats.pixelsTraced += uint64_t(settings.width) * settings.height;
-  ++stats.traceDispatches;
-}
-
 void Renderer::recordTrace(vk::Commands& commands, const ViewRequest& request, View& view, bool masked,
                            FrameStats& stats) {
-  const FrameSettings& settings = request.settings;
-  gpu::TracePush push = tracePush(request, masked);
-  uint32_t tilesY = (settings.height + gpu::kTraceTile - 1) / gpu::kTraceTile;
-  ViewImages& images = view.images;
-  if (masked) {
-    // The pre-pass's mask becomes the list of pixels to trace, and the
-    // trace's workgroup count: enough pixels a workgroup that even a list of
-    // every pixel stays within the device's limit on workgroups.
-    uint64_t pixels = uint64_t(settings.width) * settings.height;
-    uint64_t maxGroups = context_.caps().maxComputeWorkgroupCount[0];
-    push.pixelsPerGroup = static_cast<uint32_t>(64 * ((pixels + 64 * maxGroups - 1) / (64 * maxGroups)));
-    commands.graphicsToCompute();
-    const gpu::TracePixelListHeader header{0, 0, 0, 1, 1, 0, 0, 0};
-    commands.updateBuffer(images.pixels, &header, sizeof(header));
-    commands.transferToCompute();
-    gpu::TraceCompactPush compact{settings.width, settings.height, push.tilesX, push.pixelsPerGroup};
-    uint64_t tiles = uint64_t(push.tilesX) * tilesY;
-    commands.beginPass("trace list");
-    compact_->dispatchGroups(commands,
-                             {{gpu::kTraceBindingMask, nullptr, &images.mask},
-                              {gpu::kTraceBindingPixels, &images.pixels}},
-                             compact, (tiles + gpu::kTraceCompactTiles - 1) / gpu::kTraceCompactTiles);
-    commands.endPass();
-    commands.computeToIndirect();
-    commands.beginPass("trace");
+  TraceInputs in{&scene_, &instances_, &lights_, lightCount_, origin_.origin(), blas_.get(), tlas_.get()};
+  TraceTarget target{&view.images.trace, request.aov ? &view.images.aov : nullptr,
+                     request.settings.rays.empty() ? nullptr : &view.rays, &view.images.mask, &view.images.pixels};
+  if (request.output == ViewOutput::Trace && request.driverTrace) {
+    stats.pixelsTraced += trace_->recordDriver(commands, in, request.settings, target);
   } else {
-    commands.computeToCompute();
-    commands.beginPass("trace");
-    stats.pixelsTraced += uint64_t(settings.width) * settings.height;
+    stats.pixelsTraced += trace_->record(commands, in, request.settings, target, masked);
   }
-  std::vector<vk::BufferBinding> bindings = pathBindings(request, view);
-  bindings.insert(bindings.end(), {{gpu::kTraceBindingTlasNodes, &tlas_->nodes},
-                                   {gpu::kTraceBindingTlasGroups, &tlas_->groups},
-                                   {gpu::kTraceBindingBlasNodes, &blas_->nodes},
-                                   {gpu::kTraceBindingBlasGroups, &blas_->groups},
-                                   {gpu::kTraceBindingPixels, masked ? &images.pixels : &placeholder_}});
-  if (masked) {
-    trace_->dispatchIndirect(commands, bindings, push, images.pixels, gpu::kTracePixelListDispatchOffset);
-  } else {
-    trace_->dispatchGroups(commands, bindings, push, uint64_t(push.tilesX) * tilesY);
-  }
-  commands.endPass();
   ++stats.traceDispatches;
 }
 
@@ -622,7 +371,7 @@ void Renderer::recordView(vk::Commands& commands, Slot& slot, size_t index, cons
                           FrameStats& stats) {
   View& view = views_[index];
   const FrameSettings& settings = request.settings;
-  bool unchanged = view.rendered && view.version == sceneVersion_ && sameRequest(request, view.last);
+  bool unchanged = view.rendered && view.version == sceneVersion_ && request == view.last;
   if (unchanged) {
     ++stats.viewsSkipped;
   } else {
@@ -631,16 +380,14 @@ void Renderer::recordView(vk::Commands& commands, Slot& slot, size_t index, cons
         std::vector<gpu::GpuRay> rays(settings.rays.size());
         for (size_t i = 0; i < rays.size(); ++i) {
           // Relative to the origin in double, like the instances, before the cast to float.
-          rays[i].origin = glm::vec4(glm::vec3(settings.rays[i].origin - origin_), 1.0f);
+          rays[i].origin = glm::vec4(glm::vec3(settings.rays[i].origin - origin_.origin()), 1.0f);
           rays[i].direction = glm::vec4(glm::vec3(glm::normalize(settings.rays[i].direction)), 0.0f);
         }
         return rays;
       }(), view.rays);
     if (!settings.rays.empty()) commands.transferToCompute();
-    RasterScene scene{&scene_, &sceneModel_, &instances_, &lights_, lightCount_, origin_};
-    if (request.output == ViewOutput::Trace && request.driverTrace) {
-      recordDriverTrace(commands, request, view, stats);
-    } else if (request.output == ViewOutput::Trace) {
+    RasterScene scene{&scene_, &sceneModel_, &instances_, &lights_, lightCount_, origin_.origin()};
+    if (request.output == ViewOutput::Trace) {
       recordTrace(commands, request, view, false, stats);
     } else {
       bool glass = request.raster.refraction && refractive_ && transmissiveInView(settings);
@@ -666,15 +413,15 @@ void Renderer::recordView(vk::Commands& commands, Slot& slot, size_t index, cons
     view.last.settings.rays.clear();
     if (!settings.rays.empty()) view.rendered = false;  // a ray list is never assumed the same
   }
-  if (!request.readback) return;
+  if (!request.readback.enabled) return;
   Slot::ViewReadback rb;
   rb.view = index;
   rb.width = settings.width;
   rb.height = settings.height;
   rb.composite = request.output == ViewOutput::Composite;
-  rb.trace = !rb.composite || request.readbackTrace;
+  rb.trace = !rb.composite || request.readback.trace;
   rb.aov = request.aov;
-  rb.half = request.halfReadback;
+  rb.half = request.readback.half;
   VkDeviceSize pixels = VkDeviceSize(settings.width) * settings.height;
   VkDeviceSize images = pixels * 8 * ((rb.trace ? 1 : 0) + (rb.composite ? 1 : 0));
   VkDeviceSize bytes = images + (rb.aov ? pixels * sizeof(gpu::TraceAov) : 0);
@@ -713,7 +460,7 @@ uint64_t Renderer::submit(const FrameRequest& request) {
       throw std::invalid_argument("renderer: ray lists have no raster image");
     }
   }
-  uploadEnvironments(request.views);
+  for (const ViewRequest& v : request.views) trace_->prepare(v.settings);
   uint64_t frame = ++submitted_;
   Slot& slot = *slots_[frame % slots_.size()];
   if (slot.pending) collect(slot);
@@ -782,6 +529,7 @@ uint64_t Renderer::submit(const FrameRequest& request) {
 
   Update update = planUpdate(pose, request.views, stats);
   vk::Commands& commands = slot.commands;
+  commands.setTimed(options_.passTimes);
   commands.begin();
   if (request.prologue) request.prologue(commands);
   // Frames in flight share the scene's GPU data: what this frame rewrites,
@@ -847,23 +595,11 @@ void Renderer::collect(Slot& slot) {
     std::vector<char> built(scene_.geometries.size(), 0);
     for (uint32_t g : slot.builtGroups) built[g] = 1;
     for (uint32_t g : slot.refitGroups) {
-      double cost = sahAt(uint64_t(g) * 16);
-      if (built[g] || baselineSah_[g] <= 0.0) {
-        baselineSah_[g] = cost;
-        continue;
-      }
-      result.stats.sahGrowth = std::max(result.stats.sahGrowth, cost / baselineSah_[g]);
-      if (cost > options_.rebuildGrowth * baselineSah_[g] && !queued_[g]) {
-        queued_[g] = 1;
-        rebuildQueue_.push_back(g);
-      }
+      double growth = rebuilds_.noteBottom(g, sahAt(uint64_t(g) * 16), built[g]);
+      result.stats.sahGrowth = std::max(result.stats.sahGrowth, growth);
     }
   }
-  if (slot.topRefit) {
-    double cost = sahAt(slot.topStatsAt);
-    if (slot.topBuilt || topBaselineSah_ <= 0.0) topBaselineSah_ = cost;
-    else if (cost > options_.rebuildGrowth * topBaselineSah_) topRebuildDue_ = true;
-  }
+  if (slot.topRefit) rebuilds_.noteTop(sahAt(slot.topStatsAt), slot.topBuilt);
   for (size_t k = 0; k < slot.maskedViews.size(); ++k) result.stats.pixelsTraced += word(slot.pixelCountsAt + 4 * k);
   result.views.clear();
   for (Slot::ViewReadback& rb : slot.readbacks) {
@@ -933,7 +669,7 @@ RenderedFrame renderOneView(Renderer& renderer, const scene::Pose& pose, const V
   FrameRequest request;
   request.pose = &pose;
   request.views.push_back(view);
-  request.views.back().readback = true;
+  request.views.back().readback.enabled = true;
   const FrameResult& result = renderer.wait(renderer.submit(request));
   RenderedFrame frame;
   frame.width = view.settings.width;

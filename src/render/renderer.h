@@ -15,12 +15,13 @@
 // moved only when a camera gets far from it (so orbiting alone touches no tree).
 #pragma once
 
-#include "peer/driver_tracer.h"
 #include "render/bvh.h"
 #include "render/deform_pass.h"
 #include "render/frame_settings.h"
 #include "render/raster_pass.h"
 #include "render/scene_gpu.h"
+#include "render/scene_state.h"
+#include "render/trace_pass.h"
 #include "scene/evaluate.h"
 #include "scene/scene.h"
 #include "scene/view.h"
@@ -46,6 +47,18 @@ enum class ViewOutput {
   Composite,  ///< the viewport: raster pass, transmissive pixels traced
 };
 
+/// What a view brings back to the host with its frame. It never changes
+/// what the view draws, so it takes no part in comparing requests.
+struct ReadbackRequest {
+  bool enabled = false;  ///< bring the images (and AOV) back with the frame
+  /// Keep the images as the GPU's half floats (ViewPixels::*Half), for
+  /// writers that convert them once, straight to the file's encoding.
+  bool half = false;
+  /// A composite's trace image too (off: the composite alone).
+  bool trace = true;
+  friend bool operator==(const ReadbackRequest&, const ReadbackRequest&) { return true; }
+};
+
 /// One view of a frame.
 struct ViewRequest {
   FrameSettings settings;
@@ -58,12 +71,11 @@ struct ViewRequest {
   /// tracing (the driver-rt peer; needs DeviceCaps::driverRayTracing).
   bool driverTrace = false;
   bool aov = false;       ///< per-pixel gpu::TraceAov of the traced pixels
-  bool readback = false;  ///< bring the images (and AOV) back with the frame
-  /// With readback: keep the images as the GPU's half floats (ViewPixels::*Half),
-  /// for writers that convert them once, straight to the file's encoding.
-  bool halfReadback = false;
-  /// With readback of a composite: bring the trace image back too (off: the composite alone).
-  bool readbackTrace = true;
+  ReadbackRequest readback;
+
+  /// Two requests that compare equal draw the same image: a frame may reuse
+  /// the last one (every field counts, so a new field can never reuse a stale image).
+  friend bool operator==(const ViewRequest&, const ViewRequest&) = default;
 };
 
 /// What one frame did and skipped.
@@ -90,7 +102,7 @@ struct ViewPixels {
   std::vector<glm::vec4> trace;      ///< the trace image, linear RGBA, row 0 at the top
   std::vector<glm::vec4> composite;  ///< composite views
   std::vector<gpu::TraceAov> aov;    ///< when asked for
-  /// ViewRequest::halfReadback: the same images as 4 IEEE halves per pixel (then trace and composite stay empty).
+  /// ReadbackRequest::half: the same images as 4 IEEE halves per pixel (then trace and composite stay empty).
   std::vector<uint16_t> traceHalf, compositeHalf;
 };
 
@@ -126,6 +138,8 @@ struct RendererOptions {
   uint64_t rebuildBudget = 1u << 20;
   /// A host scene's vertex buffers (every shape a host shape); null handles: none.
   HostBuffers host;
+  /// GPU timestamps around every pass (FrameResult::passes); off, a frame records none.
+  bool passTimes = true;
 };
 
 /// The images of one view; they keep the last frame's result until the next frame that renders the view.
@@ -175,7 +189,7 @@ class Renderer {
 
   const SceneGpu& sceneGpu() const { return scene_; }
   const scene::Scene& scene() const { return sceneModel_; }
-  const glm::dvec3& origin() const { return origin_; }
+  const glm::dvec3& origin() const { return origin_.origin(); }
   /// Whether any face of the scene refracts (else a composite never traces).
   bool refractive() const { return refractive_; }
   /// The trees, built by the first frame that traces (null before).
@@ -199,13 +213,8 @@ class Renderer {
   Update planUpdate(const scene::Pose& pose, const std::vector<ViewRequest>& views, FrameStats& stats);
   void recordUpdate(vk::Commands& commands, Slot& slot, const scene::Pose& pose, const Update& update);
   void recordView(vk::Commands& commands, Slot& slot, size_t index, const ViewRequest& request, FrameStats& stats);
+  /// The view's trace, by snell's own traversal or (driverTrace) the driver's.
   void recordTrace(vk::Commands& commands, const ViewRequest& request, View& view, bool masked, FrameStats& stats);
-  gpu::TracePush tracePush(const ViewRequest& request, bool masked) const;
-  void uploadEnvironments(const std::vector<ViewRequest>& views);
-  const vk::Buffer& environmentBuffer(const scene::Optics& optics) const;
-  void recordDriverTrace(vk::Commands& commands, const ViewRequest& request, View& view, FrameStats& stats);
-  /// What trace.comp and the driver's ray generation shader both bind (path.glsl's buffers).
-  std::vector<vk::BufferBinding> pathBindings(const ViewRequest& request, View& view) const;
   void collect(Slot& slot);
   bool viewNeedsTrees(const ViewRequest& request) const;
   bool transmissiveInView(const FrameSettings& settings) const;
@@ -216,17 +225,10 @@ class Renderer {
   SceneGpu scene_;
   std::unique_ptr<DeformPass> deform_;
   std::unique_ptr<RasterPass> raster_;
+  std::unique_ptr<TracePass> trace_;
   std::unique_ptr<BvhBuilder> builder_;
   std::unique_ptr<Bvh> blas_, tlas_;
-  std::unique_ptr<vk::ComputeProgram> trace_, compact_;
-  vk::Buffer instances_, lights_, placeholder_, stats_;
-  /// Environments uploaded for views, by identity; each holds its own reference,
-  /// so a buffer is never freed under a frame in flight that reads it.
-  struct Environment {
-    std::shared_ptr<const scene::Environment> source;
-    vk::Buffer buffer;
-  };
-  std::map<const scene::Environment*, Environment> environments_;
+  vk::Buffer instances_, lights_;
   uint32_t lightCount_ = 0;
   bool refractive_ = false;
 
@@ -240,31 +242,12 @@ class Renderer {
   std::vector<uint32_t> itemDeformOutput_; ///< per pose item: its DeformPass output, or ~0
   std::vector<gpu::GpuInstance> uploadedInstances_;
   std::vector<gpu::GpuLight> uploadedLights_;
-  std::unique_ptr<peer::DriverTracer> driver_;  ///< the driver-rt peer, made when a view asks for it
-  std::vector<char> driverMoved_;  ///< per geometry: positions changed since the driver's structures saw them
-  bool driverInstancesStale_ = true;  ///< instances moved in frames the driver's top level did not see
   std::vector<char> geometryDirty_;  ///< per bottom-level group: positions changed since its tree last saw them
   bool treesBuilt_ = false, topDirty_ = true, topBuilt_ = false;
-  bool originSet_ = false;
-  glm::dvec3 origin_{0.0};
   uint64_t sceneVersion_ = 0;  ///< bumps whenever what a view shows may have changed
-  // Tree quality: SAH cost right after each group's build, and rebuilds due.
-  std::vector<double> baselineSah_;
-  double topBaselineSah_ = 0.0;
-  std::deque<uint32_t> rebuildQueue_;
-  std::vector<char> queued_;
-  bool topRebuildDue_ = false;
-  // Bounding spheres: per shape at rest (its morph targets' largest
-  // displacements apart), and per item as the last frame placed it.
-  struct Sphere {
-    glm::dvec3 centre{0.0};
-    double radius = 0.0;
-  };
-  /// The sphere around a box; a host shape's empty box (no promise) is never culled.
-  static Sphere boundingSphere(const glm::dvec3& lo, const glm::dvec3& hi, bool host);
-  std::vector<Sphere> shapeSpheres_;
-  std::vector<std::vector<double>> shapeMorphReach_;  ///< per shape, per target: its largest displacement
-  std::vector<Sphere> itemSpheres_;
+  SceneBounds bounds_;
+  FrameOrigin origin_;
+  RebuildQueue rebuilds_;
 
   std::vector<std::unique_ptr<Slot>> slots_;
   std::vector<View> views_;

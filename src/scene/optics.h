@@ -37,6 +37,7 @@ struct Optics {
   bool textureLod = true;
   bool dispersion = true;  ///< dispersive materials split the colours (off: none does)
   bool volume = true;      ///< volumes attenuate (off: every material is thin-walled)
+  friend bool operator==(const Optics&, const Optics&) = default;
 };
 
 }  // namespace snell::scene

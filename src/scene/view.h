@@ -28,6 +28,7 @@ struct ViewRequest {
 struct Ray {
   glm::dvec3 origin{0.0};
   glm::dvec3 direction{0.0, 0.0, -1.0};  ///< unit length
+  friend bool operator==(const Ray&, const Ray&) = default;
 };
 
 /// A camera frame in world space, orthonormal, in double precision.
@@ -43,6 +44,7 @@ struct View {
   /// (a 2D pan that moves the picture, not the camera; halfHeight zooms).
   glm::dvec2 shift{0.0};
   std::string description;  ///< for messages: which camera this is
+  friend bool operator==(const View&, const View&) = default;
 };
 
 /// Resolves the request at a pose. Throws std::invalid_argument when the

@@ -253,7 +253,7 @@ void Commands::fillBuffer(const Buffer& buffer, uint32_t word, VkDeviceSize offs
 
 void Commands::beginPass(const std::string& name) {
   if (passOpen_) endPass();
-  if (!queries_ || queryCount_ + 2 > kMaxTimestamps) return;
+  if (!timed_ || !queries_ || queryCount_ + 2 > kMaxTimestamps) return;
   // BOTTOM_OF_PIPE waits for every earlier command: a TOP_OF_PIPE stamp would
   // start the clock while earlier copies still run and charge them to this pass.
   vkCmdWriteTimestamp(buffer_, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, queries_, queryCount_++);

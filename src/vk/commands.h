@@ -94,6 +94,8 @@ class Commands {
   /// not nest; at most 128 per submission. No-op where the queue has no timestamps.
   void beginPass(const std::string& name);
   void endPass();
+  /// Whether passes are timed at all (on by default): off, beginPass and endPass record nothing.
+  void setTimed(bool timed) { timed_ = timed; }
   /// The timings of the last completed submission, in recording order.
   const std::vector<PassTime>& passTimes() const { return times_; }
 
@@ -125,6 +127,7 @@ class Commands {
   bool recording_ = false;
   uint32_t queryCount_ = 0;
   std::vector<std::string> passNames_;
+  bool timed_ = true;
   bool passOpen_ = false;
   std::vector<PassTime> times_;
   std::vector<std::shared_ptr<void>> keptAlive_;

@@ -102,7 +102,7 @@ vec3 environmentTexel(int x, int y, int width, int height) {
 }
 
 vec3 environmentColour(vec3 d) {
-  if ((pc.optics & kOpticsEnvironmentMap) == 0u) {
+  if (!opticsOn(kOpticsEnvironmentMap)) {
     return d.y >= 0.0 ? mix(kStudioHorizon, kStudioZenith, d.y) : mix(kStudioHorizon, kStudioGround, min(1.0, -4.0 * d.y));
   }
   int width = int(environment[0].x), height = int(environment[0].y);

@@ -10,6 +10,12 @@
 
 const float kInf = 1.0 / 0.0;  // folded to +infinity at compile time
 
+// What the pipeline was specialised for (shared/trace.h: kTraceSpecOptics), and what this dispatch draws.
+layout(constant_id = kTraceSpecOptics) const uint kSpecOptics = 0xffffffffu;
+layout(constant_id = kTraceSpecFlags) const uint kSpecFlags = 0xffffffffu;
+bool opticsOn(uint bit) { return (kSpecOptics & pc.optics & bit) != 0u; }
+bool traceFlag(uint bit) { return (kSpecFlags & pc.flags & bit) != 0u; }
+
 uint visits;  // nodes visited by this pixel's whole path (the driver's pipeline cannot count them: 0)
 
 struct Hit {
@@ -134,7 +140,7 @@ vec3 leave(Surface s, vec3 dir, out float tMin) {
 bool tracePath(vec3 origin, vec3 dir, float width, float spread, int channel, out Path path) {
   path = Path(vec3(0.0), 0u, kOutcomeMiss, -1.0, kNoHit, kNoHit, vec2(uintBitsToFloat(0x7fc00000u)), kNoHit, vec3(0.0),
               0.0, vec3(0.0));
-  bool fresnel = (pc.optics & kOpticsFresnel) != 0u;
+  bool fresnel = opticsOn(kOpticsFresnel);
   uint reflections = fresnel ? pc.reflections : 0u;
   vec3 throughput = vec3(1.0);
   mediaCount = 0u;
@@ -176,7 +182,7 @@ bool tracePath(vec3 origin, vec3 dir, float width, float spread, int channel, ou
       return false;
     }
     int inside = currentMedium();
-    if (inside >= 0 && (pc.optics & kOpticsVolume) != 0u) {  // Beer-Lambert over the segment
+    if (inside >= 0 && opticsOn(kOpticsVolume)) {  // Beer-Lambert over the segment
       GpuMaterial volume = materials[media[inside]];
       if (volume.attenuationDistance > 0.0) {
         throughput *= pow(volume.attenuationColor.rgb, vec3(hit.t / volume.attenuationDistance));
@@ -223,7 +229,7 @@ bool tracePath(vec3 origin, vec3 dir, float width, float spread, int channel, ou
       if (outside >= 0) other = media[outside];
     }
     float otherIor = other == kNoHit ? 1.0 : mediumIor(other, channel);
-    bool dispersive = (pc.optics & kOpticsDispersion) != 0u &&
+    bool dispersive = opticsOn(kOpticsDispersion) &&
                       (m.dispersion > 0.0 || (other != kNoHit && materials[other].dispersion > 0.0));
     if (boundary && channel < 0 && dispersive) return true;
     float n1 = entering ? otherIor : surface, n2 = entering ? surface : otherIor;
@@ -288,11 +294,11 @@ void tracePixel(uvec2 pixel) {
   float sy = (1.0 - 2.0 * (float(pixel.y) + 0.5) / float(pc.height)) * pc.up.w + pc.shiftY;
   vec3 origin = pc.eye.xyz, dir;
   float width = 0.0, spread = 0.0;  // listed rays have no footprint: level 0
-  if ((pc.flags & kTraceFlagRayList) != 0u) {
+  if (traceFlag(kTraceFlagRayList)) {
     GpuRay ray = rays[pixel.y * pc.width + pixel.x];
     origin = ray.origin.xyz;
     dir = ray.direction.xyz;
-  } else if ((pc.flags & kTraceFlagOrthographic) != 0u) {
+  } else if (traceFlag(kTraceFlagOrthographic)) {
     origin += sx * pc.right.xyz + sy * pc.up.xyz;
     dir = pc.forward.xyz;
     width = 2.0 * pc.up.w / float(pc.height);
@@ -300,7 +306,7 @@ void tracePixel(uvec2 pixel) {
     dir = normalize(pc.forward.xyz + sx * pc.right.xyz + sy * pc.up.xyz);
     spread = atan(2.0 * pc.up.w / float(pc.height));
   }
-  if ((pc.optics & kOpticsTextureLod) == 0u) width = spread = 0.0;
+  if (!opticsOn(kOpticsTextureLod)) width = spread = 0.0;
 
   visits = 0u;
   // One call site for the path (a compiler that inlines would copy it per
@@ -323,7 +329,7 @@ void tracePixel(uvec2 pixel) {
   path.colour = colour;
 
   imageStore(outImage, ivec2(pixel), vec4(path.colour, 1.0));
-  if ((pc.flags & kTraceFlagAov) != 0u) {
+  if (traceFlag(kTraceFlagAov)) {
     // The colour less its landing's textured part is the shine (every channel's path, so dispersion too).
     vec3 shine = path.interfaces > 0u ? path.colour - path.landingWeight * path.landingTexel : vec3(0.0);
     vec3 weight = path.interfaces > 0u ? path.landingWeight : vec3(0.0);
