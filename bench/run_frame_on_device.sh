@@ -12,6 +12,10 @@
 #   bench/run_frame_on_device.sh maps    # refraction-map beside the trace and the raster methods (1920x1080), drift table
 #   bench/run_frame_on_device.sh robust  # the long runs: bench frame --soak (validation on) on the GPU while the
 #                                        # libFuzzer targets (carried in .fuzz/) run on the other cores
+#   bench/run_frame_on_device.sh first   # a first image in a fresh process: driver and snell caches empty, then warm
+#   bench/run_frame_on_device.sh trace   # trace against driver-rt at 1920x1080: glass spheres of 100k and 1M
+#                                        # triangles (bench/make_sphere.py), the eye
+#   bench/run_frame_on_device.sh viewport # the viewport's refraction work: crowd 2, eye 64, eye 256, crowd 100 at 4K
 #   bench/run_frame_on_device.sh python  # the Python module, built there for its python3 against the carried
 #                                        # install (.carry/prefix), replaying the Blender feed in .carry/feed
 #                                        # (bench/record_blender_feed.py), beside bench frame of the rig's glTF
@@ -137,4 +141,49 @@ if [[ $step == python ]]; then
     echo "== snell bench frame of Blender's glTF export of the same rig, same size"
     .carry/snell bench frame .carry/feed/rig.glb --viewport --size 1920x1080 --warmup 200 --frames 48 --json "$OUT/frame-rig.json"
   } 2>&1 | tee "$OUT/python.log"
+fi
+if [[ $step == first ]]; then
+  {
+    TIMEFORMAT="%R s wall"
+    for run in cold warm; do
+      # Fresh caches for the cold run: the driver's own (NVIDIA reads __GL_SHADER_DISK_CACHE_PATH) and snell's.
+      [[ $run == cold ]] && rm -rf /tmp/caches
+      mkdir -p /tmp/caches/xdg /tmp/caches/nv
+      echo "== $run: snell render --eye --size 1920x1080"
+      time XDG_CACHE_HOME=/tmp/caches/xdg __GL_SHADER_DISK_CACHE_PATH=/tmp/caches/nv \
+        .carry/snell -q render --eye --size 1920x1080 -o /tmp/first.png
+    done
+    echo "== where a cold first frame goes (snell info --timings, empty caches)"
+    .carry/snell eye -o /tmp/eye.glb >/dev/null
+    rm -rf /tmp/caches && mkdir -p /tmp/caches/xdg /tmp/caches/nv
+    XDG_CACHE_HOME=/tmp/caches/xdg __GL_SHADER_DISK_CACHE_PATH=/tmp/caches/nv .carry/snell info /tmp/eye.glb --timings | tail -2
+    XDG_CACHE_HOME=/tmp/caches/xdg __GL_SHADER_DISK_CACHE_PATH=/tmp/caches/nv .carry/snell info /tmp/eye.glb --timings | tail -1
+  } 2>&1 | tee "$OUT/first.log"
+fi
+if [[ $step == trace ]]; then
+  json=$(mktemp -d)
+  {
+    python3 bench/make_sphere.py 100000 /tmp/sphere-100k.gltf
+    python3 bench/make_sphere.py 1000000 /tmp/sphere-1m.gltf
+    for scene in /tmp/sphere-100k.gltf /tmp/sphere-1m.gltf eye; do
+      name=$(basename "$scene" .gltf)
+      [[ $scene == eye ]] && scene=""
+      echo "== trace against driver-rt, 1920x1080, $name"
+      .carry/snell bench methods $scene --methods trace,driver-rt --no-reference --frames 8 --size 1920x1080 \
+        --json "$json/trace-$name.json" | grep -v "CPU reference"
+    done
+  } 2>&1 | tee "$OUT/trace.log"
+  tar -C "$json" -cf "$OUT/trace-results.tar" .
+fi
+if [[ $step == viewport ]]; then
+  json=$(mktemp -d)
+  {
+    s=.carry/snell
+    $s bench frame --crowd 2 --viewport --warmup 200 --json "$json/frame-crowd2.json"
+    $s bench frame --viewport --warmup 200 --json "$json/frame-eye64.json"
+    $s bench frame --eye-resolution 256 --viewport --warmup 200 --json "$json/frame-eye256.json"
+    $s bench frame --crowd 100 --viewport --size 3840x2160 --warmup 100 --json "$json/frame-crowd100-4k.json"
+    $s bench frame --viewport --orbit --warmup 200 --json "$json/frame-eye64-orbit.json"
+  } 2>&1 | grep -E "scene:|^refraction|^frame |^wall|device:" | tee "$OUT/viewport.log"
+  tar -C "$json" -cf "$OUT/viewport-results.tar" .
 fi

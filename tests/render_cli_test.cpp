@@ -1,4 +1,5 @@
 // `snell render` as a pipeline engineer runs it: what --stats prints.
+#include "assets.h"
 #include "command_run.h"
 
 #include <gtest/gtest.h>
@@ -28,6 +29,20 @@ TEST(RenderCommand, StatsReportTheFirstFramesBuildAndTracedPixels) {
   EXPECT_GT(std::stoul(m[1]), 0u) << run.output;
   EXPECT_LT(std::stoul(m[1]), 96u * 72u) << "the masked trace covers the glass, not the image: " << run.output;
   EXPECT_NE(run.output.find("GPU ms:"), std::string::npos) << run.output;
+}
+
+// A still glTF measures nothing after its first frame unless the camera moves.
+TEST(BenchFrame, OrbitTracesEveryFrameOfAStillScene) {
+  std::string scene = shellQuoted(model("TransmissionTest/glTF-Binary/TransmissionTest.glb"));
+  CommandRun still = snell("bench frame " + scene + " --viewport --frames 3 --warmup 1 --size 48x32");
+  CommandRun orbit = snell("bench frame " + scene + " --viewport --orbit --frames 3 --warmup 1 --size 48x32");
+  ASSERT_EQ(orbit.exitCode, 0) << orbit.output;
+  EXPECT_NE(orbit.output.find("viewport, masked trace, orbiting"), std::string::npos) << orbit.output;
+  std::smatch m;
+  ASSERT_TRUE(std::regex_search(orbit.output, m, std::regex("pixels traced ([0-9]+)"))) << orbit.output;
+  EXPECT_GT(std::stoul(m[1]), 0u) << "the median orbiting frame traced glass: " << orbit.output;
+  ASSERT_TRUE(std::regex_search(still.output, m, std::regex("pixels traced ([0-9]+)"))) << still.output;
+  EXPECT_EQ(std::stoul(m[1]), 0u) << "a still frame redraws nothing: " << still.output;
 }
 
 TEST(SnellCommand, VersionPrintsTheVersionAndExitsZero) {

@@ -30,6 +30,7 @@ struct Options {
   uint32_t width = 1920, height = 1080, frames = 30, warmup = 5;
   scene::EyeOptions eye;
   bool viewport = false, noMask = false, noRefraction = false;
+  bool orbit = false;  ///< the camera circles the scene, a degree a frame
   std::string json;
   double soak = 0;  ///< seconds; 0: measure --frames instead
 };
@@ -37,6 +38,15 @@ struct Options {
 // The refraction work these tables quote: the refraction passes, and the
 // deform that trees and trace both wait for.
 bool refractionPass(const std::string& name) { return name == "deform" || render::isRefractionPass(name); }
+
+// The view turned `degrees` about the vertical axis through `centre`: an orbit.
+scene::View orbited(scene::View v, const glm::dvec3& centre, double degrees) {
+  double a = degrees * 3.14159265358979 / 180.0, c = std::cos(a), s = std::sin(a);
+  auto turn = [&](const glm::dvec3& d) { return glm::dvec3(c * d.x + s * d.z, d.y, -s * d.x + c * d.z); };
+  v.eye = centre + turn(v.eye - centre);
+  v.right = turn(v.right), v.up = turn(v.up), v.forward = turn(v.forward);
+  return v;
+}
 
 // A long run: is anything growing? Each sample covers a twentieth of the run;
 // only the samples are kept, so the benchmark's own memory stays flat.
@@ -126,11 +136,15 @@ int runFrame(const Options& o) {
   scene::SceneSummary summary = scene::summarize(scene);
   std::string mode = !viewport ? "trace" : !refraction ? "viewport, no refraction" : masked ? "viewport, masked trace"
                                                                                             : "viewport, full trace";
+  if (o.orbit) mode += ", orbiting";
   std::printf("device: %s\nscene: %s, %llu triangles, %ux%u, %s\n", context->facts().name.c_str(), label.c_str(),
               static_cast<unsigned long long>(summary.triangles), width, height, mode.c_str());
 
   double duration = std::max(scene::animationDuration(scene), 1e-3);
   scene::Pose layout = scene::evaluate(scene, 0.0);
+  glm::dvec3 lo, hi;
+  scene::approximateBounds(scene, layout, lo, hi);
+  const glm::dvec3 centre = lo.x <= hi.x ? 0.5 * (lo + hi) : glm::dvec3(0.0);
   render::Renderer renderer(*context, scene, layout);
   std::map<std::string, std::vector<double>> times;
   std::vector<std::string> order;
@@ -143,8 +157,9 @@ int runFrame(const Options& o) {
     double t = std::fmod(double(f) / 24.0, duration);
     scene::Pose pose = scene::evaluate(scene, t);
     render::ViewRequest view;
-    view.settings = {width, height, scene::resolveView(scene, pose, {}), {0.02f, 0.02f, 0.025f},
-                     gpu::kDefaultMaxInterfaces};
+    scene::View camera = scene::resolveView(scene, pose, {});
+    if (o.orbit) camera = orbited(camera, centre, double(f));
+    view.settings = {width, height, camera, {0.02f, 0.02f, 0.025f}, gpu::kDefaultMaxInterfaces};
     if (viewport) {
       view.output = render::ViewOutput::Composite;
       view.masked = masked;
@@ -270,6 +285,8 @@ void addBenchFrame(CLI::App& bench, Runner& run) {
       ->check(CLI::Range(0u, 10000u));
   CLI::Option* viewport =
       sub->add_flag("--viewport", o->viewport, "the viewport composite: raster pass, transmissive pixels traced");
+  sub->add_flag("--orbit", o->orbit,
+                "the camera circles the scene, a degree a frame: a still scene\nis measured too (its trees stay; the trace and raster run)");
   CLI::Option* noMask = sub->add_flag("--no-mask", o->noMask, "with --viewport: trace every pixel")->needs(viewport);
   sub->add_flag("--no-refraction", o->noRefraction, "with --viewport: glass left out, nothing traced")
       ->needs(viewport)
