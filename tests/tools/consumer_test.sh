@@ -25,4 +25,11 @@ cmake --build "$work/build" >/dev/null
 head -c 15 "$work/eye.ppm" | grep -q "^P6" || { echo "no PPM written"; exit 1; }
 size=$(stat -c %s "$work/eye.ppm")
 [ "$size" = $((13 + 64 * 48 * 3)) ] || { echo "PPM of $size bytes"; exit 1; }
+# The Python module, where the build made one: installed into the prefix's dist-packages, finding libsnell there.
+if [ -d "$build/python/snell" ]; then
+  site=$(ls -d "$work"/prefix/lib/python3*/dist-packages 2>/dev/null | head -1)
+  [ -n "$site" ] || { echo "the Python module was not installed"; exit 1; }
+  PYTHONPATH="$site" /usr/bin/python3 -c "import snell; assert snell.version()" ||
+    { echo "the installed Python module does not import"; exit 1; }
+fi
 echo "consumer built against $work/prefix and rendered a frame"
