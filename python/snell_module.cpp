@@ -484,14 +484,15 @@ PYBIND11_MODULE(_snell, m) {
            }),
            "width"_a = 640, "height"_a = 480, "camera"_a = -1, "view_matrix"_a = py::none(), "projection"_a = py::none(),
            "eye"_a = std::vector<float>{0, 0, 3}, "target"_a = std::vector<float>{0, 0, 0},
-           "up"_a = std::vector<float>{0, 1, 0}, "yfov"_a = 0.6981317f, "viewport"_a = false, "method"_a = "trace",
+           "up"_a = std::vector<float>{0, 1, 0}, "yfov"_a = 0.6981317f, "viewport"_a = false, "method"_a = "auto",
            "max_interfaces"_a = 8, "fresnel"_a = true, "dispersion"_a = true, "volume"_a = true,
            "background"_a = std::vector<float>{0.02f, 0.02f, 0.025f}, "transparent_background"_a = false,
            "The camera: the scene's camera `camera` (an index), else view_matrix (world to camera)\n"
            "with projection (OpenGL: perspective or orthographic, off-centre for lens shift; its\n"
            "aspect must be width/height), else a look-at from eye to target with yfov radians.\n"
            "viewport=True draws the viewport composite: rasterised, with only the glass traced.\n"
-           "method: trace, trace-1, iris-plane, normal-offset, refraction-map, none or driver-rt.")
+           "method: auto (trace, or driver-rt where it times faster), trace, trace-1, iris-plane,\n"
+           "normal-offset, refraction-map, none or driver-rt.")
       .def_readwrite("width", &snell::View::width)
       .def_readwrite("height", &snell::View::height)
       .def_readwrite("camera", &snell::View::sceneCamera)

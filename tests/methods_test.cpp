@@ -71,6 +71,45 @@ TEST(Methods, EveryMethodHasAUniqueNameThatParsesBack) {
 
 // The eye's rays cross one interface, the cornea, before the iris: bending
 // only there is the whole physics.
+// Pass times of one frame of a method, as the renderer reports them.
+std::vector<vk::PassTime> tracePass(render::Method m, double ms) {
+  return {{"tlas", 0.01}, {m == render::Method::DriverRt ? "driver trace" : "trace", ms}};
+}
+
+TEST(AutoMethod, IsTraceWhereTheDeviceHasNoRayTracingPipelines) {
+  render::AutoMethod automatic(false, false);
+  EXPECT_TRUE(automatic.decided());
+  EXPECT_EQ(automatic.next(), render::Method::Trace);
+  EXPECT_NE(automatic.describe().find("no ray tracing pipelines"), std::string::npos) << automatic.describe();
+}
+
+TEST(AutoMethod, IsTheMaskedTraceForAViewport) {
+  render::AutoMethod automatic(true, true);
+  EXPECT_EQ(automatic.next(), render::Method::Masked);
+}
+
+TEST(AutoMethod, IsTraceForTooFewFramesToTime) {
+  render::AutoMethod automatic(true, false, 3);
+  EXPECT_EQ(automatic.next(), render::Method::Trace);
+}
+
+TEST(AutoMethod, TimesBothThenKeepsTheFasterWithoutCountingEachOnesFirstFrame) {
+  for (double driverMs : {0.5, 2.0}) {
+    render::AutoMethod automatic(true, false);
+    int frames = 0;
+    while (!automatic.decided()) {
+      render::Method m = automatic.next();
+      // A first frame of either that looks fast must not decide it.
+      bool first = frames < 2;
+      automatic.note(m, tracePass(m, first ? 0.01 : (m == render::Method::Trace ? 1.0 : driverMs)));
+      ASSERT_LT(++frames, 20);
+    }
+    EXPECT_EQ(frames, 2 * (render::AutoMethod::kTrials + 1));
+    EXPECT_EQ(automatic.next(), driverMs < 1.0 ? render::Method::DriverRt : render::Method::Trace) << automatic.describe();
+    EXPECT_NE(automatic.describe().find("trace 1.000 ms"), std::string::npos) << automatic.describe();
+  }
+}
+
 TEST_F(GpuTest, TraceOnceIsTheFullTraceWhereRaysCrossOneInterface) {
   scene::Scene eye = eyeWith(1.376f);
   Comparison c = compare(draw(context(), eye, Method::TraceOnce).image, draw(context(), eye, Method::Trace).image);

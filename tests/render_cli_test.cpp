@@ -45,6 +45,15 @@ TEST(BenchFrame, OrbitTracesEveryFrameOfAStillScene) {
   EXPECT_EQ(std::stoul(m[1]), 0u) << "a still frame redraws nothing: " << still.output;
 }
 
+TEST(RenderCommand, TheDefaultMethodIsAutoAndSaysWhatItDrewWith) {
+  fs::path out = fs::temp_directory_path() / "snell_render_auto.png";
+  CommandRun run = snell("render --eye --size 32x24 -o " + shellQuoted(out.string()));
+  fs::remove(out);
+  ASSERT_EQ(run.exitCode, 0) << run.output;
+  EXPECT_TRUE(std::regex_search(run.output, std::regex("method auto: (trace|driver-rt) \\(")))
+      << run.output;
+}
+
 TEST(SnellCommand, VersionPrintsTheVersionAndExitsZero) {
   CommandRun run = snell("--version");
   EXPECT_EQ(run.exitCode, 0) << run.output;

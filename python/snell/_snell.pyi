@@ -202,7 +202,7 @@ class View:
         up: Sequence[float] = (0, 1, 0),
         yfov: float = 0.6981317,
         viewport: bool = False,
-        method: str = "trace",
+        method: str = "auto",
         max_interfaces: int = 8,
         fresnel: bool = True,
         dispersion: bool = True,

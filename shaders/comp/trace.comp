@@ -116,9 +116,10 @@ BvhNode blasNode(uint i) {
   return nodeFromWords(blasWords[w], blasWords[w + 1u], blasWords[w + 2u], blasWords[w + 3u], blasWords[w + 4u]);
 }
 
-// Pushes the children the ray enters before tMax, the nearer on top. A full
-// stack drops them (only a corrupted tree is that deep): the ray still ends.
-void pushChildren(BvhNode node, ShearedRay r, float tMax, inout uint sp) {
+// The children of `node` the ray enters before tMax, nearer first: their
+// entry distances (kInf where missed or empty) and references.
+void enterChildren(BvhNode node, ShearedRay r, float tMax, out float tNear, out float tFar, out uint nearRef,
+                   out uint farRef) {
   vec3 lo0, hi0, lo1, hi1;
   decodeChild(node, 0u, lo0, hi0);
   decodeChild(node, 1u, lo1, hi1);
@@ -126,15 +127,28 @@ void pushChildren(BvhNode node, ShearedRay r, float tMax, inout uint sp) {
   float t0 = lo0.x <= hi0.x ? enterBox(r, lo0, hi0, tMax) : kInf;
   float t1 = lo1.x <= hi1.x ? enterBox(r, lo1, hi1, tMax) : kInf;
   bool swapOrder = t1 < t0;
-  uint nearRef = swapOrder ? node.child[1] : node.child[0], farRef = swapOrder ? node.child[0] : node.child[1];
-  if (max(t0, t1) < kInf && sp < kStackSize) stack[sp++] = farRef;
-  if (min(t0, t1) < kInf && sp < kStackSize) stack[sp++] = nearRef;
+  tNear = min(t0, t1);
+  tFar = max(t0, t1);
+  nearRef = swapOrder ? node.child[1] : node.child[0];
+  farRef = swapOrder ? node.child[0] : node.child[1];
+}
+
+// A triangle of the instance's tree: the closest hit so far if nearer.
+void testTriangle(ShearedRay r, uint instance, uint tri, uint skipPrim, uint first, uint end, float tMin,
+                  inout Hit hit) {
+  if (tri == skipPrim || tri < first || tri >= end) return;  // skipPrim: the face this ray leaves
+  vec3 bary;
+  float t = intersectTriangle(r, tri, hit.t, bary);
+  if (t < hit.t && t > tMin) hit = Hit(t, instance, tri, bary);
 }
 
 // One instance's tree, with the ray in its object space (t is shared: the
-// direction is not renormalised). Uses the stack above `base`. References
-// outside the group's own nodes and triangles (only a corrupted tree has
-// them) are skipped, so a bad tree costs visits, never a wild read.
+// direction is not renormalised). Uses the stack above `base`. The nearer
+// child entered goes on at once (no stack round trip) and the farther is
+// pushed; a leaf child's triangle is tested before the next node, from one
+// call site (lavapipe compiles each call site of the test in full).
+// References outside the group's own nodes and triangles (only a corrupted
+// tree has them) are skipped, so a bad tree costs visits, never a wild read.
 void traverseBlas(uint instance, vec3 origin, vec3 dir, uint skipPrim, float tMin, uint base, inout Hit hit) {
   GpuInstance inst = instances[instance];
   BvhGroup group = blasGroups[inst.geometry];
@@ -146,21 +160,32 @@ void traverseBlas(uint instance, vec3 origin, vec3 dir, uint skipPrim, float tMi
                 dot(inst.worldToObject[2].xyz, dir));
   ShearedRay r = shearRay(o, d);
   uint sp = base;
-  stack[sp++] = group.root;
-  while (sp > base && budget > 0u) {
-    --budget;
-    uint ref = stack[--sp];
-    ++visits;
-    if ((ref & kBvhLeafBit) != 0u) {
-      uint tri = ref & ~kBvhLeafBit;
-      if (tri == skipPrim || tri < group.first || tri >= end) continue;  // skipPrim: the face this ray leaves
-      vec3 bary;
-      float t = intersectTriangle(r, tri, hit.t, bary);
-      if (t < hit.t && t > tMin) hit = Hit(t, instance, tri, bary);
-      continue;
+  uint ref = group.root;
+  bool haveNode = (ref & kBvhLeafBit) == 0u;
+  uint leaves[2] = uint[2](ref & ~kBvhLeafBit, 0u);
+  uint leafCount = haveNode ? 0u : 1u;
+  for (;;) {
+    for (uint k = 0u; k < leafCount; ++k) testTriangle(r, instance, leaves[k], skipPrim, group.first, end, tMin, hit);
+    leafCount = 0u;
+    if (!haveNode) {
+      if (sp == base || budget == 0u) break;
+      ref = stack[--sp];
     }
+    haveNode = false;
+    --budget;
+    ++visits;
     if (ref < group.first || ref + 1u >= end) continue;
-    pushChildren(blasNode(ref), r, hit.t, sp);
+    float tNear, tFar;
+    uint nearRef, farRef;
+    enterChildren(blasNode(ref), r, hit.t, tNear, tFar, nearRef, farRef);
+    if (tFar < kInf) {
+      if ((farRef & kBvhLeafBit) != 0u) leaves[leafCount++] = farRef & ~kBvhLeafBit;
+      else if (sp < kStackSize) stack[sp++] = farRef;  // a full stack drops it: only a corrupted tree is that deep
+    }
+    if (tNear < kInf) {
+      if ((nearRef & kBvhLeafBit) != 0u) leaves[leafCount++] = nearRef & ~kBvhLeafBit;
+      else ref = nearRef, haveNode = true;
+    }
   }
 }
 
@@ -187,7 +212,12 @@ Hit traceClosest(vec3 origin, vec3 dir, uint skipInstance, uint skipPrim, float 
       continue;
     }
     if (ref >= nodeEnd) continue;
-    pushChildren(tlasNode(ref), r, hit.t, sp);
+    float tNear, tFar;
+    uint nearRef, farRef;
+    enterChildren(tlasNode(ref), r, hit.t, tNear, tFar, nearRef, farRef);
+    // The nearer on top. A full stack drops them (only a corrupted tree is that deep): the ray still ends.
+    if (tFar < kInf && sp < kStackSize) stack[sp++] = farRef;
+    if (tNear < kInf && sp < kStackSize) stack[sp++] = nearRef;
   }
   return hit;
 }

@@ -444,6 +444,8 @@ struct Renderer::Impl {
   render::RefractionMapBuffer map;
   FrameInfo last;
   std::string method;      ///< the last request's method
+  std::optional<render::AutoMethod> chooser;  ///< method "auto": trace or driver-rt, timed over the first frames
+  render::Method drawn = render::Method::Trace;  ///< the last request's method before the viewport's substitutions
   uint32_t uploading = 0;  ///< kept meshes the frame being recorded copies
   bool composite = false;  ///< the last request draws the viewport composite (render() blits it)
 
@@ -514,10 +516,17 @@ struct Renderer::Impl {
     settings.optics.dispersion = view.dispersion;
     settings.optics.volume = view.volume;
 
-    std::string name = view.method.empty() ? "trace" : view.method;
-    std::optional<render::Method> chosen = render::methodFromName(name);
-    if (!chosen) throw Error("view: no method '" + name + "' (the methods: " + render::methodNames() + ")");
+    std::string name = view.method.empty() ? "auto" : view.method;
+    std::optional<render::Method> chosen = name == "auto" ? std::optional<render::Method>(render::Method::Trace)
+                                                          : render::methodFromName(name);
+    if (!chosen) throw Error("view: no method '" + name + "' (the methods: auto, " + render::methodNames() + ")");
     render::Method m = *chosen;
+    bool viewportOutput = view.output == View::Output::Viewport;
+    if (name == "auto") {
+      if (!chooser) chooser.emplace(context.caps().driverRayTracing, viewportOutput);
+      m = chooser->next();
+    }
+    drawn = m;
     if (render::needsDriverRayTracing(m) && !context.caps().driverRayTracing) {
       throw Error("view: method " + name + " needs a Device made with DeviceOptions::driverRayTracing on a device that has it");
     }
@@ -572,6 +581,7 @@ struct Renderer::Impl {
   }
 
   void note(const render::FrameResult& result) {
+    if (chooser) chooser->note(drawn, result.passes);
     const render::FrameStats& s = result.stats;
     last = FrameInfo{};
     last.frame = s.frame;

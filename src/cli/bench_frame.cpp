@@ -30,7 +30,7 @@ struct Options {
   uint32_t width = 1920, height = 1080, frames = 30, warmup = 5;
   scene::EyeOptions eye;
   bool viewport = false, noMask = false, noRefraction = false;
-  bool orbit = false;  ///< the camera circles the scene, a degree a frame
+  bool orbit = false;  ///< the camera swings about the scene, 30 degrees either way over 240 frames
   std::string json;
   double soak = 0;  ///< seconds; 0: measure --frames instead
 };
@@ -158,7 +158,8 @@ int runFrame(const Options& o) {
     scene::Pose pose = scene::evaluate(scene, t);
     render::ViewRequest view;
     scene::View camera = scene::resolveView(scene, pose, {});
-    if (o.orbit) camera = orbited(camera, centre, double(f));
+    // A swing of 30 degrees either way, not a full circle: the side that faces the camera stays in view.
+    if (o.orbit) camera = orbited(camera, centre, 30.0 * std::sin(double(f) * 2.0 * 3.14159265358979 / 240.0));
     view.settings = {width, height, camera, {0.02f, 0.02f, 0.025f}, gpu::kDefaultMaxInterfaces};
     if (viewport) {
       view.output = render::ViewOutput::Composite;
@@ -286,7 +287,7 @@ void addBenchFrame(CLI::App& bench, Runner& run) {
   CLI::Option* viewport =
       sub->add_flag("--viewport", o->viewport, "the viewport composite: raster pass, transmissive pixels traced");
   sub->add_flag("--orbit", o->orbit,
-                "the camera circles the scene, a degree a frame: a still scene\nis measured too (its trees stay; the trace and raster run)");
+                "the camera swings about the scene (30 degrees either way over\n240 frames): a still scene is measured too (its trees stay;\nthe trace and raster run)");
   CLI::Option* noMask = sub->add_flag("--no-mask", o->noMask, "with --viewport: trace every pixel")->needs(viewport);
   sub->add_flag("--no-refraction", o->noRefraction, "with --viewport: glass left out, nothing traced")
       ->needs(viewport)

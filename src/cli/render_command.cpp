@@ -59,6 +59,7 @@ struct Options {
   bool reference = false;
   bool viewport = false;
   std::optional<render::Method> method;
+  bool autoMethod = false;  ///< --method auto (the default for a trace): trace or driver-rt, timed
   bool stats = false;
   render::RasterOptions raster;
   scene::Optics optics;
@@ -274,10 +275,15 @@ void addOptions(CLI::App& render, Options& o) {
   render.add_option_function<std::string>(
          "--method",
          [&o](const std::string& name) {
-           o.method = render::methodFromName(name);
-           if (!o.method) throw UsageError{"--method takes one of " + render::methodNames() + ", got '" + name + "'"};
+           o.autoMethod = name == "auto";
+           o.method = o.autoMethod ? std::nullopt : render::methodFromName(name);
+           if (!o.method && !o.autoMethod) {
+             throw UsageError{"--method takes auto or one of " + render::methodNames() + ", got '" + name + "'"};
+           }
          },
-         "how refraction is drawn (default trace): trace,\n"
+         "how refraction is drawn (default auto): auto (trace,\n"
+         "or driver-rt where the first frames time it faster;\n"
+         "EXR and AOV need trace, so there it is trace), trace,\n"
          "trace-1 (bends at the first interface only), masked\n"
          "(the viewport: raster, glass pixels traced),\n"
          "iris-plane and normal-offset (raster, no trace),\n"
@@ -339,7 +345,7 @@ void check(Options& o) {
   if (o.viewport && o.reference) {
     throw UsageError{"render: --viewport is drawn on the GPU; the reference traces (--reference) without it"};
   }
-  if (o.method && o.reference) {
+  if ((o.method || o.autoMethod) && o.reference) {
     throw UsageError{"render: --method draws on the GPU; the reference (--reference) is the physics they approximate"};
   }
   if (o.method && o.viewport && !render::drawsComposite(*o.method)) {
@@ -347,6 +353,8 @@ void check(Options& o) {
                      " draws the trace image, not the viewport (--viewport)"};
   }
   if (!o.method) {
+    // No method, or auto: a trace (auto picks its hits' source per frame), or the viewport's.
+    o.autoMethod = o.autoMethod || (!o.viewport && !o.reference);
     o.method = !o.viewport ? render::Method::Trace : o.raster.refraction ? render::Method::Masked : render::Method::None;
   } else if (!o.raster.refraction) {
     if (*o.method != render::Method::None && render::drawsComposite(*o.method)) {
@@ -370,6 +378,8 @@ void check(Options& o) {
                                  "--reference), not --method ") + render::methodName(*o.method)};
   }
   if (o.reference && o.wants("cost")) throw UsageError{"render: --aov cost counts BVH nodes on the GPU; the reference has none"};
+  // EXR coverage and AOVs come from the trace's own per-pixel data, which the driver's ray tracing has not.
+  if (o.exr() || o.viewport || o.reference) o.autoMethod = false;
 }
 
 
@@ -390,9 +400,9 @@ int runRender(Options& o) {
   std::unique_ptr<render::Renderer> renderer;
   if (!o.reference) {
     vk::ContextDesc desc = io::contextDescFromEnvironment();
-    desc.driverRayTracing = render::needsDriverRayTracing(*o.method);
+    desc.driverRayTracing = render::needsDriverRayTracing(*o.method) || o.autoMethod;
     context = vk::Context::create(desc);
-    if (desc.driverRayTracing && !context->caps().driverRayTracing) {
+    if (render::needsDriverRayTracing(*o.method) && !context->caps().driverRayTracing) {
       throw std::runtime_error("render --method driver-rt: " + context->facts().name +
                                " offers no ray tracing pipelines (VK_KHR_ray_tracing_pipeline)");
     }
@@ -402,7 +412,7 @@ int runRender(Options& o) {
       throw UsageError{std::string("render: ") + e.what()};
     }
     render::RendererOptions options;
-    options.passTimes = o.stats;  // timestamps only where someone reads them
+    options.passTimes = o.stats || o.autoMethod;  // timestamps only where someone reads them
     renderer = std::make_unique<render::Renderer>(*context, scene, layout, options);
   }
   const std::string device = o.reference ? "CPU reference" : context->facts().name;
@@ -424,6 +434,7 @@ int runRender(Options& o) {
 
   // Coverage (EXR alpha) comes from the trace's AOV, so an EXR trace asks for it.
   const bool traced = !render::drawsComposite(*o.method) && *o.method != render::Method::DriverRt;
+  render::AutoMethod chooser(context && context->caps().driverRayTracing, false, frames.size());
   const bool wantAov = o.exr() && traced;
   io::Progress progress("frames", frames.size(), quiet());
   auto start = std::chrono::steady_clock::now();
@@ -461,7 +472,8 @@ int runRender(Options& o) {
       glm::dvec3 lo, hi;
       scene::sceneBounds(scene, pose, lo, hi);
       render::fitDepthRange(view, lo, hi, raster);
-      render::ViewRequest request = render::methodView(*o.method, settings, raster);
+      render::Method method = o.autoMethod ? chooser.next() : *o.method;
+      render::ViewRequest request = render::methodView(method, settings, raster);
       request.readback.enabled = true;
       request.readback.half = true;
       request.aov = request.aov || wantAov;
@@ -469,6 +481,7 @@ int runRender(Options& o) {
       frame.pose = &pose;
       frame.views.push_back(request);
       const render::FrameResult& result = renderer->wait(renderer->submit(frame));
+      if (o.autoMethod) chooser.note(method, result.passes);
       const render::ViewPixels& pixels = result.views.at(0);
       image.rgbaHalf = render::drawsComposite(*o.method) ? pixels.compositeHalf : pixels.traceHalf;
       if (wantAov) {
@@ -481,6 +494,7 @@ int runRender(Options& o) {
         extras.aovs = aovLayers(o, scene, pose, view, image, hits);
       }
       if (o.stats) printStats(frames[i].first, result.stats, result.passes);
+      if (o.stats && o.autoMethod) std::printf("  method %s\n", chooser.describe().c_str());
     }
     std::string path = o.frames ? framePath(o.output, frames[i].first) : o.output;
     io::writeImage(path, image, extras);
@@ -495,13 +509,16 @@ int runRender(Options& o) {
         for (const io::AovLayer& l : extras.aovs) layers += (layers.empty() ? "" : ", ") + l.layer;
         std::printf("  AOV layers: %s\n", layers.c_str());
       }
-      if (!o.reference) {
+      if (!o.reference && o.autoMethod) {
+        std::printf("  method %s\n", chooser.describe().c_str());
+      } else if (!o.reference) {
         for (const render::MethodInfo& m : render::methods()) {
           if (m.method == *o.method) std::printf("  method %s: %s\n", m.name, m.summary);
         }
       }
     }
   }
+  if (frames.size() > 1 && o.autoMethod && !quiet()) std::printf("method %s\n", chooser.describe().c_str());
   return context ? validationExitCode(*context) : kExitOk;
 }
 

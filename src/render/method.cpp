@@ -1,5 +1,8 @@
 #include "render/method.h"
 
+#include <algorithm>
+#include <cstdio>
+
 namespace snell::render {
 
 const std::vector<MethodInfo>& methods() {
@@ -77,6 +80,49 @@ ViewRequest methodViewport(Method method, const FrameSettings& settings, const R
     view.masked = method == Method::TraceOnce;
   }
   return view;
+}
+
+AutoMethod::AutoMethod(bool driverRayTracing, bool viewport, uint64_t frames) {
+  if (viewport) {
+    chosen_ = Method::Masked;
+    why_ = "a viewport traces only its glass pixels, which the driver's ray tracing cannot";
+  } else if (!driverRayTracing) {
+    chosen_ = Method::Trace;
+    why_ = "the device has no ray tracing pipelines to compare with";
+  } else if (frames < uint64_t(4 * (kTrials + 1))) {
+    chosen_ = Method::Trace;
+    why_ = "too few frames to time the driver's ray tracing against";
+  }
+}
+
+Method AutoMethod::next() const {
+  if (chosen_) return *chosen_;
+  return traceMs_.size() <= driverMs_.size() ? Method::Trace : Method::DriverRt;
+}
+
+void AutoMethod::note(Method drawn, const std::vector<vk::PassTime>& passes) {
+  if (chosen_) return;
+  const char* pass = drawn == Method::DriverRt ? "driver trace" : "trace";
+  for (const vk::PassTime& p : passes) {
+    if (p.name == pass) (drawn == Method::DriverRt ? driverMs_ : traceMs_).push_back(p.milliseconds);
+  }
+  // Each method's first frame warms its caches (12 ms against 2 ms after, on the H100): it does not count.
+  if (int(traceMs_.size()) < kTrials + 1 || int(driverMs_.size()) < kTrials + 1) return;
+  auto median = [](std::vector<double> v) {
+    v.erase(v.begin());
+    std::sort(v.begin(), v.end());
+    return v[v.size() / 2];
+  };
+  double trace = median(traceMs_), driver = median(driverMs_);
+  chosen_ = driver < trace ? Method::DriverRt : Method::Trace;
+  char line[160];
+  std::snprintf(line, sizeof line, "median of %d frames each: trace %.3f ms, driver-rt %.3f ms", kTrials, trace, driver);
+  why_ = line;
+}
+
+std::string AutoMethod::describe() const {
+  if (!chosen_) return "auto: timing trace against driver-rt";
+  return std::string("auto: ") + methodName(*chosen_) + " (" + why_ + ")";
 }
 
 bool isRefractionPass(const std::string& passName) {

@@ -6,7 +6,9 @@
 
 #include "render/raster_pass.h"
 #include "render/renderer.h"
+#include "vk/commands.h"
 
+#include <cstdint>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -52,6 +54,34 @@ ViewRequest methodView(Method method, const FrameSettings& settings, const Raste
 /// The same, always as the viewport composite (the viewer's): `trace` traces
 /// every pixel under the raster, `trace-1` the glass pixels with one bend.
 ViewRequest methodViewport(Method method, const FrameSettings& settings, const RasterOptions& raster);
+
+/// --method auto: a full trace's hits from whichever of snell's trace and the
+/// driver's ray tracing measures faster on this device. Without the
+/// driver's ray tracing, or for a viewport (whose masked trace the driver
+/// cannot draw), it is trace (masked for a viewport) from the start;
+/// otherwise the first frames alternate between the two, and the median GPU
+/// time of each one's trace pass over kTrials frames (after a first that
+/// warms its caches) picks. The trace stays the
+/// reference: on a tie it wins.
+class AutoMethod {
+ public:
+  static constexpr int kTrials = 3;
+  /// `frames`: how many frames the caller will draw (a short sequence is
+  /// not worth the trials: trace).
+  AutoMethod(bool driverRayTracing, bool viewport, uint64_t frames = UINT64_MAX);
+  /// The method the next frame draws with.
+  Method next() const;
+  /// A frame drawn with `drawn` is done: its pass times count towards the choice.
+  void note(Method drawn, const std::vector<vk::PassTime>& passes);
+  bool decided() const { return chosen_.has_value(); }
+  /// One line for --stats, progress and JSON: what auto draws with, and why.
+  std::string describe() const;
+
+ private:
+  std::optional<Method> chosen_;
+  std::string why_;
+  std::vector<double> traceMs_, driverMs_;
+};
 
 /// The passes that draw refraction, as opposed to those every viewport pays
 /// (deform, the raster pass's own depth and shading). The one list every

@@ -68,7 +68,7 @@ def test_a_missing_file_is_named(tmp_path):
 
 def test_an_unknown_method_lists_the_methods(device):
     renderer = snell.Renderer(device, lens_arrays())
-    with pytest.raises(snell.Error, match=r"no method 'raytrace' \(the methods: trace, "):
+    with pytest.raises(snell.Error, match=r"no method 'raytrace' \(the methods: auto, trace, "):
         renderer.render(snell.View(32, 24, method="raytrace"))
 
 
