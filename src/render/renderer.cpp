@@ -460,7 +460,13 @@ uint64_t Renderer::submit(const FrameRequest& request) {
       throw std::invalid_argument("renderer: ray lists have no raster image");
     }
   }
-  for (const ViewRequest& v : request.views) trace_->prepare(v.settings);
+  // The pipelines the views will trace with start compiling now, beside the update's.
+  for (const ViewRequest& v : request.views) {
+    trace_->prepare(v.settings);
+    bool traces = v.output == ViewOutput::Trace ? !v.driverTrace
+                                                : v.raster.refraction && v.raster.screenSpace == ScreenSpace::Off && refractive_;
+    if (traces) trace_->prefetch(v.settings, v.aov, v.output == ViewOutput::Composite && v.masked);
+  }
   uint64_t frame = ++submitted_;
   Slot& slot = *slots_[frame % slots_.size()];
   if (slot.pending) collect(slot);

@@ -53,6 +53,12 @@ const vk::ComputeProgram& TracePass::program(uint32_t optics, uint32_t flags) {
   return *programs_.emplace(key, std::make_unique<vk::ComputeProgram>(context_, desc)).first->second;
 }
 
+void TracePass::prefetch(const FrameSettings& settings, bool aov, bool masked) {
+  uint32_t flags = (aov ? gpu::kTraceFlagAov : 0u) | (settings.view.orthographic ? gpu::kTraceFlagOrthographic : 0u) |
+                   (settings.rays.empty() ? 0u : gpu::kTraceFlagRayList) | (masked ? gpu::kTraceFlagPixelList : 0u);
+  program(opticsFor(settings), flags);
+}
+
 void TracePass::prepare(const FrameSettings& settings) {
   const std::shared_ptr<const scene::Environment>& env = settings.optics.environment;
   if (!env || environments_.count(env.get())) return;
@@ -101,7 +107,7 @@ gpu::TracePush TracePass::push(const TraceInputs& in, const FrameSettings& setti
   push.maxBends = settings.maxBends;
   push.lightCount = in.lightCount;
   push.flags = (target.aov ? gpu::kTraceFlagAov : 0u) | (v.orthographic ? gpu::kTraceFlagOrthographic : 0u) |
-               (target.rays ? gpu::kTraceFlagRayList : 0u) | (masked ? gpu::kTraceFlagPixelList : 0u);
+               (target.rays ? gpu::kTraceFlagRayList : 0u) | (masked ? gpu::kTraceFlagPixelList : 0u);  // as prefetch()
   push.tilesX = (settings.width + gpu::kTraceTile - 1) / gpu::kTraceTile;
   push.shiftX = float(v.shift.x);
   push.shiftY = float(v.shift.y);

@@ -59,6 +59,9 @@ class TracePass {
 
   /// Uploads the environment `settings` reflects, once per environment (before recording).
   void prepare(const FrameSettings& settings);
+  /// Starts compiling the pipeline a trace of `settings` needs, so the
+  /// compile runs beside the frame's other work (Context::compileAsync).
+  void prefetch(const FrameSettings& settings, bool aov, bool masked);
   /// Records one view's trace: every pixel, or (masked) the pixels the mask
   /// marks, compacted first into the pixel list. Returns the pixels traced
   /// when the host knows them (unmasked), else 0 (the GPU counts them).

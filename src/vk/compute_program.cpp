@@ -53,31 +53,46 @@ ComputeProgram::ComputeProgram(Context& context, const ComputeProgramDesc& desc)
     entries.push_back({s.id, static_cast<uint32_t>(values.size() * sizeof(uint32_t)), sizeof(uint32_t)});
     values.push_back(s.value);
   }
-  VkSpecializationInfo specInfo{static_cast<uint32_t>(entries.size()), entries.data(), values.size() * sizeof(uint32_t),
-                                values.data()};
-  VkPipelineShaderStageCreateInfo stage{VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO};
-  stage.flags = desc.requireFullSubgroups ? VK_PIPELINE_SHADER_STAGE_CREATE_REQUIRE_FULL_SUBGROUPS_BIT : 0;
-  stage.stage = VK_SHADER_STAGE_COMPUTE_BIT;
-  stage.module = module_;
-  stage.pName = "main";
-  stage.pSpecializationInfo = entries.empty() ? nullptr : &specInfo;
-  VkComputePipelineCreateInfo pipelineInfo{VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO};
-  if (caps.pipelineStatistics) pipelineInfo.flags = VK_PIPELINE_CREATE_CAPTURE_STATISTICS_BIT_KHR;
-  pipelineInfo.stage = stage;
-  pipelineInfo.layout = pipelineLayout_;
-  VK_CHECK(context.compile(
-      [&] { return vkCreateComputePipelines(device, context.pipelineCache(), 1, &pipelineInfo, nullptr, &pipeline_); }));
-  context.setName(VK_OBJECT_TYPE_PIPELINE, pipeline_, name_);
+  VkPipelineShaderStageCreateFlags stageFlags =
+      desc.requireFullSubgroups ? VK_PIPELINE_SHADER_STAGE_CREATE_REQUIRE_FULL_SUBGROUPS_BIT : 0;
+  VkPipelineCreateFlags pipelineFlags = caps.pipelineStatistics ? VK_PIPELINE_CREATE_CAPTURE_STATISTICS_BIT_KHR : 0;
+  // The compile runs on its own thread; what it reads is copied into it or lives as long as this program.
+  pending_ = context.compileAsync(name_, [&context, module = module_, layout = pipelineLayout_, entries, values,
+                                         stageFlags, pipelineFlags](VkPipeline* pipeline) {
+    VkSpecializationInfo specInfo{static_cast<uint32_t>(entries.size()), entries.data(),
+                                  values.size() * sizeof(uint32_t), values.data()};
+    VkPipelineShaderStageCreateInfo stage{VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO};
+    stage.flags = stageFlags;
+    stage.stage = VK_SHADER_STAGE_COMPUTE_BIT;
+    stage.module = module;
+    stage.pName = "main";
+    stage.pSpecializationInfo = entries.empty() ? nullptr : &specInfo;
+    VkComputePipelineCreateInfo pipelineInfo{VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO};
+    pipelineInfo.flags = pipelineFlags;
+    pipelineInfo.stage = stage;
+    pipelineInfo.layout = layout;
+    return vkCreateComputePipelines(context.device(), context.pipelineCache(), 1, &pipelineInfo, nullptr, pipeline);
+  });
+}
+
+VkPipeline ComputeProgram::pipeline() const {
+  if (!pipeline_) pipeline_ = pending_.get();
+  return pipeline_;
 }
 
 ComputeProgram::~ComputeProgram() {
   VkDevice device = context_->device();
-  VkPipeline pipeline = pipeline_;
+  VkPipeline handle = VK_NULL_HANDLE;
+  try {
+    handle = pipeline();  // a compile still running finishes first: it reads the module and layout
+  } catch (...) {
+    // The compile failed: its first use reported it, or nothing used it; there is no pipeline to destroy.
+  }
   VkPipelineLayout layout = pipelineLayout_;
   VkDescriptorSetLayout setLayout = setLayout_;
   VkShaderModule module = module_;
   context_->retire([=] {
-    vkDestroyPipeline(device, pipeline, nullptr);
+    if (handle) vkDestroyPipeline(device, handle, nullptr);
     vkDestroyPipelineLayout(device, layout, nullptr);
     vkDestroyDescriptorSetLayout(device, setLayout, nullptr);
     vkDestroyShaderModule(device, module, nullptr);
@@ -94,12 +109,12 @@ std::vector<std::string> ComputeProgram::statistics() const {
       vkGetDeviceProcAddr(device, "vkGetPipelineExecutableStatisticsKHR"));
   if (!getProperties || !getStatistics) return lines;
   VkPipelineInfoKHR pipelineInfo{VK_STRUCTURE_TYPE_PIPELINE_INFO_KHR};
-  pipelineInfo.pipeline = pipeline_;
+  pipelineInfo.pipeline = pipeline();
   uint32_t executables = 0;
   VK_CHECK(getProperties(device, &pipelineInfo, &executables, nullptr));
   for (uint32_t e = 0; e < executables; ++e) {
     VkPipelineExecutableInfoKHR executable{VK_STRUCTURE_TYPE_PIPELINE_EXECUTABLE_INFO_KHR};
-    executable.pipeline = pipeline_;
+    executable.pipeline = pipeline();
     executable.executableIndex = e;
     uint32_t count = 0;
     VK_CHECK(getStatistics(device, &executable, &count, nullptr));
@@ -132,7 +147,7 @@ void ComputeProgram::record(Commands& commands, std::span<const BufferBinding> b
       writeSet(commands, setLayout_, reflection_.bindings, buffers, name_);
 
   VkCommandBuffer cmd = commands.handle();
-  vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline_);
+  vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline());
   vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, pipelineLayout_, 0, 1, &set, 0, nullptr);
   if (reflection_.pushConstantBytes) {
     vkCmdPushConstants(cmd, pipelineLayout_, VK_SHADER_STAGE_COMPUTE_BIT, 0, reflection_.pushConstantBytes, push);

@@ -85,7 +85,10 @@ class ComputeProgram {
   VkShaderModule module_ = VK_NULL_HANDLE;
   VkDescriptorSetLayout setLayout_ = VK_NULL_HANDLE;
   VkPipelineLayout pipelineLayout_ = VK_NULL_HANDLE;
-  VkPipeline pipeline_ = VK_NULL_HANDLE;
+  /// Compiled on a thread of its own (Context::compileAsync); the first use waits for it.
+  VkPipeline pipeline() const;
+  std::shared_future<VkPipeline> pending_;
+  mutable VkPipeline pipeline_ = VK_NULL_HANDLE;
 };
 
 }  // namespace snell::vk

@@ -389,6 +389,12 @@ void Context::initialise(VkPhysicalDevice physicalDevice, const DeviceFacts& fac
 }
 
 Context::~Context() {
+  {
+    std::lock_guard lock(compileMutex_);
+    stopCompilers_ = true;
+  }
+  compileReady_.notify_all();
+  for (std::thread& t : compilers_) t.join();  // programs waited for their own compiles; any left finish here
   if (device_) vkDeviceWaitIdle(device_);  // the host's device too: our handles die with us
   for (Retired& r : retired_) r.destroy();
   retired_.clear();
@@ -404,6 +410,49 @@ Context::~Context() {
     if (destroyMessenger) destroyMessenger(instance_, messenger_, nullptr);
   }
   if (instance_) vkDestroyInstance(instance_, nullptr);
+}
+
+std::shared_future<VkPipeline> Context::compileAsync(std::string name, std::function<VkResult(VkPipeline*)> create) {
+  static const bool log = [] {
+    const char* v = std::getenv("SNELL_LOG_PIPELINES");
+    return v && std::string(v) == "1";
+  }();
+  std::packaged_task<VkPipeline()> task([this, name = std::move(name), create = std::move(create)] {
+    VkPipeline pipeline = VK_NULL_HANDLE;
+    auto started = std::chrono::steady_clock::now();
+    VK_CHECK(compile([&] { return create(&pipeline); }));
+    if (log) {
+      double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - started).count();
+      std::fprintf(stderr, "snell: compiled pipeline '%s' in %.1f ms\n", name.c_str(), ms);
+    }
+    setName(VK_OBJECT_TYPE_PIPELINE, pipeline, name);
+    return pipeline;
+  });
+  std::shared_future<VkPipeline> result = task.get_future().share();
+  {
+    std::lock_guard lock(compileMutex_);
+    if (compilers_.empty()) {
+      unsigned threads = std::clamp(std::thread::hardware_concurrency(), 1u, 8u);
+      for (unsigned t = 0; t < threads; ++t) compilers_.emplace_back([this] { compileWorker(); });
+    }
+    compileQueue_.push_back(std::move(task));
+  }
+  compileReady_.notify_one();
+  return result;
+}
+
+void Context::compileWorker() {
+  for (;;) {
+    std::packaged_task<VkPipeline()> task;
+    {
+      std::unique_lock lock(compileMutex_);
+      compileReady_.wait(lock, [this] { return stopCompilers_ || !compileQueue_.empty(); });
+      if (compileQueue_.empty()) return;  // stopping, with nothing left to compile
+      task = std::move(compileQueue_.front());
+      compileQueue_.pop_front();
+    }
+    task();  // a failure is kept in the task's future
+  }
 }
 
 VkBool32 VKAPI_PTR Context::onDebugMessage(VkDebugUtilsMessageSeverityFlagBitsEXT severity,

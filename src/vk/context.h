@@ -11,8 +11,12 @@
 #include <chrono>
 #include <cstdint>
 #include <functional>
+#include <future>
 #include <memory>
+#include <condition_variable>
+#include <deque>
 #include <mutex>
+#include <thread>
 #include <unordered_map>
 #include <set>
 #include <string>
@@ -185,6 +189,11 @@ class Context {
     pipelinesCreated_.fetch_add(1);
     return result;
   }
+  /// The same on the context's compile threads: programs compile side by
+  /// side, and a program's first use waits for its own pipeline only.
+  /// `create` fills in the pipeline; a failure throws at get().
+  /// SNELL_LOG_PIPELINES=1 prints each pipeline's name and compile time.
+  std::shared_future<VkPipeline> compileAsync(std::string name, std::function<VkResult(VkPipeline*)> create);
 
  private:
   Context() = default;
@@ -224,6 +233,15 @@ class Context {
   std::unordered_map<VkDeviceMemory, uint64_t> counted_;  ///< device-local allocations and their sizes
 
   std::unique_ptr<PipelineCache> pipelineCache_;
+  // A few long-lived compile threads, not one per pipeline: each new thread
+  // gave the allocator a new arena, and a viewer switching scenes a thousand
+  // frames long grew by 200 MiB.
+  void compileWorker();
+  std::mutex compileMutex_;
+  std::condition_variable compileReady_;
+  std::deque<std::packaged_task<VkPipeline()>> compileQueue_;
+  std::vector<std::thread> compilers_;
+  bool stopCompilers_ = false;
   std::atomic<uint64_t> compileMicroseconds_{0}, pipelinesCreated_{0};
 };
 

@@ -66,7 +66,10 @@ class GraphicsProgram {
   VkShaderModule vertex_ = VK_NULL_HANDLE, fragment_ = VK_NULL_HANDLE;
   VkDescriptorSetLayout setLayout_ = VK_NULL_HANDLE;
   VkPipelineLayout pipelineLayout_ = VK_NULL_HANDLE;
-  VkPipeline pipeline_ = VK_NULL_HANDLE;
+  /// Compiled on a thread of its own (Context::compileAsync); the first use waits for it.
+  VkPipeline pipeline() const;
+  std::shared_future<VkPipeline> pending_;
+  mutable VkPipeline pipeline_ = VK_NULL_HANDLE;
 };
 
 /// A rendering scope (dynamic rendering) on one colour image and an optional
