@@ -429,6 +429,12 @@ std::shared_future<VkPipeline> Context::compileAsync(std::string name, std::func
     return pipeline;
   });
   std::shared_future<VkPipeline> result = task.get_future().share();
+  // A CPU device (lavapipe) compiles at a pipeline's first dispatch, not here:
+  // threads would buy nothing but the allocator's arenas.
+  if (facts_.type == VK_PHYSICAL_DEVICE_TYPE_CPU) {
+    task();
+    return result;
+  }
   {
     std::lock_guard lock(compileMutex_);
     if (compilers_.empty()) {
