@@ -16,6 +16,7 @@
 #   bench/run_frame_on_device.sh trace   # trace against driver-rt at 1920x1080: glass spheres of 100k and 1M
 #                                        # triangles (bench/make_sphere.py), the eye
 #   bench/run_frame_on_device.sh viewport # the viewport's refraction work: crowd 2, eye 64, eye 256, crowd 100 at 4K
+#   bench/run_frame_on_device.sh build   # bench scale: build and refit of 1M and 10M triangles beside the driver's
 #   bench/run_frame_on_device.sh python  # the Python module, built there for its python3 against the carried
 #                                        # install (.carry/prefix), replaying the Blender feed in .carry/feed
 #                                        # (bench/record_blender_feed.py), beside bench frame of the rig's glTF
@@ -186,4 +187,7 @@ if [[ $step == viewport ]]; then
     $s bench frame --viewport --orbit --warmup 200 --json "$json/frame-eye64-orbit.json"
   } 2>&1 | grep -E "scene:|^refraction|^frame |^wall|device:" | tee "$OUT/viewport.log"
   tar -C "$json" -cf "$OUT/viewport-results.tar" .
+fi
+if [[ $step == build ]]; then
+  .carry/snell bench scale --crowds 0 --triangles 1000000,10000000 --json "$OUT/scale.json" 2>&1 | tee "$OUT/scale.log"
 fi

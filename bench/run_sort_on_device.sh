@@ -9,7 +9,7 @@ for f in .gl/*.deb; do dpkg -x "$f" /; done
 ldconfig
 icd=/usr/local/nvidia/share/vulkan/icd.d/nvidia_icd.json
 [[ -f $icd ]] && export VK_DRIVER_FILES=$icd
-export VK_ADD_LAYER_PATH=$PWD/.carry/layer
+export VK_ADD_LAYER_PATH=$PWD/.carry/layer LD_LIBRARY_PATH=$PWD/.carry/lib:$PWD/.carry
 OUT=${OUT:-/tmp/out}
 mkdir -p "$OUT"
 nvidia-smi --query-gpu=name,driver_version,clocks.sm,clocks.mem --format=csv | tee "$OUT/gpu.txt"
