@@ -4,7 +4,10 @@
 
 #include <gtest/gtest.h>
 
+#include <string>
 #include <vector>
+
+#include "vk/error.h"
 
 namespace snell::vk {
 namespace {
@@ -86,6 +89,63 @@ TEST(DeviceSelection, TiesGoToMoreDeviceMemory) {
 
 TEST(DeviceSelection, NoDevicesMeansNoChoice) {
   EXPECT_FALSE(chooseDevice({}, "").chosen);
+}
+
+// A node as a driver may enumerate it: not in PCI bus order, lavapipe among the GPUs.
+std::vector<DeviceFacts> fourGpuNode() {
+  std::vector<DeviceFacts> devices;
+  const char* buses[] = {"0000:c1:00.0", "0000:41:00.0", "0000:81:00.0", "0000:01:00.0"};
+  for (uint32_t i = 0; i < 4; ++i) {
+    devices.push_back(device(i, "NVIDIA H200", VK_PHYSICAL_DEVICE_TYPE_DISCRETE_GPU, 143771));
+    devices.back().pciBus = buses[i];
+    devices.back().uuid = "0" + std::to_string(i) + "c0ffee-1234-5678-9abc-def012345678";
+  }
+  devices.push_back(device(4, "llvmpipe (LLVM 15.0.6, 256 bits)", VK_PHYSICAL_DEVICE_TYPE_CPU));
+  return devices;
+}
+
+TEST(DeviceSelection, OverrideByUuidTakesNvidiaSmisSpelling) {
+  auto devices = fourGpuNode();
+  EXPECT_EQ(*chooseDevice(devices, "GPU-02C0FFEE-1234-5678-9abc-def012345678").chosen, 2u);
+  EXPECT_EQ(*chooseDevice(devices, "03c0ffee-1234").chosen, 3u) << "a unique prefix is enough";
+}
+
+TEST(LauncherOverride, AnIndexCountsGpusInPciBusOrder) {
+  std::string why;
+  // Bus order: [3] 01, [1] 41, [2] 81, [0] c1.
+  EXPECT_EQ(launcherOverride(fourGpuNode(), "CUDA_VISIBLE_DEVICES", "0", why), "3");
+  EXPECT_EQ(launcherOverride(fourGpuNode(), "CUDA_VISIBLE_DEVICES", "2", why), "2");
+  EXPECT_EQ(launcherOverride(fourGpuNode(), "CUDA_VISIBLE_DEVICES", "3,1", why), "0") << "the first entry is taken";
+  EXPECT_NE(why.find("CUDA_VISIBLE_DEVICES=3,1"), std::string::npos) << why;
+  EXPECT_NE(why.find("0000:c1:00.0"), std::string::npos) << why;
+}
+
+TEST(LauncherOverride, AUuidNamesItsGpuWhereverItIsEnumerated) {
+  std::string why;
+  EXPECT_EQ(launcherOverride(fourGpuNode(), "CUDA_VISIBLE_DEVICES", "GPU-01c0ffee-1234-5678-9abc-def012345678", why),
+            "1");
+}
+
+TEST(LauncherOverride, AnIndexPastTheGpusFailsNamingTheVariable) {
+  std::string why;
+  try {
+    launcherOverride(fourGpuNode(), "GPU_DEVICE_ORDINAL", "4", why);
+    FAIL() << "lavapipe was counted as a GPU";
+  } catch (const VulkanError& e) {
+    EXPECT_NE(std::string(e.what()).find("GPU_DEVICE_ORDINAL=4"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("4 GPU(s)"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(launcherOverride(fourGpuNode(), "CUDA_VISIBLE_DEVICES", "GPU-ffffffff-0000", why), VulkanError);
+  EXPECT_THROW(launcherOverride(fourGpuNode(), "CUDA_VISIBLE_DEVICES", "gpu", why), VulkanError);
+}
+
+TEST(LauncherOverride, VerdictsNameTheLauncherVariable) {
+  auto devices = fourGpuNode();
+  std::string why;
+  std::string override = launcherOverride(devices, "CUDA_VISIBLE_DEVICES", "1", why);
+  DeviceChoice choice = chooseDevice(devices, override, why);
+  EXPECT_EQ(*choice.chosen, 1u);
+  EXPECT_NE(choice.verdicts[0].find("CUDA_VISIBLE_DEVICES=1"), std::string::npos) << choice.verdicts[0];
 }
 
 }  // namespace

@@ -71,13 +71,12 @@ int listDevices(const Options& o) {
   vk::DeviceReport report = vk::surveyDevices();
   const std::optional<uint32_t>& chosen = report.choice.chosen;
   if (text) {
-    std::printf("Vulkan devices%s:\n%s",
-                report.override.empty() ? "" : (" (SNELL_DEVICE=" + report.override + ")").c_str(),
-                report.table().c_str());
+    std::printf("Vulkan devices (%s):\n%s", report.why.c_str(), report.table().c_str());
   }
   if (!o.json.empty()) {
     io::Json j = io::reportHead("info", chosen ? &report.devices[*chosen] : nullptr);
     j["override"] = report.override.empty() ? io::Json() : io::Json(report.override);
+    j["override_from"] = report.why;
     j["devices"] = io::Json::array();
     for (size_t i = 0; i < report.devices.size(); ++i) j["devices"].push_back(deviceEntry(report, i));
     j["chosen"] = chosen ? io::Json(report.devices[*chosen].index) : io::Json();

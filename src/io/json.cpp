@@ -19,7 +19,8 @@ std::vector<std::string>& recordedWords() {
   return words;
 }
 
-// A word as a POSIX shell would need it to read it back as one word.
+}  // namespace
+
 std::string shellQuoted(const std::string& word) {
   if (!word.empty() && word.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789-_./=:,+@%") ==
                            std::string::npos) {
@@ -29,8 +30,6 @@ std::string shellQuoted(const std::string& word) {
   for (char c : word) quoted += c == '\'' ? std::string("'\\''") : std::string(1, c);
   return quoted + "'";
 }
-
-}  // namespace
 
 void recordCommandLine(int argc, const char* const* argv) {
   recordedWords().assign(argv, argv + argc);
@@ -54,7 +53,9 @@ Json deviceJson(const vk::DeviceFacts& device) {
               {"driver_info", device.driverInfo},
               {"vulkan", api},
               {"device_local_bytes", device.deviceLocalBytes},
-              {"subgroup_size", device.subgroupSize}};
+              {"subgroup_size", device.subgroupSize},
+              {"uuid", device.uuid},
+              {"pci_bus", device.pciBus.empty() ? Json() : Json(device.pciBus)}};
 }
 
 Json reportHead(const std::string& kind, const vk::DeviceFacts* device) {

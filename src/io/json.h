@@ -20,6 +20,8 @@ using Json = nlohmann::ordered_json;
 void recordCommandLine(int argc, const char* const* argv);
 /// The command line as recorded, words joined by spaces (quoted where needed).
 std::string commandLine();
+/// A word as a POSIX shell reads it back as one word: as it is, or in single quotes.
+std::string shellQuoted(const std::string& word);
 
 /// snell's version, as `snell --version` prints it.
 const char* version();

@@ -35,10 +35,27 @@ bool hasInstanceExtension(const char* name) {
                      [&](const VkExtensionProperties& e) { return std::strcmp(e.extensionName, name) == 0; });
 }
 
-std::string overrideOrEnvironment(const std::string& given) {
-  if (!given.empty()) return given;
-  const char* env = std::getenv("SNELL_DEVICE");
-  return env ? env : "";
+// The device override and where it came from: the caller's (--device),
+// SNELL_DEVICE, then a launcher's GPU list. Slurm and CUDA launchers set
+// CUDA_VISIBLE_DEVICES and GPU_DEVICE_ORDINAL, which no Vulkan driver reads:
+// without them every task of a node would pile onto its first GPU.
+std::string resolveOverride(const std::string& given, std::span<const DeviceFacts> facts, std::string& why) {
+  if (!given.empty()) {
+    why = "device=" + given;
+    return given;
+  }
+  if (const char* env = std::getenv("SNELL_DEVICE"); env && *env) {
+    why = std::string("SNELL_DEVICE=") + env;
+    return env;
+  }
+  for (const char* variable : {"CUDA_VISIBLE_DEVICES", "GPU_DEVICE_ORDINAL"}) {
+    const char* value = std::getenv(variable);
+    // Unset, empty, "-1" or Slurm's "NoDevFiles": the launcher gave this task no GPU to keep to.
+    if (!value || !*value || *value == '-' || std::strcmp(value, "NoDevFiles") == 0) continue;
+    return launcherOverride(facts, variable, value, why);
+  }
+  why = "none named: the best in rank, discrete, integrated, virtual GPU, then CPU";
+  return "";
 }
 
 struct InstanceRequest {
@@ -125,6 +142,7 @@ std::string DeviceReport::table() const {
         << (d.driverName.empty() ? "?" : d.driverName) << " " << d.driverInfo << "\n"
         << "      subgroup " << d.subgroupSize << " lanes (" << d.minSubgroupSize << "-" << d.maxSubgroupSize
         << " in compute), device-local memory " << mebibytes(d.deviceLocalBytes) << "\n"
+        << "      UUID " << d.uuid << ", PCI bus " << (d.pciBus.empty() ? "unknown" : d.pciBus) << "\n"
         << "      " << choice.verdicts[i] << "\n";
   }
   return out.str();
@@ -132,7 +150,6 @@ std::string DeviceReport::table() const {
 
 DeviceReport surveyDevices(const std::string& deviceOverride) {
   DeviceReport report;
-  report.override = overrideOrEnvironment(deviceOverride);
   bool debugUtils = false;
   VkInstance instance = createInstance({}, debugUtils);
   try {
@@ -143,7 +160,8 @@ DeviceReport surveyDevices(const std::string& deviceOverride) {
     throw;
   }
   vkDestroyInstance(instance, nullptr);
-  report.choice = chooseDevice(report.devices, report.override);
+  report.override = resolveOverride(deviceOverride, report.devices, report.why);
+  report.choice = chooseDevice(report.devices, report.override, report.why);
   return report;
 }
 
@@ -183,14 +201,14 @@ std::unique_ptr<Context> Context::create(const ContextDesc& desc) {
 
   std::vector<VkPhysicalDevice> handles;
   std::vector<DeviceFacts> facts = readAllFacts(c.instance_, handles);
-  std::string override = overrideOrEnvironment(desc.deviceOverride);
-  DeviceChoice choice = chooseDevice(facts, override);
+  std::string why;
+  std::string override = resolveOverride(desc.deviceOverride, facts, why);
+  DeviceChoice choice = chooseDevice(facts, override, why);
   if (!choice.chosen) {
-    DeviceReport report{facts, choice, override};
-    throw VulkanError("no Vulkan device meets snell's requirements" +
-                      (override.empty() ? std::string() : " among those SNELL_DEVICE=" + override + " names") +
-                      ":\n" + report.table());
+    DeviceReport report{facts, choice, override, why};
+    throw VulkanError("no Vulkan device meets snell's requirements (" + why + "):\n" + report.table());
   }
+  c.deviceWhy_ = why;
   const DeviceFacts& chosen = facts[*choice.chosen];
   VkPhysicalDevice physical = handles[*choice.chosen];
 

@@ -32,7 +32,8 @@ struct ContextDesc {
   bool validation = false;
   /// With validation: also check synchronization (missing barriers, hazards).
   bool synchronizationValidation = false;
-  /// An index or a name substring; empty means use the SNELL_DEVICE variable.
+  /// An index, a UUID or a name substring; empty means SNELL_DEVICE, then a
+  /// launcher's CUDA_VISIBLE_DEVICES or GPU_DEVICE_ORDINAL (see launcherOverride).
   std::string deviceOverride;
   /// Ask the driver for per-pipeline statistics where it offers them.
   bool pipelineStatistics = false;
@@ -96,6 +97,8 @@ struct DeviceReport {
   std::vector<DeviceFacts> devices;
   DeviceChoice choice;
   std::string override;
+  /// How the override was found ("SNELL_DEVICE=1", "CUDA_VISIBLE_DEVICES=2: ...").
+  std::string why;
   /// A table with one row per device and its verdict.
   std::string table() const;
 };
@@ -123,6 +126,8 @@ class Context {
   VkQueue queue() const { return queue_; }
   uint32_t queueFamily() const { return queueFamily_; }
   const DeviceFacts& facts() const { return facts_; }
+  /// Why this device: "SNELL_DEVICE=1", "CUDA_VISIBLE_DEVICES=2: GPU 2 in PCI bus order is ...".
+  const std::string& deviceWhy() const { return deviceWhy_; }
   const DeviceCaps& caps() const { return caps_; }
   bool ownsDevice() const { return owned_; }
   /// Whether an optional device extension (ContextDesc::optionalDeviceExtensions) was enabled.
@@ -214,6 +219,7 @@ class Context {
   bool validation_ = false;
   bool pipelineStatisticsRequested_ = false;
   DeviceFacts facts_;
+  std::string deviceWhy_;
   DeviceCaps caps_;
   VkPhysicalDeviceMemoryProperties memory_{};
   PFN_vkSetDebugUtilsObjectNameEXT setObjectName_ = nullptr;

@@ -4,10 +4,11 @@
 #include <algorithm>
 #include <cctype>
 #include <charconv>
+#include <cstdio>
 #include <cstring>
+#include <sstream>
 
 #include "vk/error.h"
-#include <sstream>
 
 namespace snell::vk {
 
@@ -33,6 +34,29 @@ bool isIndex(const std::string& text, uint32_t& index) {
   if (text.empty()) return false;
   auto [end, error] = std::from_chars(text.data(), text.data() + text.size(), index);
   return error == std::errc() && end == text.data() + text.size();
+}
+
+// 8-4-4-4-12 hex digits, as nvidia-smi -L prints a UUID after "GPU-".
+std::string uuidText(const uint8_t (&bytes)[VK_UUID_SIZE]) {
+  static const char digits[] = "0123456789abcdef";
+  std::string text;
+  for (uint32_t i = 0; i < VK_UUID_SIZE; ++i) {
+    if (i == 4 || i == 6 || i == 8 || i == 10) text += '-';
+    text += {digits[bytes[i] >> 4], digits[bytes[i] & 15]};
+  }
+  return text;
+}
+
+// A UUID as a user or launcher writes it: "GPU-" prefix and case dropped.
+std::string bareUuid(const std::string& text) {
+  std::string t = lower(text);
+  return t.rfind("gpu-", 0) == 0 ? t.substr(4) : t;
+}
+
+bool looksLikeUuid(const std::string& text) {
+  std::string t = bareUuid(text);
+  return t.size() >= 8 && std::count(t.begin(), t.end(), '-') >= 1 &&
+         std::all_of(t.begin(), t.end(), [](char c) { return std::isxdigit(static_cast<unsigned char>(c)) || c == '-'; });
 }
 
 }  // namespace
@@ -87,11 +111,30 @@ DeviceFacts readDeviceFacts(VkPhysicalDevice device, uint32_t index) {
     return facts;  // the 1.2/1.3 property structs below may not be chained on it
   }
 
-  VkPhysicalDeviceVulkan13Properties props13{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_3_PROPERTIES};
+  uint32_t extensionCount = 0;
+  VK_CHECK(vkEnumerateDeviceExtensionProperties(device, nullptr, &extensionCount, nullptr));
+  std::vector<VkExtensionProperties> extensions(extensionCount);
+  VK_CHECK(vkEnumerateDeviceExtensionProperties(device, nullptr, &extensionCount, extensions.data()));
+  auto hasExtension = [&](const char* name) {
+    return std::any_of(extensions.begin(), extensions.end(),
+                       [&](const VkExtensionProperties& e) { return std::strcmp(e.extensionName, name) == 0; });
+  };
+
+  VkPhysicalDevicePCIBusInfoPropertiesEXT pci{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PCI_BUS_INFO_PROPERTIES_EXT};
+  bool hasPci = hasExtension(VK_EXT_PCI_BUS_INFO_EXTENSION_NAME);
+  VkPhysicalDeviceVulkan13Properties props13{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_3_PROPERTIES,
+                                             hasPci ? &pci : nullptr};
   VkPhysicalDeviceVulkan12Properties props12{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_PROPERTIES, &props13};
   VkPhysicalDeviceVulkan11Properties props11{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_1_PROPERTIES, &props12};
   VkPhysicalDeviceProperties2 props{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2, &props11};
   vkGetPhysicalDeviceProperties2(device, &props);
+  facts.vendorId = basic.vendorID;
+  facts.uuid = uuidText(props11.deviceUUID);
+  if (hasPci) {
+    char bus[32];
+    std::snprintf(bus, sizeof bus, "%04x:%02x:%02x.%x", pci.pciDomain, pci.pciBus, pci.pciDevice, pci.pciFunction);
+    facts.pciBus = bus;
+  }
   facts.driverId = props12.driverID;
   facts.driverName = props12.driverName;
   facts.driverInfo = props12.driverInfo;
@@ -115,28 +158,25 @@ DeviceFacts readDeviceFacts(VkPhysicalDevice device, uint32_t index) {
   if (!features13.computeFullSubgroups) facts.unmet.push_back("feature computeFullSubgroups is missing");
   // glslang writes a specialised workgroup size as LocalSizeId, which needs maintenance4.
   if (!features13.maintenance4) facts.unmet.push_back("feature maintenance4 is missing");
-  uint32_t extensionCount = 0;
-  VK_CHECK(vkEnumerateDeviceExtensionProperties(device, nullptr, &extensionCount, nullptr));
-  std::vector<VkExtensionProperties> extensions(extensionCount);
-  VK_CHECK(vkEnumerateDeviceExtensionProperties(device, nullptr, &extensionCount, extensions.data()));
-  facts.pipelineStatistics = std::any_of(extensions.begin(), extensions.end(), [](const VkExtensionProperties& e) {
-    return std::strcmp(e.extensionName, VK_KHR_PIPELINE_EXECUTABLE_PROPERTIES_EXTENSION_NAME) == 0;
-  });
+  facts.pipelineStatistics = hasExtension(VK_KHR_PIPELINE_EXECUTABLE_PROPERTIES_EXTENSION_NAME);
   if (props13.maxSubgroupSize > 128) {
     facts.unmet.push_back("subgroups of " + std::to_string(props13.maxSubgroupSize) + " lanes exceed the 128 snell's ballots hold");
   }
   return facts;
 }
 
-DeviceChoice chooseDevice(std::span<const DeviceFacts> devices, const std::string& override) {
+DeviceChoice chooseDevice(std::span<const DeviceFacts> devices, const std::string& override,
+                          const std::string& source) {
   DeviceChoice choice;
   uint32_t overrideIndex = 0;
   bool byIndex = isIndex(override, overrideIndex);
   std::string needle = lower(override);
 
+  bool byUuid = !byIndex && looksLikeUuid(override);
   auto named = [&](const DeviceFacts& d) {
     if (override.empty()) return true;
     if (byIndex) return d.index == overrideIndex;
+    if (byUuid) return !d.uuid.empty() && d.uuid.rfind(bareUuid(override), 0) == 0;  // a unique prefix will do
     return lower(d.name).find(needle) != std::string::npos;
   };
   // Lower is better: device type first, then more device-local memory.
@@ -158,7 +198,7 @@ DeviceChoice chooseDevice(std::span<const DeviceFacts> devices, const std::strin
       verdict = "rejected: ";
       for (size_t u = 0; u < d.unmet.size(); ++u) verdict += (u ? "; " : "") + d.unmet[u];
     } else if (!named(d)) {
-      verdict = "not chosen: SNELL_DEVICE=" + override + " names another device";
+      verdict = "not chosen: " + (source.empty() ? "SNELL_DEVICE=" + override : source) + " names another device";
     } else {
       const DeviceFacts& best = devices[*choice.chosen];
       verdict = "not chosen: ranks below " + best.name + " (a " + deviceTypeName(best.type) +
@@ -167,6 +207,40 @@ DeviceChoice chooseDevice(std::span<const DeviceFacts> devices, const std::strin
     choice.verdicts.push_back(verdict);
   }
   return choice;
+}
+
+std::string launcherOverride(std::span<const DeviceFacts> devices, const std::string& variable,
+                             const std::string& value, std::string& why) {
+  std::string first = value.substr(0, value.find(','));
+  std::string given = variable + "=" + value;
+  if (first.empty()) throw VulkanError(given + " names no device");
+  if (looksLikeUuid(first)) {
+    for (const DeviceFacts& d : devices) {
+      if (!d.uuid.empty() && d.uuid.rfind(bareUuid(first), 0) == 0) {
+        why = given + " names " + d.name + " by its UUID";
+        return std::to_string(d.index);
+      }
+    }
+    throw VulkanError(given + ": no Vulkan device has UUID " + first + " ('snell info --devices' lists them)");
+  }
+  uint32_t k = 0;
+  if (!isIndex(first, k)) throw VulkanError(given + ": '" + first + "' is neither a GPU index nor a UUID");
+  // The GPUs (not CPU devices such as lavapipe) in PCI bus order; enumeration order where the bus is unknown.
+  std::vector<const DeviceFacts*> gpus;
+  for (const DeviceFacts& d : devices) {
+    if (d.type != VK_PHYSICAL_DEVICE_TYPE_CPU) gpus.push_back(&d);
+  }
+  std::stable_sort(gpus.begin(), gpus.end(), [](const DeviceFacts* a, const DeviceFacts* b) {
+    if (a->pciBus.empty() || b->pciBus.empty()) return false;
+    return a->pciBus < b->pciBus;
+  });
+  if (k >= gpus.size()) {
+    throw VulkanError(given + " names GPU " + first + ", but Vulkan sees " + std::to_string(gpus.size()) +
+                             " GPU(s) ('snell info --devices' lists them)");
+  }
+  const DeviceFacts& d = *gpus[k];
+  why = given + ": GPU " + first + " in PCI bus order is " + d.name + (d.pciBus.empty() ? "" : " at " + d.pciBus);
+  return std::to_string(d.index);
 }
 
 }  // namespace snell::vk

@@ -26,6 +26,9 @@ struct DeviceFacts {
   uint32_t minSubgroupSize = 0;  ///< smallest the driver may pick for compute
   uint32_t maxSubgroupSize = 0;
   uint64_t deviceLocalBytes = 0;  ///< sum of the DEVICE_LOCAL heaps
+  uint32_t vendorId = 0;           ///< PCI vendor (0x10de NVIDIA, 0x1002 AMD, 0x8086 Intel)
+  std::string uuid;   ///< deviceUUID, 8-4-4-4-12 hex digits (nvidia-smi prints it after "GPU-")
+  std::string pciBus; ///< domain:bus:device.function (VK_EXT_pci_bus_info); empty where the driver has none
   uint32_t computeQueueFamily = UINT32_MAX;
   /// VK_KHR_pipeline_executable_properties: the driver reports per-pipeline
   /// statistics (registers, spills), which benchmarks print.
@@ -46,11 +49,24 @@ struct DeviceChoice {
   std::vector<std::string> verdicts;
 };
 
-/// Chooses a device: `override` (SNELL_DEVICE: an index, or a case-insensitive
-/// substring of the name) narrows the field; among qualifying devices a discrete
-/// GPU ranks first, then integrated, virtual, CPU (lavapipe); ties go to the
-/// larger device-local memory, then to the lower index.
-DeviceChoice chooseDevice(std::span<const DeviceFacts> devices, const std::string& override);
+/// Chooses a device: `override` (--device or SNELL_DEVICE: an index, a UUID
+/// with or without nvidia-smi's "GPU-" prefix, or a case-insensitive
+/// substring of the name) narrows the field; among qualifying devices a
+/// discrete GPU ranks first, then integrated, virtual, CPU (lavapipe); ties go
+/// to the larger device-local memory, then to the lower index. `source` says
+/// where the override came from, for the verdicts ("SNELL_DEVICE=..." if empty).
+DeviceChoice chooseDevice(std::span<const DeviceFacts> devices, const std::string& override,
+                          const std::string& source = "");
+
+/// A launcher's GPU list as a device override. Slurm and CUDA launchers name
+/// GPUs by CUDA_VISIBLE_DEVICES (indices or GPU-UUIDs) or SLURM_STEP_GPUS
+/// (the node's GPU indices), which the Vulkan driver does not read: an index
+/// k is the k-th GPU in PCI bus order (nvidia-smi's, and Slurm's, numbering),
+/// a UUID names itself. The first entry is taken. Returns the override (a
+/// device index, as text) and, in `why`, one line saying how it was found;
+/// throws VulkanError naming the variable when it names no device.
+std::string launcherOverride(std::span<const DeviceFacts> devices, const std::string& variable,
+                             const std::string& value, std::string& why);
 
 /// "discrete GPU", "integrated GPU", "virtual GPU", "CPU" or "other".
 const char* deviceTypeName(VkPhysicalDeviceType type);
