@@ -17,6 +17,8 @@
 #                                        # triangles (bench/make_sphere.py), the eye
 #   bench/run_frame_on_device.sh viewport # the viewport's refraction work: crowd 2, eye 64, eye 256, crowd 100 at 4K
 #   bench/run_frame_on_device.sh build   # bench scale: build and refit of 1M and 10M triangles beside the driver's
+#   bench/run_frame_on_device.sh farm    # CUDA_VISIBLE_DEVICES by index and UUID mapped to the Vulkan device,
+#                                        # the frame-list, farm and device-mapping tests
 #   bench/run_frame_on_device.sh python  # the Python module, built there for its python3 against the carried
 #                                        # install (.carry/prefix), replaying the Blender feed in .carry/feed
 #                                        # (bench/record_blender_feed.py), beside bench frame of the rig's glTF
@@ -142,6 +144,25 @@ if [[ $step == python ]]; then
     echo "== snell bench frame of Blender's glTF export of the same rig, same size"
     .carry/snell bench frame .carry/feed/rig.glb --viewport --size 1920x1080 --warmup 200 --frames 48 --json "$OUT/frame-rig.json"
   } 2>&1 | tee "$OUT/python.log"
+fi
+if [[ $step == farm ]]; then
+  echo "== GPUs as a launcher names them: CUDA_VISIBLE_DEVICES by index and by UUID, and one past the end"
+  nvidia-smi -L | tee "$OUT/nvidia-smi-L.txt"
+  nvidia-smi --query-gpu=index,pci.bus_id,uuid --format=csv | tee -a "$OUT/nvidia-smi-L.txt"
+  .carry/snell info --devices | tee "$OUT/info-devices.txt"
+  uuid=$(nvidia-smi --query-gpu=uuid --format=csv,noheader | head -1)
+  n=0
+  for v in 0 "$uuid" 1; do
+    n=$((n + 1))
+    CUDA_VISIBLE_DEVICES=$v SNELL_VALIDATION=1 .carry/snell render --eye --size 320x240 --frames 1-3 --method trace \
+      -o "/tmp/farm$n.#.png" --stats-json "$OUT/cuda$n.#.json" > "$OUT/cuda$n.log" 2>&1
+    echo "CUDA_VISIBLE_DEVICES=$v: exit $?"; grep -E "^device|error" "$OUT/cuda$n.log"
+  done
+  cmp <(grep image_hash "$OUT/cuda1.2.json") <(grep image_hash "$OUT/cuda2.2.json") && echo "index and UUID give the same pixels"
+  SNELL_VALIDATION=1 .carry/snell_tests --gtest_brief=1 \
+    --gtest_filter='FrameList.*:FramePattern.*:FarmPlan.*:FarmFolder.*:DeviceSelection.*:LauncherOverride.*:DeviceSurvey.*:Robustness.Sigterm*:Robustness.DeviceLost*' \
+    > "$OUT/farm-tests.log" 2>&1
+  echo "farm tests exit $?"; grep -E "FAILED|PASSED|tests ran" "$OUT/farm-tests.log" | tail -12
 fi
 if [[ $step == first ]]; then
   {

@@ -4,6 +4,7 @@
 #include "io/environment.h"
 #include "render/renderer.h"
 #include "scene/procedural_eye.h"
+#include "vk/error.h"
 
 #include <algorithm>
 #include <charconv>
@@ -19,10 +20,17 @@
 
 namespace snell::cli {
 
-const char* const kHelpFooter = R"(exit codes: 0 done, 1 failed (the message says what), 2 bad command line
+const char* const kHelpFooter = R"(exit codes: 0 done, 1 failed (the message says what), 2 bad command line,
+  3 the GPU was lost (retry on another machine), 128+N stopped by signal N
+  (SIGTERM: 143; the frames written are whole, the one under way is dropped)
 
 environment:
-  SNELL_DEVICE=INDEX|NAME  the device to use (as --device; 'snell info --devices' lists them)
+  SNELL_DEVICE=INDEX|UUID|NAME  the device to use (as --device; 'snell info
+                           --devices' lists them)
+  CUDA_VISIBLE_DEVICES, GPU_DEVICE_ORDINAL  without SNELL_DEVICE: the GPU a
+                           launcher (Slurm, a CUDA job) gave this task, by
+                           index in PCI bus order (nvidia-smi's) or GPU-UUID
+  SLURM_CPUS_PER_TASK=N    lavapipe renders on N threads (unless LP_NUM_THREADS)
   SNELL_VALIDATION=1       turn on the Khronos validation layer; any message it
                            reports makes the exit code 1
   SNELL_PIPELINE_CACHE=DIR where compiled pipelines are kept for the next run
@@ -88,11 +96,11 @@ void addGlobalOptions(CLI::App& app) {
   app.add_option_function<std::string>(
          "--device",
          [](const std::string& device) {
-           if (device.empty()) throw UsageError{"--device needs an index or part of a name"};
+           if (device.empty()) throw UsageError{"--device needs an index, a UUID or part of a name"};
            ::setenv("SNELL_DEVICE", device.c_str(), 1);
          },
-         "the device to use: an index from 'snell info --devices', or part of\nits name (the same as SNELL_DEVICE)")
-      ->type_name("INDEX|NAME");
+         "the device to use: an index or UUID from 'snell info --devices', or\npart of its name (the same as SNELL_DEVICE)")
+      ->type_name("INDEX|UUID|NAME");
   app.add_flag_callback(
       "-q,--quiet",
       [] {
@@ -119,6 +127,17 @@ void parseOnly(CLI::App& app, const Args& args) {
   }
 }
 
+namespace {
+
+// lavapipe starts a thread per CPU of the node; a Slurm task that was given N
+// CPUs would take the others' from tasks sharing the node.
+void keepToTheTasksCpus() {
+  const char* cpus = std::getenv("SLURM_CPUS_PER_TASK");
+  if (cpus && *cpus && !std::getenv("LP_NUM_THREADS")) ::setenv("LP_NUM_THREADS", cpus, 0);
+}
+
+}  // namespace
+
 int runCommandLine(CLI::App& app, int argc, char** argv, const Runner& run) {
   const std::string program = programName(app);
   auto usage = [&](const std::string& message) {
@@ -139,10 +158,14 @@ int runCommandLine(CLI::App& app, int argc, char** argv, const Runner& run) {
     return kExitFailure;
   }
   if (!run) return usage("give a command");
+  keepToTheTasksCpus();
   try {
     return run();
   } catch (const UsageError& e) {
     return usage(e.message);
+  } catch (const vk::VulkanError& e) {
+    std::fprintf(stderr, "%s: error: %s\n", program.c_str(), e.what());
+    return e.result() == VK_ERROR_DEVICE_LOST ? kExitDeviceLost : kExitFailure;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "%s: error: %s\n", program.c_str(), e.what());
     return kExitFailure;

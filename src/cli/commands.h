@@ -23,6 +23,19 @@ void addBenchStress(CLI::App& bench, Runner& run);
 void addBenchScale(CLI::App& bench, Runner& run);
 void addBenchMethods(CLI::App& bench, Runner& run);
 
+/// What `snell render ARGS` would draw, found as it would find it: the
+/// options parse and agree, the scene and environment load. Throws
+/// UsageError (a bad command line) or an error naming the file otherwise.
+struct RenderCheck {
+  std::string scene;       ///< the loaded scene's source
+  bool autoMethod = false; ///< --method auto, which chooses per run by timing
+  std::string method;      ///< what it draws without auto ("trace", "masked", "reference", ...)
+  bool bakeTimeGiven = false;
+  double fps = 24.0;
+};
+RenderCheck checkRender(const Args& args);
+void addFarm(CLI::App& parent, Runner& run);
+
 /// The whole `snell` command line: every subcommand and the global options.
 /// `run` is set by whichever subcommand the parse picks.
 std::unique_ptr<CLI::App> makeSnellApp(Runner& run);

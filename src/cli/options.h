@@ -34,8 +34,11 @@ struct UsageError {
 /// What runs a subcommand once its whole command line has parsed.
 using Runner = std::function<int()>;
 
-/// Exit codes, as the README and every --help list them.
-inline constexpr int kExitOk = 0, kExitFailure = 1, kExitUsage = 2;
+/// Exit codes, as the README and every --help list them: done; failed;
+/// bad command line; the GPU was lost (VK_ERROR_DEVICE_LOST: a farm can
+/// retry the work on another node). A command stopped by SIGTERM or SIGINT
+/// exits 128 + the signal.
+inline constexpr int kExitOk = 0, kExitFailure = 1, kExitUsage = 2, kExitDeviceLost = 3;
 
 /// The footer every --help ends with: exit codes and environment.
 extern const char* const kHelpFooter;

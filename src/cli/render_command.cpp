@@ -4,6 +4,7 @@
 // EXR files carry alpha = coverage, the camera and time as metadata, and on
 // request the trace's per-pixel AOVs as named layers.
 #include "cli/commands.h"
+#include "cli/frames.h"
 
 #include "bake/refraction_bake.h"
 #include "io/image_file.h"
@@ -23,9 +24,12 @@
 
 #include <algorithm>
 #include <chrono>
+#include <csignal>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <limits>
 #include <map>
 #include <optional>
@@ -44,7 +48,16 @@ constexpr const char* kDescription =
     "--float) with alpha = coverage (1 where the pixel's ray met a surface), the\n"
     "camera, time, method, device and snell version in its header, and with --aov\n"
     "the trace's per-pixel data as layers compositors read. A file appears only\n"
-    "once it is complete.";
+    "once it is complete.\n"
+    "\n"
+    "Frames a farm can trust: --frames takes the lists farms write, and a frame's\n"
+    "pixels depend on nothing but the scene, its number and the options (each is\n"
+    "traced from trees built afresh), so any chunk, retry or node with the same\n"
+    "GPU and driver writes the same pixels; give --method trace, as auto may pick\n"
+    "driver-rt by timing. Off a terminal, progress is one line per frame.\n"
+    "SIGTERM or SIGINT drops the frame under way, keeps those written and exits\n"
+    "128+N; --skip-existing then picks up where it stopped. 'snell farm' sends\n"
+    "a shot to Slurm or writes an Open Job Description template.";
 
 /// The AOV layers --aov may name, in the order they are written.
 const std::vector<std::string> kAovNames = {"depth", "normal", "instance", "primitive", "interfaces", "cost"};
@@ -52,9 +65,10 @@ const std::vector<std::string> kAovNames = {"depth", "normal", "instance", "prim
 struct Options {
   ShotOptions shot;
   std::string output;
-  bool frames = false;
-  long firstFrame = 0, lastFrame = 0;
+  std::optional<FrameList> frames;  ///< --frames; none: one picture at --time
   double fps = 24.0;
+  bool skipExisting = false;
+  std::string statsJson;  ///< a per-frame JSON's name pattern; empty: none
   std::optional<double> bakeTime;
   bool reference = false;
   bool viewport = false;
@@ -73,21 +87,6 @@ struct Options {
   }
   bool wants(const std::string& aov) const { return std::find(aovs.begin(), aovs.end(), aov) != aovs.end(); }
 };
-
-std::string framePath(const std::string& pattern, long frame) {
-  size_t first = pattern.find('#');
-  if (first != std::string::npos) {
-    size_t last = pattern.find_first_not_of('#', first);
-    size_t width = (last == std::string::npos ? pattern.size() : last) - first;
-    std::string number = std::to_string(frame);
-    if (number.size() < width) number.insert(0, width - number.size(), '0');
-    return pattern.substr(0, first) + number + pattern.substr(first + width);
-  }
-  std::filesystem::path p(pattern);
-  char number[32];
-  std::snprintf(number, sizeof number, ".%04ld", frame);
-  return (p.parent_path() / (p.stem().string() + number + p.extension().string())).string();
-}
 
 // One frame's counters and pass times, for --stats: what a pipeline engineer
 // reads to see that a still frame skipped its work.
@@ -230,9 +229,9 @@ io::ImageExtras exrExtras(const Options& o, const scene::Scene& scene, const sce
 
 void addOptions(CLI::App& render, Options& o) {
   render.add_option("-o,--output", o.output,
-                    "the image to write: .png or .exr; with --frames, '#'s in the\n"
-                    "name become the frame number, else it is added before the\n"
-                    "extension (out.0012.png)")
+                    "the image to write: .png or .exr; with --frames, the name\n"
+                    "holds the frame number: '#'s (shot.####.exr: shot.0042.exr)\n"
+                    "or a printf %04d")
       ->required()
       ->type_name("FILE")
       ->check([](const std::string& path) -> std::string {
@@ -241,26 +240,18 @@ void addOptions(CLI::App& render, Options& o) {
       });
   o.shot.addTo(render);
   CLI::Option* frames = render.add_option_function<std::string>(
-      "--frames",
-      [&o](const std::string& v) {
-        size_t colon = v.find(':');
-        if (colon == std::string::npos) throw UsageError{"--frames expects A:B, e.g. 1:48, got '" + v + "'"};
-        auto number = [&](const std::string& part) {
-          try {
-            size_t used = 0;
-            long n = std::stol(part, &used);
-            if (used == part.size() && n >= 0) return n;
-          } catch (const std::exception&) {
-          }
-          throw UsageError{"--frames expects A:B with whole numbers, got '" + v + "'"};
-        };
-        o.firstFrame = number(v.substr(0, colon));
-        o.lastFrame = number(v.substr(colon + 1));
-        if (o.lastFrame < o.firstFrame) throw UsageError{"--frames " + v + ": the last frame comes before the first"};
-        o.frames = true;
-      },
-      "frames A to B inclusive at --fps, with progress");
-  frames->type_name("A:B")->excludes(o.shot.timeOption);
+      "--frames", [&o](const std::string& v) { o.frames = FrameList::parse("--frames", v); },
+      "render these frames at --fps: 1-240, 1-240x4 (every 4th),\n"
+      "1:240:4 (the same), 1,5,10-20; in increasing order, each once");
+  frames->type_name("LIST")->excludes(o.shot.timeOption);
+  render.add_flag("--skip-existing", o.skipExisting,
+                  "leave frames whose file exists alone: files appear only\n"
+                  "when complete, so an existing one is a finished frame");
+  render.add_option("--stats-json", o.statsJson,
+                    "beside each frame, a JSON of its own: frame, time, device,\n"
+                    "driver, and hashes of the scene file and of the pixels\n"
+                    "(the same pixels hash the same on every machine)")
+      ->type_name("PATTERN");
   render.add_option("--fps", o.fps, "frames per second for --frames (default 24)")
       ->type_name("N")
       ->check(CLI::PositiveNumber & finite())
@@ -380,20 +371,68 @@ void check(Options& o) {
   if (o.reference && o.wants("cost")) throw UsageError{"render: --aov cost counts BVH nodes on the GPU; the reference has none"};
   // EXR coverage and AOVs come from the trace's own per-pixel data, which the driver's ray tracing has not.
   if (o.exr() || o.viewport || o.reference) o.autoMethod = false;
+  size_t frames = o.frames ? o.frames->size() : 1;
+  checkFramePattern("-o", o.output, frames);
+  if (!o.statsJson.empty()) checkFramePattern("--stats-json", o.statsJson, frames);
+}
+
+// SIGTERM (a farm's scheduler ending the job) and SIGINT: the frame under way
+// is dropped unwritten, those written stay, and the exit code is 128 + the signal.
+volatile std::sig_atomic_t stopSignal = 0;
+void onStopSignal(int signal) { stopSignal = signal; }
+
+// 64-bit FNV-1a: a hash for "the same bytes", not for secrecy.
+uint64_t fnv1a(const void* data, size_t bytes, uint64_t hash = 0xcbf29ce484222325ull) {
+  const auto* p = static_cast<const unsigned char*>(data);
+  for (size_t i = 0; i < bytes; ++i) hash = (hash ^ p[i]) * 0x100000001b3ull;
+  return hash;
+}
+
+std::string hex64(uint64_t value) {
+  char text[17];
+  std::snprintf(text, sizeof text, "%016llx", static_cast<unsigned long long>(value));
+  return text;
+}
+
+// The scene's identity for --stats-json: its file's bytes, or the procedural eye's options.
+std::string sceneHash(const Options& o) {
+  if (o.shot.eye) return "fnv1a64:" + hex64(fnv1a("procedural eye", 14));
+  std::ifstream in(o.shot.input, std::ios::binary);
+  std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  return "fnv1a64:" + hex64(fnv1a(bytes.data(), bytes.size()));
+}
+
+// The pixels' identity: the values written, before the file's encoding and metadata.
+std::string pixelHash(const io::LinearImage& image) {
+  if (!image.rgbaHalf.empty()) return "fnv1a64:" + hex64(fnv1a(image.rgbaHalf.data(), image.rgbaHalf.size() * 2));
+  return "fnv1a64:" + hex64(fnv1a(image.rgba.data(), image.rgba.size() * sizeof(glm::vec4)));
 }
 
 
 int runRender(Options& o) {
-  io::checkWritable(o.frames ? framePath(o.output, o.firstFrame) : o.output);
-  if (!o.environment.empty()) o.optics.environment = std::make_shared<scene::Environment>(io::readEnvironment(o.environment));
-  scene::Scene scene = o.shot.loadScene();
-
   std::vector<std::pair<long, double>> frames;  // (frame number, time)
   if (o.frames) {
-    for (long f = o.firstFrame; f <= o.lastFrame; ++f) frames.emplace_back(f, double(f) / o.fps);
+    for (long f : o.frames->frames) frames.emplace_back(f, double(f) / o.fps);
   } else {
     frames.emplace_back(0, o.shot.time);
   }
+  auto pathOf = [&](long frame) { return o.frames ? framePath(o.output, frame) : o.output; };
+  if (o.skipExisting) {
+    size_t asked = frames.size();
+    std::erase_if(frames, [&](const auto& f) { return std::filesystem::is_regular_file(pathOf(f.first)); });
+    if (frames.size() < asked && !quiet()) {
+      std::printf("skipping %zu of %zu frames: their files exist\n", asked - frames.size(), asked);
+    }
+    if (frames.empty()) return kExitOk;
+  }
+  io::checkWritable(pathOf(frames.front().first));
+  if (!o.statsJson.empty()) io::checkWritable(framePath(o.statsJson, frames.front().first));
+  if (!o.environment.empty()) o.optics.environment = std::make_shared<scene::Environment>(io::readEnvironment(o.environment));
+  scene::Scene scene = o.shot.loadScene();
+  const std::string hashOfScene = o.statsJson.empty() ? std::string() : sceneHash(o);
+  stopSignal = 0;
+  std::signal(SIGTERM, onStopSignal);
+  std::signal(SIGINT, onStopSignal);
 
   scene::Pose layout = scene::evaluate(scene, frames.front().second);
   std::unique_ptr<vk::Context> context;
@@ -413,6 +452,7 @@ int runRender(Options& o) {
     }
     render::RendererOptions options;
     options.passTimes = o.stats || o.autoMethod;  // timestamps only where someone reads them
+    options.independentFrames = true;  // a frame's pixels are the same in whichever chunk a farm renders it
     renderer = std::make_unique<render::Renderer>(*context, scene, layout, options);
   }
   const std::string device = o.reference ? "CPU reference" : context->facts().name;
@@ -437,11 +477,19 @@ int runRender(Options& o) {
   render::AutoMethod chooser(context && context->caps().driverRayTracing, false, frames.size());
   const bool wantAov = o.exr() && traced;
   io::Progress progress("frames", frames.size(), quiet());
+  // A farm task's log says which GPU of the node it drew and why.
+  if (context && frames.size() > 1 && !quiet()) {
+    std::printf("device %s (%s)\n", device.c_str(), context->deviceWhy().c_str());
+    std::fflush(stdout);  // before the progress lines on stderr, in a farm's log too
+  }
   auto start = std::chrono::steady_clock::now();
   for (size_t i = 0; i < frames.size(); ++i) {
+    if (stopSignal) break;
+    auto frameStart = std::chrono::steady_clock::now();
     scene::Pose pose = i == 0 ? layout : scene::evaluate(scene, frames[i].second);
     scene::View view = o.shot.resolveView("render", scene, pose);
     io::LinearImage image{o.shot.width, o.shot.height, {}, {}};
+    std::string drawnWith = o.reference ? "reference" : render::methodName(*o.method);
     io::ImageExtras extras;
     if (o.exr()) extras = exrExtras(o, scene, view, frames[i].second, device);
     if (o.reference) {
@@ -473,6 +521,7 @@ int runRender(Options& o) {
       scene::sceneBounds(scene, pose, lo, hi);
       render::fitDepthRange(view, lo, hi, raster);
       render::Method method = o.autoMethod ? chooser.next() : *o.method;
+      drawnWith = render::methodName(method);
       render::ViewRequest request = render::methodView(method, settings, raster);
       request.readback.enabled = true;
       request.readback.half = true;
@@ -496,11 +545,27 @@ int runRender(Options& o) {
       if (o.stats) printStats(frames[i].first, result.stats, result.passes);
       if (o.stats && o.autoMethod) std::printf("  method %s\n", chooser.describe().c_str());
     }
-    std::string path = o.frames ? framePath(o.output, frames[i].first) : o.output;
+    if (stopSignal) break;  // the frame under way is dropped: only whole frames are ever written
+    std::string path = pathOf(frames[i].first);
     io::writeImage(path, image, extras);
+    if (!o.statsJson.empty()) {
+      io::Json j = io::reportHead("render-frame", context ? &context->facts() : nullptr);
+      j["frame"] = frames[i].first;
+      j["time_seconds"] = frames[i].second;
+      j["frame_ms"] = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - frameStart).count();
+      j["image"] = path;
+      j["image_hash"] = pixelHash(image);
+      if (context) j["device_from"] = context->deviceWhy();
+      j["scene"] = o.shot.eye ? std::string("procedural eye") : o.shot.input;
+      j["scene_hash"] = hashOfScene;
+      j["method"] = drawnWith;
+      j["width"] = o.shot.width;
+      j["height"] = o.shot.height;
+      io::writeJson(framePath(o.statsJson, frames[i].first), j);
+    }
     double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     if (frames.size() > 1) {
-      progress.update(i + 1, path);
+      progress.update(i + 1, "frame " + std::to_string(frames[i].first) + " -> " + path);
     } else {
       std::printf("wrote %s: %ux%u, %s, %s, %.2f s\n", path.c_str(), o.shot.width, o.shot.height, view.description.c_str(),
                   device.c_str(), seconds);
@@ -518,11 +583,41 @@ int runRender(Options& o) {
       }
     }
   }
+  std::signal(SIGTERM, SIG_DFL);
+  std::signal(SIGINT, SIG_DFL);
+  if (stopSignal) {
+    std::fprintf(stderr, "snell: render: stopped by signal %d; the frames written are whole, the one under way was dropped\n",
+                 int(stopSignal));
+    return 128 + int(stopSignal);
+  }
   if (frames.size() > 1 && o.autoMethod && !quiet()) std::printf("method %s\n", chooser.describe().c_str());
   return context ? validationExitCode(*context) : kExitOk;
 }
 
 }  // namespace
+
+RenderCheck checkRender(const Args& args) {
+  Options o;
+  CLI::App render("render", "render");
+  render.option_defaults()->multi_option_policy(CLI::MultiOptionPolicy::TakeLast);
+  addGlobalOptions(render);  // `snell render` takes --device and --quiet after it too
+  addOptions(render, o);
+  try {
+    parseOnly(render, args);
+    check(o);
+  } catch (const UsageError& e) {
+    throw UsageError{"render options: " + e.message};
+  }
+  if (!o.environment.empty()) io::readEnvironment(o.environment);
+  scene::Scene scene = o.shot.loadScene();
+  RenderCheck result;
+  result.scene = scene.source;
+  result.autoMethod = o.autoMethod;
+  result.method = o.reference ? "reference" : render::methodName(*o.method);
+  result.bakeTimeGiven = o.bakeTime.has_value();
+  result.fps = o.fps;
+  return result;
+}
 
 void addRender(CLI::App& parent, Runner& run) {
   auto o = std::make_shared<Options>();

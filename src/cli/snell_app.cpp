@@ -26,6 +26,7 @@ std::unique_ptr<CLI::App> makeSnellApp(Runner& run) {
   addRender(*app, run);
   addBake(*app, run);
   addExportWeb(*app, run);
+  addFarm(*app, run);
   CLI::App* bench = app->add_subcommand("bench", "benchmarks: 'snell bench NAME --help' for each");
   bench->require_subcommand(1);
   bench->footer(kHelpFooter);

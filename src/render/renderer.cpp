@@ -194,6 +194,7 @@ Renderer::Update Renderer::planUpdate(const scene::Pose& pose, const std::vector
 
   // Where every item is (bounding spheres), for culling and the origin.
   bounds_.place(pose);
+  if (options_.independentFrames) origin_ = FrameOrigin();
   stats.rebased = origin_.follow(views.front().settings.view.eye, bounds_);
   const glm::dvec3 origin = origin_.origin();
 
@@ -262,6 +263,7 @@ Renderer::Update Renderer::planUpdate(const scene::Pose& pose, const std::vector
   for (const ViewRequest& v : views) u.driver = u.driver || (v.output == ViewOutput::Trace && v.driverTrace);
   if (!u.trees) return u;
   prepareTrees();
+  if (options_.independentFrames) treesBuilt_ = topBuilt_ = false;
   bool bottomChanged = false;
   if (!treesBuilt_) {
     for (uint32_t g = 0; g < scene_.geometries.size(); ++g) u.build.push_back(g);

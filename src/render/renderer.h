@@ -140,6 +140,10 @@ struct RendererOptions {
   HostBuffers host;
   /// GPU timestamps around every pass (FrameResult::passes); off, a frame records none.
   bool passTimes = true;
+  /// Each frame as if it were the renderer's first: the origin at its camera,
+  /// every tree built afresh. Its pixels then depend on nothing drawn before
+  /// it, so a farm's chunks and retries agree bit for bit, for a build a frame.
+  bool independentFrames = false;
 };
 
 /// The images of one view; they keep the last frame's result until the next frame that renders the view.
