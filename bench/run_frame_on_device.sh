@@ -19,6 +19,10 @@
 #   bench/run_frame_on_device.sh build   # bench scale: build and refit of 1M and 10M triangles beside the driver's
 #   bench/run_frame_on_device.sh farm    # CUDA_VISIBLE_DEVICES by index and UUID mapped to the Vulkan device,
 #                                        # the frame-list, farm and device-mapping tests
+#   bench/run_frame_on_device.sh shot    # (two GPUs) bench shot on one GPU and on both; CUDA_VISIBLE_DEVICES
+#                                        # with --devices all; the multi-device tests on the GPUs
+#   bench/run_frame_on_device.sh shot1   # (one GPU) the same code with two workers on the one GPU (--devices 0,0),
+#                                        # SHOT_FRAMES (24) frames, and the multi-device tests
 #   bench/run_frame_on_device.sh python  # the Python module, built there for its python3 against the carried
 #                                        # install (.carry/prefix), replaying the Blender feed in .carry/feed
 #                                        # (bench/record_blender_feed.py), beside bench frame of the rig's glTF
@@ -30,6 +34,7 @@ icd=/usr/local/nvidia/share/vulkan/icd.d/nvidia_icd.json
 [[ -f $icd ]] && export VK_DRIVER_FILES=$icd
 export LD_LIBRARY_PATH=$PWD/.carry/lib:$PWD/.carry VK_ADD_LAYER_PATH=$PWD/.carry/layer XDG_RUNTIME_DIR=/tmp
 export SNELL_ASSETS_DIR=$PWD/.assets SNELL_GOLDEN_DIR=$PWD/golden
+mkdir -p "$SNELL_ASSETS_DIR/gltf" "$SNELL_ASSETS_DIR/gltf-invalid"  # the asset-driven tests instantiate over what is carried
 OUT=${OUT:-/tmp/out}
 mkdir -p "$OUT"
 nvidia-smi --query-gpu=name,driver_version,clocks.sm,clocks.mem --format=csv
@@ -163,6 +168,31 @@ if [[ $step == farm ]]; then
     --gtest_filter='FrameList.*:FramePattern.*:FarmPlan.*:FarmFolder.*:DeviceSelection.*:LauncherOverride.*:DeviceSurvey.*:Robustness.Sigterm*:Robustness.DeviceLost*' \
     > "$OUT/farm-tests.log" 2>&1
   echo "farm tests exit $?"; grep -E "FAILED|PASSED|tests ran" "$OUT/farm-tests.log" | tail -12
+fi
+if [[ $step == shot ]]; then
+  echo "== every GPU of the host: bench shot, crowd 100 at 3840x2160, ${SHOT_FRAMES:-240} frames as PNG on the local disk"
+  nvidia-smi --query-gpu=index,name,pci.bus_id,uuid --format=csv
+  .carry/snell info --devices | tee "$OUT/info-devices.txt"
+  df -h /tmp | tail -1; nproc
+  SNELL_PIPELINE_CACHE=/tmp/snell-cache .carry/snell bench shot --frames "${SHOT_FRAMES:-240}" --folder /tmp/shot \
+    --json "$OUT/shot.json" 2> "$OUT/shot-progress.log" | tee "$OUT/shot.txt"
+  echo "bench shot exit ${PIPESTATUS[0]}"
+  echo "== CUDA_VISIBLE_DEVICES=1 maps to the second GPU in PCI bus order; =0,1 with --devices all takes both"
+  CUDA_VISIBLE_DEVICES=1 .carry/snell render --eye --size 320x240 --frames 1-2 -o /tmp/c1.#.png 2>&1 | grep -E "^device|error"
+  CUDA_VISIBLE_DEVICES=0,1 .carry/snell render --eye --size 320x240 --frames 1-8 --devices all -o /tmp/c2.#.png 2>&1 | grep -E "device|frames on"
+  SNELL_VALIDATION=1 .carry/snell_tests --gtest_brief=1 --gtest_filter='MultiDevice.*:DeviceList.*:LauncherOverride.*' \
+    > "$OUT/multi-tests.log" 2>&1
+  echo "multi-device tests exit $?"; grep -E "FAILED|PASSED|tests ran" "$OUT/multi-tests.log" | tail -8
+fi
+if [[ $step == shot1 ]]; then
+  echo "== two workers on one GPU: bench shot --devices 0,0, crowd 100 at 3840x2160, ${SHOT_FRAMES:-24} frames as PNG"
+  SNELL_PIPELINE_CACHE=/tmp/snell-cache .carry/snell bench shot --devices 0,0 --frames "${SHOT_FRAMES:-24}" \
+    --folder /tmp/shot --json "$OUT/shot1.json" 2> "$OUT/shot1-progress.log" | tee "$OUT/shot1.txt"
+  echo "bench shot exit ${PIPESTATUS[0]}"
+  CUDA_VISIBLE_DEVICES=0 .carry/snell render --eye --size 320x240 --frames 1-8 --devices all -o /tmp/c2.#.png 2>&1 | grep -E "device|frames on"
+  SNELL_VALIDATION=1 .carry/snell_tests --gtest_brief=1 --gtest_filter='MultiDevice.*:DeviceList.*:LauncherOverride.*' \
+    > "$OUT/multi-tests.log" 2>&1
+  echo "multi-device tests exit $?"; grep -E "FAILED|PASSED|tests ran" "$OUT/multi-tests.log" | tail -8
 fi
 if [[ $step == first ]]; then
   {

@@ -148,5 +148,41 @@ TEST(LauncherOverride, VerdictsNameTheLauncherVariable) {
   EXPECT_NE(choice.verdicts[0].find("CUDA_VISIBLE_DEVICES=1"), std::string::npos) << choice.verdicts[0];
 }
 
+TEST(DeviceList, AllIsEveryQualifyingDeviceOfTheBestKind) {
+  auto devices = fourGpuNode();
+  devices[2].unmet = {"feature maintenance4 is missing"};
+  EXPECT_EQ(chooseDeviceList(devices, "all"), (std::vector<uint32_t>{0, 1, 3})) << "no lavapipe beside GPUs";
+  auto cpuOnly = laptop();
+  cpuOnly.resize(1);
+  EXPECT_EQ(chooseDeviceList(cpuOnly, "all"), (std::vector<uint32_t>{0}));
+}
+
+TEST(DeviceList, IndicesAndUuidsMayNameOneDeviceTwice) {
+  auto devices = fourGpuNode();
+  EXPECT_EQ(chooseDeviceList(devices, "3,01c0ffee-1234,3"), (std::vector<uint32_t>{3, 1, 3}));
+  EXPECT_EQ(chooseDeviceList(devices, "4,4"), (std::vector<uint32_t>{4, 4})) << "two workers on lavapipe";
+}
+
+TEST(DeviceList, AMissingOrUnqualifiedDeviceIsAnErrorNamingIt) {
+  auto devices = fourGpuNode();
+  devices[1].unmet = {"feature maintenance4 is missing"};
+  auto message = [&](const std::string& list) {
+    try {
+      chooseDeviceList(devices, list);
+    } catch (const VulkanError& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  EXPECT_NE(message("0,7").find("no device 7"), std::string::npos) << message("0,7");
+  EXPECT_NE(message("1").find("maintenance4"), std::string::npos) << message("1");
+  EXPECT_NE(message("gpu0").find("neither a device index nor a UUID"), std::string::npos) << message("gpu0");
+  EXPECT_NE(message("0,,1").find("empty entry"), std::string::npos) << message("0,,1");
+}
+
+TEST(LauncherOverride, EveryGpuOfAListMapsForDevicesAll) {
+  EXPECT_EQ(launcherDevices(fourGpuNode(), "CUDA_VISIBLE_DEVICES", "0,2"), (std::vector<uint32_t>{3, 2}));
+}
+
 }  // namespace
 }  // namespace snell::vk

@@ -192,7 +192,7 @@ TEST_F(FarmFolder, TheCheckNamesMissingFramesAndTheTaskThatFailed) {
   EXPECT_NE(check.message.find("missing frames 4"), std::string::npos) << check.message;
   EXPECT_NE(check.message.find("task 1 (frames 3,4) exited 1"), std::string::npos) << check.message;
   EXPECT_NE(check.message.find("task 2 (frames 5,6) did not finish"), std::string::npos) << check.message;
-  EXPECT_EQ(check.summary["missing"], nlohmann::json::array({4}));
+  EXPECT_EQ(check.summary["missing"], nlohmann::ordered_json::array({4}));
   EXPECT_EQ(check.summary["ok"], false);
 }
 

@@ -23,6 +23,12 @@ namespace {
 
 namespace fs = std::filesystem;
 
+// In the sanitized build a command checks for leaks at exit, and a leak
+// changes its exit code to 1; elsewhere the variable does nothing. The driver
+// stays loaded (tests/tools/keep_libraries_loaded.cpp), so only snell's own
+// leaks count.
+const std::string kLeakCheck = std::string("ASAN_OPTIONS=detect_leaks=1 LD_PRELOAD=") + SNELL_KEEP_LOADED + " ";
+
 // A private folder per test: whatever a failed run leaves in it is visible.
 class Robustness : public ::testing::Test {
  protected:
@@ -34,11 +40,9 @@ class Robustness : public ::testing::Test {
   }
   void TearDown() override { fs::remove_all(dir_); }
 
-  // In the sanitized build the command checks for leaks at exit (a leak
-  // changes its exit code); elsewhere the variable does nothing.
   CommandRun snell(const std::string& environment, const std::string& arguments) const {
-    return runCommand("cd " + shellQuoted(dir_.string()) + " && ASAN_OPTIONS=detect_leaks=1 " + environment + " " +
-                      SNELL_BINARY + " " + arguments);
+    return runCommand("cd " + shellQuoted(dir_.string()) + " && " + kLeakCheck + environment + " " + SNELL_BINARY +
+                      " " + arguments);
   }
   size_t filesLeft() const { return size_t(std::distance(fs::directory_iterator(dir_), fs::directory_iterator())); }
 
@@ -70,7 +74,7 @@ TEST_F(Robustness, SigtermDuringTheThirdFrameKeepsTwoWholeFramesAndExits143) {
   // Slurm's scancel and time limit send SIGTERM; it arrives while frame 3 of 6
   // is on the GPU (frames this size take a good part of a second on lavapipe).
   CommandRun run = runCommand(
-      "cd " + shellQuoted(dir_.string()) + " && { ASAN_OPTIONS=detect_leaks=1 " + SNELL_BINARY +
+      "cd " + shellQuoted(dir_.string()) + " && { " + kLeakCheck + SNELL_BINARY +
       " render --eye --size 960x720 --frames 1-6 -o 'f_#.png' & pid=$!; "
       "for i in $(seq 20000); do [ -e f_2.png ] && break; sleep 0.002; done; kill -TERM $pid; wait $pid; "
       "echo \"exit $?\"; }");
@@ -171,7 +175,7 @@ TEST_F(Robustness, DeviceLostDuringABenchmarkLeavesNoJson) {
 #ifdef SNELL_VIEWER_BINARY
 TEST_F(Robustness, DeviceLostEndsTheViewersDrawingWithAnErrorAndNoScreenshot) {
   CommandRun run = runCommand("cd " + shellQuoted(dir_.string()) +
-                              " && ASAN_OPTIONS=detect_leaks=1 SNELL_FAULT=vkQueueSubmit:VK_ERROR_DEVICE_LOST:16 " +
+                              " && " + kLeakCheck + "SNELL_FAULT=vkQueueSubmit:VK_ERROR_DEVICE_LOST:16 " +
                               SNELL_VIEWER_BINARY + " --offscreen --size 48x36 --frames 30 --screenshot shot.png");
   EXPECT_EQ(run.exitCode, 1) << run.output;
   EXPECT_NE(run.output.find("the GPU failed, so nothing more is drawn"), std::string::npos) << run.output;

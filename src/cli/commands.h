@@ -22,6 +22,7 @@ void addBenchFrame(CLI::App& bench, Runner& run);
 void addBenchStress(CLI::App& bench, Runner& run);
 void addBenchScale(CLI::App& bench, Runner& run);
 void addBenchMethods(CLI::App& bench, Runner& run);
+void addBenchShot(CLI::App& bench, Runner& run);
 
 /// What `snell render ARGS` would draw, found as it would find it: the
 /// options parse and agree, the scene and environment load. Throws

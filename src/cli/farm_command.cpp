@@ -241,7 +241,11 @@ std::string submit(const std::vector<std::string>& argv, const std::function<voi
 
 int runSlurm(SlurmOptions& o, const std::vector<std::string>& renderOptions) {
   FarmPlan plan = FarmPlan::make(o.scene, o.output, *o.frames, o.chunk, {});
-  plan.renderOptions = taskRenderOptions(plan.scene, plan.output, plan.frames, renderOptions);
+  std::vector<std::string> options = renderOptions;
+  // A task given several GPUs renders its chunk on all of them (render --devices).
+  bool devicesGiven = std::any_of(options.begin(), options.end(), [](const std::string& w) { return w.rfind("--devices", 0) == 0; });
+  if (o.gpusPerTask > 1 && !devicesGiven) options.insert(options.end(), {"--devices", "all"});
+  plan.renderOptions = taskRenderOptions(plan.scene, plan.output, plan.frames, options);
   if (plan.tasks() > 1001) {
     throw UsageError{"farm slurm: " + std::to_string(plan.tasks()) + " tasks of " + std::to_string(plan.chunk) +
                      " frames pass Slurm's default limit of 1001 array tasks (MaxArraySize); give --chunk " +
@@ -530,7 +534,8 @@ void addFarm(CLI::App& parent, Runner& run) {
       ->required()
       ->type_name("PATTERN");
   addFramesAndChunk(*slurm, s->frames, s->chunk);
-  slurm->add_option("--gpus-per-task", s->gpusPerTask, "GPUs Slurm gives each task (GRES; default: none asked)")
+  slurm->add_option("--gpus-per-task", s->gpusPerTask,
+                    "GPUs Slurm gives each task (GRES; default: none asked);\nwith 2 or more, each task renders on all of them (--devices all)")
       ->type_name("N");
   slurm->add_option("--cpus-per-task", s->cpusPerTask, "CPUs each task gets; lavapipe renders on that many threads")
       ->type_name("N");

@@ -36,6 +36,7 @@ std::unique_ptr<CLI::App> makeSnellApp(Runner& run) {
   addBenchStress(*bench, run);
   addBenchScale(*bench, run);
   addBenchMethods(*bench, run);
+  addBenchShot(*bench, run);
   return app;
 }
 

@@ -35,6 +35,18 @@ bool hasInstanceExtension(const char* name) {
                      [&](const VkExtensionProperties& e) { return std::strcmp(e.extensionName, name) == 0; });
 }
 
+// The GPUs a launcher gave this process, as (variable, value); a null
+// variable where none did. Unset, empty, "-1" or Slurm's "NoDevFiles": the
+// launcher gave no GPU to keep to.
+std::pair<const char*, const char*> launcherGpus() {
+  for (const char* variable : {"CUDA_VISIBLE_DEVICES", "GPU_DEVICE_ORDINAL"}) {
+    const char* value = std::getenv(variable);
+    if (!value || !*value || *value == '-' || std::strcmp(value, "NoDevFiles") == 0) continue;
+    return {variable, value};
+  }
+  return {nullptr, nullptr};
+}
+
 // The device override and where it came from: the caller's (--device),
 // SNELL_DEVICE, then a launcher's GPU list. Slurm and CUDA launchers set
 // CUDA_VISIBLE_DEVICES and GPU_DEVICE_ORDINAL, which no Vulkan driver reads:
@@ -48,15 +60,11 @@ std::string resolveOverride(const std::string& given, std::span<const DeviceFact
     why = std::string("SNELL_DEVICE=") + env;
     return env;
   }
-  for (const char* variable : {"CUDA_VISIBLE_DEVICES", "GPU_DEVICE_ORDINAL"}) {
-    const char* value = std::getenv(variable);
-    // Unset, empty, "-1" or Slurm's "NoDevFiles": the launcher gave this task no GPU to keep to.
-    if (!value || !*value || *value == '-' || std::strcmp(value, "NoDevFiles") == 0) continue;
-    return launcherOverride(facts, variable, value, why);
-  }
+  if (auto [variable, value] = launcherGpus(); variable) return launcherOverride(facts, variable, value, why);
   why = "none named: the best in rank, discrete, integrated, virtual GPU, then CPU";
   return "";
 }
+
 
 struct InstanceRequest {
   std::string applicationName = "snell";
@@ -120,6 +128,22 @@ std::vector<DeviceFacts> readAllFacts(VkInstance instance, std::vector<VkPhysica
   return facts;
 }
 
+// The devices' facts from an instance of their own, for a survey.
+std::vector<DeviceFacts> readFactsOnce() {
+  bool debugUtils = false;
+  VkInstance instance = createInstance({}, debugUtils);
+  std::vector<DeviceFacts> facts;
+  try {
+    std::vector<VkPhysicalDevice> handles;
+    facts = readAllFacts(instance, handles);
+  } catch (...) {
+    vkDestroyInstance(instance, nullptr);
+    throw;
+  }
+  vkDestroyInstance(instance, nullptr);
+  return facts;
+}
+
 std::string mebibytes(uint64_t bytes) {
   std::ostringstream text;
   text << (bytes >> 20) << " MiB";
@@ -150,19 +174,22 @@ std::string DeviceReport::table() const {
 
 DeviceReport surveyDevices(const std::string& deviceOverride) {
   DeviceReport report;
-  bool debugUtils = false;
-  VkInstance instance = createInstance({}, debugUtils);
-  try {
-    std::vector<VkPhysicalDevice> handles;
-    report.devices = readAllFacts(instance, handles);
-  } catch (...) {
-    vkDestroyInstance(instance, nullptr);
-    throw;
-  }
-  vkDestroyInstance(instance, nullptr);
+  report.devices = readFactsOnce();
   report.override = resolveOverride(deviceOverride, report.devices, report.why);
   report.choice = chooseDevice(report.devices, report.override, report.why);
   return report;
+}
+
+std::vector<uint32_t> devicesForList(const std::string& list, std::string& why) {
+  std::vector<DeviceFacts> facts = readFactsOnce();
+  if (list == "all") {
+    if (auto [variable, value] = launcherGpus(); variable) {
+      why = std::string(variable) + "=" + value + ": every GPU the launcher gave";
+      return launcherDevices(facts, variable, value);
+    }
+  }
+  why = list == "all" ? "--devices all: every device of the best kind that qualifies" : "--devices " + list;
+  return chooseDeviceList(facts, list);
 }
 
 std::unique_ptr<Context> Context::create(const ContextDesc& desc) {

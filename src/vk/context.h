@@ -106,6 +106,11 @@ struct DeviceReport {
 /// Surveys the Vulkan devices as Context::create would choose among them.
 DeviceReport surveyDevices(const std::string& deviceOverride = "");
 
+/// The devices of a --devices list (chooseDeviceList), a worker each; "all"
+/// within a launcher's CUDA_VISIBLE_DEVICES is every GPU it lists. `why` says
+/// how they were found; throws VulkanError naming a bad entry.
+std::vector<uint32_t> devicesForList(const std::string& list, std::string& why);
+
 /// Owns (or borrows) the Vulkan device everything else runs on, counts
 /// validation messages, and defers destruction of handles the GPU may still use.
 class Context {

@@ -193,7 +193,7 @@ DeviceChoice chooseDevice(std::span<const DeviceFacts> devices, const std::strin
     std::string verdict;
     if (choice.chosen && i == *choice.chosen) {
       verdict = override.empty() ? "chosen: the highest-ranked device that meets every requirement"
-                                 : "chosen: named by SNELL_DEVICE=" + override;
+                                 : "chosen: named by " + (source.empty() ? "SNELL_DEVICE=" + override : source);
     } else if (!d.unmet.empty()) {
       verdict = "rejected: ";
       for (size_t u = 0; u < d.unmet.size(); ++u) verdict += (u ? "; " : "") + d.unmet[u];
@@ -209,23 +209,21 @@ DeviceChoice chooseDevice(std::span<const DeviceFacts> devices, const std::strin
   return choice;
 }
 
-std::string launcherOverride(std::span<const DeviceFacts> devices, const std::string& variable,
-                             const std::string& value, std::string& why) {
-  std::string first = value.substr(0, value.find(','));
-  std::string given = variable + "=" + value;
-  if (first.empty()) throw VulkanError(given + " names no device");
-  if (looksLikeUuid(first)) {
+namespace {
+
+// One entry of a launcher's list: a UUID names itself, an index k is the k-th
+// GPU (not CPU device) in PCI bus order, enumeration order where the bus is unknown.
+const DeviceFacts& launcherEntry(std::span<const DeviceFacts> devices, const std::string& given,
+                                 const std::string& entry) {
+  if (entry.empty()) throw VulkanError(given + " has an empty entry");
+  if (looksLikeUuid(entry)) {
     for (const DeviceFacts& d : devices) {
-      if (!d.uuid.empty() && d.uuid.rfind(bareUuid(first), 0) == 0) {
-        why = given + " names " + d.name + " by its UUID";
-        return std::to_string(d.index);
-      }
+      if (!d.uuid.empty() && d.uuid.rfind(bareUuid(entry), 0) == 0) return d;
     }
-    throw VulkanError(given + ": no Vulkan device has UUID " + first + " ('snell info --devices' lists them)");
+    throw VulkanError(given + ": no Vulkan device has UUID " + entry + " ('snell info --devices' lists them)");
   }
   uint32_t k = 0;
-  if (!isIndex(first, k)) throw VulkanError(given + ": '" + first + "' is neither a GPU index nor a UUID");
-  // The GPUs (not CPU devices such as lavapipe) in PCI bus order; enumeration order where the bus is unknown.
+  if (!isIndex(entry, k)) throw VulkanError(given + ": '" + entry + "' is neither a GPU index nor a UUID");
   std::vector<const DeviceFacts*> gpus;
   for (const DeviceFacts& d : devices) {
     if (d.type != VK_PHYSICAL_DEVICE_TYPE_CPU) gpus.push_back(&d);
@@ -235,12 +233,70 @@ std::string launcherOverride(std::span<const DeviceFacts> devices, const std::st
     return a->pciBus < b->pciBus;
   });
   if (k >= gpus.size()) {
-    throw VulkanError(given + " names GPU " + first + ", but Vulkan sees " + std::to_string(gpus.size()) +
-                             " GPU(s) ('snell info --devices' lists them)");
+    throw VulkanError(given + " names GPU " + entry + ", but Vulkan sees " + std::to_string(gpus.size()) +
+                      " GPU(s) ('snell info --devices' lists them)");
   }
-  const DeviceFacts& d = *gpus[k];
-  why = given + ": GPU " + first + " in PCI bus order is " + d.name + (d.pciBus.empty() ? "" : " at " + d.pciBus);
+  return *gpus[k];
+}
+
+std::vector<std::string> commaList(const std::string& text) {
+  std::vector<std::string> entries;
+  for (size_t start = 0;;) {
+    size_t comma = text.find(',', start);
+    entries.push_back(text.substr(start, comma == std::string::npos ? std::string::npos : comma - start));
+    if (comma == std::string::npos) return entries;
+    start = comma + 1;
+  }
+}
+
+}  // namespace
+
+std::string launcherOverride(std::span<const DeviceFacts> devices, const std::string& variable,
+                             const std::string& value, std::string& why) {
+  std::string given = variable + "=" + value;
+  std::string first = commaList(value).front();
+  const DeviceFacts& d = launcherEntry(devices, given, first);
+  why = looksLikeUuid(first) ? given + " names " + d.name + " by its UUID"
+                             : given + ": GPU " + first + " in PCI bus order is " + d.name +
+                                   (d.pciBus.empty() ? "" : " at " + d.pciBus);
   return std::to_string(d.index);
+}
+
+std::vector<uint32_t> launcherDevices(std::span<const DeviceFacts> devices, const std::string& variable,
+                                      const std::string& value) {
+  std::vector<uint32_t> chosen;
+  for (const std::string& entry : commaList(value)) chosen.push_back(launcherEntry(devices, variable + "=" + value, entry).index);
+  return chosen;
+}
+
+std::vector<uint32_t> chooseDeviceList(std::span<const DeviceFacts> devices, const std::string& list) {
+  std::vector<uint32_t> chosen;
+  if (list == "all") {
+    DeviceChoice best = chooseDevice(devices, "");
+    if (!best.chosen) throw VulkanError("--devices all: no Vulkan device meets snell's requirements ('snell info --devices' says why)");
+    for (const DeviceFacts& d : devices) {
+      if (d.unmet.empty() && d.type == devices[*best.chosen].type) chosen.push_back(d.index);
+    }
+    return chosen;
+  }
+  for (const std::string& entry : commaList(list)) {
+    if (entry.empty()) throw VulkanError("--devices " + list + ": an empty entry between commas");
+    uint32_t index = 0;
+    bool byIndex = isIndex(entry, index);
+    if (!byIndex && !looksLikeUuid(entry)) {
+      throw VulkanError("--devices " + list + ": '" + entry + "' is neither a device index nor a UUID");
+    }
+    auto it = std::find_if(devices.begin(), devices.end(), [&](const DeviceFacts& d) {
+      return byIndex ? d.index == index : !d.uuid.empty() && d.uuid.rfind(bareUuid(entry), 0) == 0;
+    });
+    if (it == devices.end()) {
+      throw VulkanError("--devices " + list + ": no device " + entry + " ('snell info --devices' lists " +
+                        std::to_string(devices.size()) + ")");
+    }
+    if (!it->unmet.empty()) throw VulkanError("--devices " + list + ": " + it->name + " does not qualify: " + it->unmet.front());
+    chosen.push_back(it->index);
+  }
+  return chosen;
 }
 
 }  // namespace snell::vk

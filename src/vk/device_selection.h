@@ -68,6 +68,17 @@ DeviceChoice chooseDevice(std::span<const DeviceFacts> devices, const std::strin
 std::string launcherOverride(std::span<const DeviceFacts> devices, const std::string& variable,
                              const std::string& value, std::string& why);
 
+/// Every GPU of a launcher's list (CUDA_VISIBLE_DEVICES=0,1), as launcherOverride maps one.
+std::vector<uint32_t> launcherDevices(std::span<const DeviceFacts> devices, const std::string& variable,
+                                      const std::string& value);
+
+/// The devices --devices names, a worker each: "all" is every qualifying
+/// device of the best one's type (every GPU; lavapipe where there is none);
+/// otherwise a comma list of indices and UUIDs, where one device may come
+/// twice (two workers on it). Throws VulkanError naming the entry that names
+/// no device, or one that does not qualify, and why.
+std::vector<uint32_t> chooseDeviceList(std::span<const DeviceFacts> devices, const std::string& list);
+
 /// "discrete GPU", "integrated GPU", "virtual GPU", "CPU" or "other".
 const char* deviceTypeName(VkPhysicalDeviceType type);
 

@@ -66,8 +66,11 @@ struct FaultSwitch {
   std::string call;
   VkResult result = VK_SUCCESS;
   unsigned long long from = 1;
+  int worker = -1;  // SNELL_FAULT_WORKER; -1: every thread's calls
   std::atomic<unsigned long long> calls{0};
 };
+
+thread_local int faultWorker = 0;
 
 VkResult resultFromName(const std::string& name) {
   for (int code = 0; code >= -1000; --code) {  // the core error codes
@@ -108,6 +111,13 @@ FaultSwitch& faultSwitch() {
       f->from = std::strtoull(text.c_str() + second + 1, &end, 10);
       if (*end != '\0' || f->from == 0) throw VulkanError("SNELL_FAULT=" + text + ": N must be a whole number from 1");
     }
+    if (const char* worker = std::getenv("SNELL_FAULT_WORKER"); worker && *worker) {
+      char* end = nullptr;
+      f->worker = int(std::strtol(worker, &end, 10));
+      if (*end != '\0' || f->worker < 0) {
+        throw VulkanError(std::string("SNELL_FAULT_WORKER=") + worker + ": expected a worker number from 0");
+      }
+    }
     f->call = call;
     f->armed = true;
     return f;
@@ -119,7 +129,7 @@ FaultSwitch& faultSwitch() {
 
 VkResult injectedFault(const char* expression) {
   FaultSwitch& f = faultSwitch();
-  if (!f.armed) return VK_SUCCESS;
+  if (!f.armed || (f.worker >= 0 && f.worker != faultWorker)) return VK_SUCCESS;
   // The call is the expression's first word: "vkQueueSubmit(queue, ...)".
   std::string_view text(expression);
   if (text.substr(0, f.call.size()) != f.call || (text.size() > f.call.size() && text[f.call.size()] != '(')) {
@@ -127,5 +137,7 @@ VkResult injectedFault(const char* expression) {
   }
   return f.calls.fetch_add(1) + 1 >= f.from ? f.result : VK_SUCCESS;
 }
+
+void setFaultWorker(int worker) { faultWorker = worker; }
 
 }  // namespace snell::vk

@@ -38,6 +38,10 @@ void check(VkResult result, const char* expression, const char* file, int line);
 /// result to fail with, or VK_SUCCESS to make the call. A malformed setting
 /// throws VulkanError saying what is wrong with it.
 VkResult injectedFault(const char* call);
+/// SNELL_FAULT_WORKER=K narrows the fault to the calls of one worker of a
+/// render over several devices (render --devices): the threads that called
+/// setFaultWorker(K). Every thread is worker 0 until it says otherwise.
+void setFaultWorker(int worker);
 /// SNELL_FAULT=validation-message: a context with validation on reports one
 /// validation message as it is created (through the layer's messenger), so
 /// tests can see every command fail on one.
