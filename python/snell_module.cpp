@@ -86,6 +86,9 @@ py::array_t<double> fromMat4(const snell::Mat4& m) {
   return a;
 }
 
+// The API's own default, so the module's keyword default cannot drift from it.
+const snell::Vec3 kDefaultBackground = snell::View{}.background;
+
 snell::Vec3 toVec3(const std::vector<float>& v, const std::string& what) {
   if (v.size() != 3) throw snell::Error(what + " needs 3 numbers, got " + std::to_string(v.size()));
   return {v[0], v[1], v[2]};
@@ -486,7 +489,7 @@ PYBIND11_MODULE(_snell, m) {
            "eye"_a = std::vector<float>{0, 0, 3}, "target"_a = std::vector<float>{0, 0, 0},
            "up"_a = std::vector<float>{0, 1, 0}, "yfov"_a = 0.6981317f, "viewport"_a = false, "method"_a = "auto",
            "max_interfaces"_a = 8, "fresnel"_a = true, "dispersion"_a = true, "volume"_a = true,
-           "background"_a = std::vector<float>{0.02f, 0.02f, 0.025f}, "transparent_background"_a = false,
+           "background"_a = std::vector<float>(kDefaultBackground.begin(), kDefaultBackground.end()), "transparent_background"_a = false,
            "The camera: the scene's camera `camera` (an index), else view_matrix (world to camera)\n"
            "with projection (OpenGL: perspective or orthographic, off-centre for lens shift; its\n"
            "aspect must be width/height), else a look-at from eye to target with yfov radians.\n"

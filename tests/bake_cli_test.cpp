@@ -3,6 +3,7 @@
 #include "assets.h"
 #include "command_run.h"
 
+#include "bake/map_file.h"
 #include "bake/refraction_bake.h"
 #include "io/image_file.h"
 
@@ -129,7 +130,7 @@ TEST(ExportWebCommand, ThePageInChromiumDrawsWhatTheRefractionMapMethodRenders) 
   ASSERT_EQ(rendered.exitCode, 0) << rendered.output;
   io::Rgb8Image render = io::readRgb8((dir / "render.png").string());
   bake::Encoding encoding = bake::Encoding::Exr;
-  bake::MapPixels mapPixels = io::readMapFile((site / "map.png").string(), encoding);
+  bake::MapPixels mapPixels = bake::readMapFile((site / "map.png").string(), encoding);
   bake::DecodedMap map = bake::decodeMap(mapPixels, encoding);
   ASSERT_EQ(encoding, bake::Encoding::Sky8);
 

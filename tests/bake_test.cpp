@@ -4,6 +4,7 @@
 #include "gpu_test.h"
 #include "golden_support.h"
 
+#include "bake/map_file.h"
 #include "bake/refraction_bake.h"
 #include "io/image_file.h"
 #include "render/method.h"
@@ -35,9 +36,9 @@ struct Baked {
 Baked bakeEye(vk::Context& context, double time = 0.0) {
   Baked b;
   b.pose = scene::evaluate(b.scene, time);
-  b.settings = {kWidth, kHeight, scene::resolveView(b.scene, b.pose, {}), {0.02f, 0.02f, 0.025f}, 8};
+  b.settings = {kWidth, kHeight, scene::resolveView(b.scene, b.pose, {}), glm::vec3(scene::kDefaultBackground), 8};
   render::Renderer renderer(context, b.scene, b.pose);
-  b.bake = bake::bakeRefraction(context, renderer, b.pose, b.settings);
+  b.bake = bake::bakeRefraction(renderer, b.pose, b.settings);
   return b;
 }
 
@@ -46,9 +47,6 @@ io::Rgb8Image drawWithMap(vk::Context& context, const scene::Scene& s, const sce
                            const render::FrameSettings& settings, const render::RefractionMapBuffer& map) {
   render::Renderer renderer(context, s, pose);
   render::RasterOptions raster;
-  glm::dvec3 lo, hi;
-  scene::sceneBounds(s, pose, lo, hi);
-  render::fitDepthRange(settings.view, lo, hi, raster);
   raster.refractionMap = &map;
   render::FrameRequest request;
   request.pose = &pose;
@@ -61,7 +59,7 @@ io::Rgb8Image drawWithMap(vk::Context& context, const scene::Scene& s, const sce
 io::Rgb8Image traceOf(vk::Context& context, const scene::Scene& s, const scene::Pose& pose,
                        const render::FrameSettings& settings) {
   render::Renderer renderer(context, s, pose);
-  render::RenderedFrame frame = render::renderFrame(context, renderer, pose, settings);
+  render::RenderedFrame frame = render::renderFrame(renderer, pose, settings);
   return io::toSrgb8({settings.width, settings.height, frame.rgba});
 }
 
@@ -187,14 +185,14 @@ TEST_F(GpuTest, EachMapFileRoundTripsTheBakedUvsWithinItsStep) {
                         Case{bake::Encoding::Sky8, "map8.png", 8.0 / 65025 + 1e-9}}) {
     std::string path = (dir / c.file).string();
     try {
-      io::writeMapFile(path, bake::encodeMap(want, c.encoding), c.encoding);
+      bake::writeMapFile(path, bake::encodeMap(want, c.encoding), c.encoding);
     } catch (const std::runtime_error& e) {
       if (std::string(e.what()).find("no OpenImageIO") == std::string::npos) throw;
       std::printf("%s: skipped, %s\n", c.file, e.what());  // the GPU machine's build carries no OpenImageIO
       continue;
     }
     bake::Encoding read = bake::Encoding::Exr;
-    bake::MapPixels pixels = io::readMapFile(path, read);
+    bake::MapPixels pixels = bake::readMapFile(path, read);
     bake::DecodedMap got = bake::decodeMap(pixels, read);
     EXPECT_EQ(read, c.encoding) << c.file;
     ASSERT_EQ(got.coverage.size(), want.coverage.size());

@@ -5,7 +5,9 @@
 #include "command_run.h"
 
 #include "io/json.h"
+#include "io/version.h"
 #include "scene/gltf_writer.h"
+#include "scene/png.h"
 #include "scene/procedural_eye.h"
 
 #include <OpenImageIO/imagebuf.h>

@@ -227,6 +227,11 @@ TEST(Embedding, HostBufferMeshesFollowTheHostsDeformationLikeTheGltfMorphAndSkin
   std::filesystem::remove(glb);
 }
 
+TEST(Embedding, TheApisDefaultBackgroundIsTheRenderersDefault) {
+  const snell::Vec3 api = snell::View{}.background;
+  for (int c = 0; c < 3; ++c) EXPECT_EQ(api[size_t(c)], float(snell::scene::kDefaultBackground[c])) << "channel " << c;
+}
+
 TEST(Embedding, HostSceneRefusesAMeshPastItsBuffers) {
   snell::Device device = snell::Device::create({.validation = true});
   HostBuffer buffer(device, 9);

@@ -35,17 +35,14 @@ scene::Scene smallEye() {
 
 ViewRequest traceView(const scene::View& view) {
   ViewRequest v;
-  v.settings = {kWidth, kHeight, view, {0.02f, 0.02f, 0.025f}, gpu::kDefaultMaxInterfaces};
+  v.settings = {kWidth, kHeight, view, glm::vec3(scene::kDefaultBackground), gpu::kDefaultMaxInterfaces};
   return v;
 }
 
-ViewRequest compositeView(const scene::Scene& s, const scene::Pose& pose, const scene::View& view, bool masked = true) {
+ViewRequest compositeView(const scene::View& view, bool masked = true) {
   ViewRequest v = traceView(view);
   v.output = ViewOutput::Composite;
   v.masked = masked;
-  glm::dvec3 lo, hi;
-  scene::sceneBounds(s, pose, lo, hi);
-  render::fitDepthRange(view, lo, hi, v.raster);
   return v;
 }
 
@@ -157,7 +154,7 @@ TEST_F(GpuTest, AnEyeOffScreenGetsNoTraceDispatch) {
   scene::Pose pose = scene::evaluate(s, 0.0);
   Renderer renderer(context(), s, pose);
   scene::View away = lookFrom({0.0, 0.0, 0.1}, {0.0, 0.0, 1.0});  // looking away from the eye behind
-  FrameStats stats = frame(renderer, pose, {compositeView(s, pose, away)}).stats;
+  FrameStats stats = frame(renderer, pose, {compositeView(away)}).stats;
   EXPECT_EQ(stats.traceDispatches, 0u);
   EXPECT_EQ(stats.pixelsTraced, 0u);
   EXPECT_EQ(renderer.blas(), nullptr) << "no view traced, so no tree was built";
@@ -169,7 +166,7 @@ TEST_F(GpuTest, AnEyeTurnedAwayTracesNoPixel) {
   scene::Scene s = smallEye();
   scene::Pose pose = scene::evaluate(s, 0.0);
   Renderer renderer(context(), s, pose);
-  FrameStats stats = frame(renderer, pose, {compositeView(s, pose, lookFrom({0.0, 0.0, -0.1}))}).stats;
+  FrameStats stats = frame(renderer, pose, {compositeView(lookFrom({0.0, 0.0, -0.1}))}).stats;
   EXPECT_EQ(stats.pixelsTraced, 0u);
   EXPECT_LE(stats.traceDispatches, 1u);
 }
@@ -179,7 +176,7 @@ TEST_F(GpuTest, TheMaskedTraceCoversExactlyThePixelsWhoseVisibleFaceIsTransmissi
   scene::Pose pose = scene::evaluate(s, 0.0);
   Renderer renderer(context(), s, pose);
   scene::View view = scene::resolveView(s, pose, {});
-  FrameStats stats = frame(renderer, pose, {compositeView(s, pose, view)}).stats;
+  FrameStats stats = frame(renderer, pose, {compositeView(view)}).stats;
   std::vector<uint32_t> mask(size_t(kWidth) * kHeight);
   vk::downloadImage(context(), renderer.viewImages(0).mask, mask.data());
   uint64_t transmissive = 0;
@@ -200,7 +197,7 @@ TEST_F(GpuTest, TheMaskedCompositeMatchesTheFullTraceComposite) {
   scene::View view = scene::resolveView(s, pose, {});
   auto composite = [&](bool masked) {
     Renderer renderer(context(), s, pose);
-    ViewRequest v = compositeView(s, pose, view, masked);
+    ViewRequest v = compositeView(view, masked);
     v.settings.width = 192;
     v.settings.height = 144;
     v.readback.enabled = true;
@@ -218,7 +215,7 @@ TEST_F(GpuTest, AViewportOfASceneWithoutTransmissiveFacesBuildsNoTrees) {
   for (scene::Material& m : s.materials) m.transmission = 0.0f;
   scene::Pose pose = scene::evaluate(s, 0.0);
   Renderer renderer(context(), s, pose);
-  FrameStats stats = frame(renderer, pose, {compositeView(s, pose, scene::resolveView(s, pose, {}))}).stats;
+  FrameStats stats = frame(renderer, pose, {compositeView(scene::resolveView(s, pose, {}))}).stats;
   EXPECT_FALSE(renderer.refractive());
   EXPECT_EQ(renderer.blas(), nullptr);
   EXPECT_EQ(renderer.builder(), nullptr) << "no tree builder and no trace pipeline were made";
@@ -230,7 +227,7 @@ TEST_F(GpuTest, RefractionOffRunsNoTreeWork) {
   scene::Scene s = smallEye();
   scene::Pose pose = scene::evaluate(s, 0.0);
   Renderer renderer(context(), s, pose);
-  ViewRequest view = compositeView(s, pose, scene::resolveView(s, pose, {}));
+  ViewRequest view = compositeView(scene::resolveView(s, pose, {}));
   view.raster.refraction = false;
   frame(renderer, pose, {view});
   FrameStats stats = frame(renderer, scene::evaluate(s, 1.0), {view}).stats;

@@ -6,10 +6,13 @@
 
 #include "assets.h"
 
+#include "io/image_compare.h"
 #include "ref/reference_tracer.h"
 #include "scene/gltf_loader.h"
 #include "scene/procedural_eye.h"
+#include "scene/scene_builder.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <sstream>
@@ -35,31 +38,27 @@ std::filesystem::path goldenDir() {
 }
 
 Comparison compare(const io::Rgb8Image& got, const io::Rgb8Image& want) {
+  std::vector<uint8_t> worst;
+  io::ImageDifference d = io::compareImages(got, want, nullptr, &worst);
   Comparison c;
-  c.pixels = size_t(want.width) * want.height;
+  c.pixels = d.pixels;
+  c.withinOne = d.pixels - d.over1;
+  c.maxDifference = d.maximum;
+  // The diff image: mismatches in red, brighter for larger ones, over a dim copy of the golden.
   c.diff = {want.width, want.height, std::vector<uint8_t>(c.pixels * 3, 0)};
   int listed = 0;
   for (size_t i = 0; i < c.pixels; ++i) {
-    int worst = 0;
-    for (int k = 0; k < 3; ++k) worst = std::max(worst, std::abs(int(got.rgb[3 * i + k]) - int(want.rgb[3 * i + k])));
-    c.maxDifference = std::max(c.maxDifference, worst);
-    if (worst <= 1) {
-      ++c.withinOne;
+    if (worst[i] <= 1) {
+      for (size_t k = 0; k < 3; ++k) c.diff.rgb[3 * i + k] = uint8_t(want.rgb[3 * i + k] / 4);
       continue;
     }
-    // The diff image: mismatches in red, brighter for larger ones, over a dim copy of the golden.
-    c.diff.rgb[3 * i] = uint8_t(std::min(255, 64 + 4 * worst));
+    c.diff.rgb[3 * i] = uint8_t(std::min(255, 64 + 4 * int(worst[i])));
     if (listed++ < 5) {
       std::ostringstream line;
       line << "  pixel (" << i % want.width << ", " << i / want.width << "): GPU " << int(got.rgb[3 * i]) << ","
            << int(got.rgb[3 * i + 1]) << "," << int(got.rgb[3 * i + 2]) << " golden " << int(want.rgb[3 * i]) << ","
            << int(want.rgb[3 * i + 1]) << "," << int(want.rgb[3 * i + 2]) << "\n";
       c.firstMismatches += line.str();
-    }
-  }
-  for (size_t i = 0; i < c.pixels; ++i) {
-    if (c.diff.rgb[3 * i] == 0) {
-      for (int k = 0; k < 3; ++k) c.diff.rgb[3 * i + k] = uint8_t(want.rgb[3 * i + k] / 4);
     }
   }
   return c;
@@ -141,40 +140,10 @@ scene::Scene eyeWithAqueous() {
 
 int addFlatShape(scene::Scene& s, const std::vector<glm::vec3>& positions, const std::vector<uint32_t>& indices,
                  int material, const glm::mat4& world) {
-  scene::Shape shape;
+  scene::Shape shape = scene::flatShape(positions, indices, material);
   shape.name = "shape" + std::to_string(s.shapes.size());
-  shape.material = material;
-  for (size_t t = 0; t + 2 < indices.size(); t += 3) {  // faces share no vertices: flat normals
-    glm::vec3 a = positions[indices[t]], b = positions[indices[t + 1]], c = positions[indices[t + 2]];
-    glm::vec3 n = glm::normalize(glm::cross(b - a, c - a));
-    for (glm::vec3 p : {a, b, c}) {
-      shape.indices.push_back(uint32_t(shape.positions.size()));
-      shape.positions.push_back(p);
-      shape.normals.push_back(n);
-      shape.texcoords0.push_back({p.x / 2.0f + 0.5f, p.y / 2.0f + 0.5f});
-    }
-  }
-  int index = int(s.shapes.size());
-  s.shapes.push_back(shape);
-  scene::Mesh mesh;
-  mesh.shapes = {index};
-  s.meshes.push_back(mesh);
-  scene::Node node;
-  node.mesh = int(s.meshes.size()) - 1;
-  node.matrix = world;
-  s.nodes.push_back(node);
-  s.roots.push_back(int(s.nodes.size()) - 1);
-  return index;
-}
-
-void boxTriangles(glm::vec3 lo, glm::vec3 hi, std::vector<glm::vec3>& positions, std::vector<uint32_t>& indices) {
-  uint32_t base = uint32_t(positions.size());
-  for (int i = 0; i < 8; ++i) positions.push_back({i & 1 ? hi.x : lo.x, i & 2 ? hi.y : lo.y, i & 4 ? hi.z : lo.z});
-  // Corner bits: x = 1, y = 2, z = 4; each face counter-clockwise seen from outside.
-  const uint32_t faces[6][4] = {{0, 4, 6, 2}, {1, 3, 7, 5}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 2, 3, 1}, {4, 5, 7, 6}};
-  for (const auto& f : faces) {
-    for (uint32_t k : {f[0], f[1], f[2], f[0], f[2], f[3]}) indices.push_back(base + k);
-  }
+  scene::addRootShape(s, std::move(shape), world);
+  return int(s.shapes.size()) - 1;
 }
 
 scene::Scene iorStepScene() {
@@ -211,7 +180,7 @@ scene::Scene iorStepScene() {
   s.materials = {glass, wall};
   std::vector<glm::vec3> p;
   std::vector<uint32_t> idx;
-  boxTriangles({-1, -1, -0.3f}, {1, 1, 0.3f}, p, idx);
+  scene::addBox({-1, -1, -0.3f}, {1, 1, 0.3f}, p, idx);
   addFlatShape(s, p, idx, 0, glm::rotate(glm::mat4(1.0f), 0.5f, glm::vec3(0.3f, 1.0f, 0.0f)));
   addFlatShape(s, {{-4, -4, -3}, {4, -4, -3}, {4, 4, -3}, {-4, 4, -3}}, {0, 1, 2, 0, 2, 3}, 1);
   scene::Light light;  // shines from behind the wall: the wall shows only its own light
@@ -225,13 +194,10 @@ scene::Scene iorStepScene() {
   return s;
 }
 
-render::CompositeFrame compositeOf(vk::Context& context, render::Renderer& renderer, const scene::Scene& s,
-                                   const scene::Pose& pose, const scene::View& view, uint32_t width, uint32_t height) {
-  render::RasterOptions options;
-  glm::dvec3 lo, hi;
-  scene::sceneBounds(s, pose, lo, hi);
-  render::fitDepthRange(view, lo, hi, options);
-  return render::renderComposite(context, renderer, pose, {width, height, view, {0.02f, 0.02f, 0.025f}, 8}, options);
+render::CompositeFrame compositeOf(render::Renderer& renderer, const scene::Pose& pose, const scene::View& view,
+                                   uint32_t width, uint32_t height) {
+  return render::renderComposite(renderer, pose, {width, height, view, glm::vec3(scene::kDefaultBackground), 8},
+                                 {});
 }
 
 void addGlassBox(scene::Scene& s, glm::vec3 lo, glm::vec3 hi, float ior) {
@@ -242,7 +208,7 @@ void addGlassBox(scene::Scene& s, glm::vec3 lo, glm::vec3 hi, float ior) {
   s.materials.push_back(glass);
   std::vector<glm::vec3> positions;
   std::vector<uint32_t> indices;
-  boxTriangles(lo, hi, positions, indices);
+  scene::addBox(lo, hi, positions, indices);
   addFlatShape(s, positions, indices, int(s.materials.size()) - 1, glm::mat4(1.0f));
 }
 

@@ -37,10 +37,10 @@ struct Comparison {
 
 Comparison compare(const io::Rgb8Image& got, const io::Rgb8Image& want);
 
-/// The viewport composite (and its whole trace) of `renderer`'s scene `s` at
-/// `pose` from `view`, the raster depth range fitted to the scene's bounds.
-render::CompositeFrame compositeOf(vk::Context& context, render::Renderer& renderer, const scene::Scene& s,
-                                   const scene::Pose& pose, const scene::View& view, uint32_t width, uint32_t height);
+/// The viewport composite (and its whole trace) of `renderer`'s scene at
+/// `pose` from `view`.
+render::CompositeFrame compositeOf(render::Renderer& renderer, const scene::Pose& pose, const scene::View& view,
+                                   uint32_t width, uint32_t height);
 
 /// The procedural eye with the cornea's index of refraction set.
 scene::Scene eyeWith(float ior);
@@ -57,10 +57,8 @@ scene::Scene iorStepScene();
 /// under a root node of transform `world`; returns the shape's index.
 int addFlatShape(scene::Scene& s, const std::vector<glm::vec3>& positions, const std::vector<uint32_t>& indices,
                  int material, const glm::mat4& world = glm::mat4(1.0f));
-/// An axis-aligned box's 12 triangles, wound to face out.
 /// A closed box of glass (transmission 1, `ior`) from `lo` to `hi`, flat faces.
 void addGlassBox(scene::Scene& s, glm::vec3 lo, glm::vec3 hi, float ior);
-void boxTriangles(glm::vec3 lo, glm::vec3 hi, std::vector<glm::vec3>& positions, std::vector<uint32_t>& indices);
 /// A model of ../shared/assets, its iridescence ignored.
 scene::Scene loadModel(const std::string& relative);
 

@@ -106,8 +106,8 @@ TEST_P(Golden, GpuTraceMatchesTheReferenceGolden) {
   ASSERT_EQ(golden.height, c.height);
 
   render::Renderer renderer(context(), s, pose);
-  render::FrameSettings settings{c.width, c.height, view, {0.02f, 0.02f, 0.025f}, gpu::kDefaultMaxInterfaces};
-  render::RenderedFrame frame = render::renderFrame(context(), renderer, pose, settings);
+  render::FrameSettings settings{c.width, c.height, view, glm::vec3(scene::kDefaultBackground), gpu::kDefaultMaxInterfaces};
+  render::RenderedFrame frame = render::renderFrame(renderer, pose, settings);
   io::Rgb8Image gpu = io::toSrgb8({c.width, c.height, frame.rgba});
   Comparison result = compare(gpu, golden);
   double share = double(result.withinOne) / double(result.pixels);
@@ -150,7 +150,7 @@ TEST_F(GpuTest, EyeWithIorOneEqualsTheEyeWithoutItsTransmissiveFaces) {
     scene::Pose pose = scene::evaluate(s, 0.0);
     scene::View view = scene::resolveView(s, pose, {});
     render::Renderer renderer(context(), s, pose);
-    render::RenderedFrame frame = render::renderFrame(context(), renderer, pose, {192, 144, view, {0.02f, 0.02f, 0.025f}, 8});
+    render::RenderedFrame frame = render::renderFrame(renderer, pose, {192, 144, view, glm::vec3(scene::kDefaultBackground), 8});
     return io::toSrgb8({192, 144, frame.rgba});
   };
   Comparison result = compare(render(eyeWith(1.0f)), render(eyeWithoutCorneaTip()));

@@ -37,12 +37,9 @@ Shot draw(vk::Context& context, const scene::Scene& s, Method method, float offs
   scene::Pose pose = scene::evaluate(s, 0.0);
   scene::View view = scene::resolveView(s, pose, camera);
   render::Renderer renderer(context, s, pose);
-  render::FrameSettings settings{kWidth, kHeight, view, {0.02f, 0.02f, 0.025f}, gpu::kDefaultMaxInterfaces};
+  render::FrameSettings settings{kWidth, kHeight, view, glm::vec3(scene::kDefaultBackground), gpu::kDefaultMaxInterfaces};
   render::RasterOptions raster;
   raster.offsetStrength = offsetStrength;
-  glm::dvec3 lo, hi;
-  scene::sceneBounds(s, pose, lo, hi);
-  render::fitDepthRange(view, lo, hi, raster);
   render::FrameRequest request;
   request.pose = &pose;
   request.views.push_back(render::methodView(method, settings, raster));
@@ -175,7 +172,7 @@ TEST(DriverRt, DrawsTheTracesPictureWithTheSameFirstHits) {
   scene::Scene eye = eyeWith(1.376f);
   scene::Pose pose = scene::evaluate(eye, 1.5);
   scene::View view = scene::resolveView(eye, pose, {});
-  render::FrameSettings settings{kWidth, kHeight, view, {0.02f, 0.02f, 0.025f}, gpu::kDefaultMaxInterfaces};
+  render::FrameSettings settings{kWidth, kHeight, view, glm::vec3(scene::kDefaultBackground), gpu::kDefaultMaxInterfaces};
   std::vector<render::ViewPixels> pixels;
   for (Method m : {Method::Trace, Method::DriverRt}) {
     render::Renderer renderer(*context, eye, pose);

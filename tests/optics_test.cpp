@@ -9,6 +9,7 @@
 #include "ref/reference_tracer.h"
 #include "render/renderer.h"
 #include "scene/evaluate.h"
+#include "scene/scene_builder.h"
 #include "scene/view.h"
 
 #include <gtest/gtest.h>
@@ -60,7 +61,7 @@ scene::Scene slabScene(scene::Material glass) {
   s.materials = {glass};
   std::vector<glm::vec3> p;
   std::vector<uint32_t> idx;
-  boxTriangles({-50, -50, -1}, {50, 50, 1}, p, idx);
+  scene::addBox({-50, -50, -1}, {50, 50, 1}, p, idx);
   addFlatShape(s, p, idx, 0);
   addBackLight(s);
   return s;
@@ -89,7 +90,7 @@ Traced traceRays(vk::Context& context, const scene::Scene& s, const std::vector<
   render::FrameSettings settings{width, 1, view, background, gpu::kDefaultMaxInterfaces};
   settings.rays = rays;
   settings.optics = optics;
-  render::RenderedFrame frame = render::renderFrame(context, renderer, pose, settings);
+  render::RenderedFrame frame = render::renderFrame(renderer, pose, settings);
   ref::ReferenceSettings reference;
   reference.width = width;
   reference.height = 1;
@@ -214,7 +215,7 @@ TEST_F(Optics, DispersionBendsEachChannelBySnellsLawWithItsOwnIor) {
   s.materials = {glass, floor};
   std::vector<glm::vec3> p;
   std::vector<uint32_t> idx;
-  boxTriangles({-5, -1, -5}, {5, 1, 5}, p, idx);
+  scene::addBox({-5, -1, -5}, {5, 1, 5}, p, idx);
   addFlatShape(s, p, idx, 0);
   // The floor at y = 0, facing up, texture u from x.
   addFlatShape(s, {{-1, 0, 1}, {1, 0, 1}, {1, 0, -1}, {-1, 0, -1}}, {0, 1, 2, 0, 2, 3}, 1);
@@ -257,12 +258,12 @@ TEST_F(Optics, ALowerPriorityMediumInsideAHigherOneDoesNotBend) {
     s.materials = {outer, dense};
     std::vector<glm::vec3> p;
     std::vector<uint32_t> idx;
-    boxTriangles({-2, -2, -2}, {2, 2, 2}, p, idx);
+    scene::addBox({-2, -2, -2}, {2, 2, 2}, p, idx);
     addFlatShape(s, p, idx, 0);
     if (inner) {
       std::vector<glm::vec3> q;
       std::vector<uint32_t> qi;
-      boxTriangles({-1, -1, -1}, {1, 1, 1}, q, qi);
+      scene::addBox({-1, -1, -1}, {1, 1, 1}, q, qi);
       addFlatShape(s, q, qi, 1);
     }
     addBackLight(s);
@@ -295,9 +296,9 @@ TEST_F(Optics, EqualPrioritiesHandOverBetweenMediaAtTheirOwnIors) {
   s.materials = {glassOf(1.5f), glassOf(1.5f)};
   std::vector<glm::vec3> p, q;
   std::vector<uint32_t> idx, qi;
-  boxTriangles({-2, -2, -2}, {2, 2, 2}, p, idx);
+  scene::addBox({-2, -2, -2}, {2, 2, 2}, p, idx);
   addFlatShape(s, p, idx, 0);
-  boxTriangles({-1, -1, -1}, {1, 1, 1}, q, qi);
+  scene::addBox({-1, -1, -1}, {1, 1, 1}, q, qi);
   addFlatShape(s, q, qi, 1);
   addBackLight(s);
   scene::Optics optics;

@@ -181,7 +181,7 @@ TEST_F(GpuTest, TheTraceReportsWhereRefractedRaysLandInTextureSpace) {
   const uint32_t width = 128, height = 96;
   render::Renderer renderer(context(), s, pose);
   render::RenderedFrame frame =
-      render::renderFrame(context(), renderer, pose, {width, height, view, {0.02f, 0.02f, 0.025f}, 8}, true);
+      render::renderFrame(renderer, pose, {width, height, view, glm::vec3(scene::kDefaultBackground), 8}, true);
   ref::ReferenceSettings settings;
   settings.width = width;
   settings.height = height;

@@ -75,7 +75,7 @@ TEST_F(GpuTest, ACorruptedBvhEndsEveryRayWithinTheVisitBudget) {
   scene::ViewRequest request;
   request.lookAt = scene::LookAt{{0.0, 0.3, 4.0}, {0.0, 0.0, 0.0}, {0.0, 1.0, 0.0}};
   settings.view = scene::resolveView(s, pose, request);
-  render::RenderedFrame clean = render::renderFrame(context(), renderer, pose, settings, true);  // builds the trees
+  render::RenderedFrame clean = render::renderFrame(renderer, pose, settings, true);  // builds the trees
   uint32_t cleanMost = 0;
   for (const gpu::TraceAov& a : clean.aov) cleanMost = std::max(cleanMost, a.nodeVisits);
 
@@ -98,7 +98,7 @@ TEST_F(GpuTest, ACorruptedBvhEndsEveryRayWithinTheVisitBudget) {
   vk::upload(context(), renderer.blas()->nodes, tree.nodes.data(), tree.nodes.size() * sizeof(gpu::BvhNode));
   renderer.invalidateViews();  // nothing the renderer knows of changed
 
-  render::RenderedFrame frame = render::renderFrame(context(), renderer, pose, settings, true);
+  render::RenderedFrame frame = render::renderFrame(renderer, pose, settings, true);
   uint32_t most = 0;
   for (const gpu::TraceAov& a : frame.aov) {
     // Each segment stops at the budget, its top and bottom levels together.

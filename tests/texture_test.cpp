@@ -80,7 +80,7 @@ TEST_F(GpuTest, TexturesLargerTogetherThanOneStorageBufferRenderAsTheReferenceDo
   scene::View view = scene::resolveView(s, pose, request);
   const uint32_t width = 256, height = 32;
   render::Renderer renderer(context(), s, pose);
-  render::RenderedFrame frame = render::renderFrame(context(), renderer, pose, {width, height, view, {0.02f, 0.02f, 0.025f}, 8});
+  render::RenderedFrame frame = render::renderFrame(renderer, pose, {width, height, view, glm::vec3(scene::kDefaultBackground), 8});
   Comparison result = compare(io::toSrgb8({width, height, frame.rgba}), referenceImage(s, pose, view, width, height));
   std::printf("%u textures, %.0f MiB: %zu of %zu pixels within 1/255, max difference %d/255\n", count,
               double(bytes) / 1048576.0, result.withinOne, result.pixels, result.maxDifference);
@@ -236,12 +236,12 @@ TEST_F(GpuTest, ACheckerboardFloorBehindGlassDoesNotShimmer) {
   // The traced floor seen through the window, against the raster pass's
   // mipmapped floor with no window, and the same floor read at level 0.
   FloorShot behind = checkerFloor(true), open = checkerFloor(false);
-  render::FrameSettings settings{kFloorWidth, kFloorHeight, behind.view, {0.02f, 0.02f, 0.025f}, 8};
+  render::FrameSettings settings{kFloorWidth, kFloorHeight, behind.view, glm::vec3(scene::kDefaultBackground), 8};
   render::Renderer tracer(context(), behind.scene, behind.pose);
-  render::RenderedFrame traced = render::renderFrame(context(), tracer, behind.pose, settings);
+  render::RenderedFrame traced = render::renderFrame(tracer, behind.pose, settings);
 
   render::Renderer raster(context(), open.scene, open.pose);
-  render::CompositeFrame drawn = compositeOf(context(), raster, open.scene, open.pose, open.view, kFloorWidth, kFloorHeight);
+  render::CompositeFrame drawn = compositeOf(raster, open.pose, open.view, kFloorWidth, kFloorHeight);
 
   ref::ReferenceSettings unfiltered;
   unfiltered.width = kFloorWidth;
@@ -297,7 +297,7 @@ TEST_F(GpuTest, TextureTransformsAndTheSecondUvSetReadAsTheReferenceReadsThem) {
     scene::View view = scene::resolveView(s, pose, request);
     const uint32_t width = 96, height = 72;
     render::Renderer renderer(context(), s, pose);
-    render::CompositeFrame frame = compositeOf(context(), renderer, s, pose, view, width, height);
+    render::CompositeFrame frame = compositeOf(renderer, pose, view, width, height);
     io::Rgb8Image want = referenceImage(s, pose, view, width, height);
     // The raster pass draws the open quad; the trace, the quad behind glass.
     Comparison composite = compare(io::toSrgb8({width, height, frame.rgba}), want);
@@ -330,7 +330,7 @@ TEST_F(GpuTest, EverySampleModelRendersItsTexturesAsTheReferenceDoes) {
       scene::View view = scene::resolveView(s, pose, {});
       const uint32_t width = 80, height = 60;
       render::Renderer renderer(context(), s, pose);
-      render::CompositeFrame frame = compositeOf(context(), renderer, s, pose, view, width, height);
+      render::CompositeFrame frame = compositeOf(renderer, pose, view, width, height);
       Comparison result = compare(io::toSrgb8({width, height, frame.rgba}), referenceImage(s, pose, view, width, height));
       std::printf("%s: %zu of %zu pixels within 1/255, max difference %d/255\n", entry.path().filename().c_str(),
                   result.withinOne, result.pixels, result.maxDifference);

@@ -6,6 +6,7 @@
 
 #include "io/image_file.h"
 #include "io/json.h"
+#include "io/version.h"
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>

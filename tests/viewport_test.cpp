@@ -60,11 +60,8 @@ struct Composite {
   explicit Composite(vk::Context& context, const ViewportCase& c, render::RasterOptions options = {})
       : scene(c.makeScene()), pose(scene::evaluate(scene, 0.0)), view(scene::resolveView(scene, pose, c.view)) {
     render::Renderer renderer(context, scene, pose);
-    glm::dvec3 lo, hi;
-    scene::sceneBounds(scene, pose, lo, hi);
-    render::fitDepthRange(view, lo, hi, options);
-    render::FrameSettings settings{c.width, c.height, view, {0.02f, 0.02f, 0.025f}, gpu::kDefaultMaxInterfaces};
-    frame = render::renderComposite(context, renderer, pose, settings, options, true);
+    render::FrameSettings settings{c.width, c.height, view, glm::vec3(scene::kDefaultBackground), gpu::kDefaultMaxInterfaces};
+    frame = render::renderComposite(renderer, pose, settings, options, true);
   }
   /// Whether the trace's first hit at pixel i is a transmissive face.
   bool transmissive(size_t i) const {
@@ -197,7 +194,7 @@ TEST_F(GpuTest, FilmBackPanAndZoomMoveTraceAndRasterTogether) {
   view.halfHeight /= 1.6;
   const uint32_t w = 192, h = 144;
   render::Renderer renderer(context(), s, pose);
-  render::CompositeFrame frame = compositeOf(context(), renderer, s, pose, view, w, h);
+  render::CompositeFrame frame = compositeOf(renderer, pose, view, w, h);
   io::Rgb8Image reference = referenceImage(s, pose, view, w, h);
   Comparison composite = compare(io::toSrgb8({w, h, frame.rgba}), reference);
   Comparison trace = compare(io::toSrgb8({w, h, frame.trace.rgba}), reference);

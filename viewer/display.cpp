@@ -12,9 +12,15 @@
 #include <imgui.h>
 
 #include <algorithm>
+#include <cstddef>
 #include <cstdio>
 
 namespace snell::viewer {
+
+// present.comp reads the push constants with std430 rules (the viewer's own
+// layout, so its check lives here rather than in render/layout_checks.cpp).
+static_assert(sizeof(gpu::PresentPush) == 48 && offsetof(gpu::PresentPush, gate) == 16 &&
+              offsetof(gpu::PresentPush, flags) == 32);
 
 // refraction-map's maps, baked by the trace at the pose and views of now
 // for viewports that have none of their size (or all, after B). The frames in
@@ -40,8 +46,8 @@ void Viewer::bakeRefractionMaps() {
   if (maps_.size() < viewports_.size()) maps_.resize(viewports_.size());
   for (size_t i : due) {
     const Viewport& vp = viewports_[i];
-    render::FrameSettings settings{vp.width, vp.height, viewOf(vp), {0.02f, 0.02f, 0.025f}, gpu::kDefaultMaxInterfaces};
-    bake::RefractionBake baked = bake::bakeRefraction(*context_, *renderer_, pose_, settings);
+    render::FrameSettings settings{vp.width, vp.height, viewOf(vp), glm::vec3(scene::kDefaultBackground), gpu::kDefaultMaxInterfaces};
+    bake::RefractionBake baked = bake::bakeRefraction(*renderer_, pose_, settings);
     maps_[i] = std::make_unique<render::RefractionMapBuffer>(bake::uploadRefractionMap(*context_, baked));
     char when[32];
     std::snprintf(when, sizeof when, "%.2f s", pose_.time);
@@ -57,10 +63,9 @@ render::FrameRequest Viewer::frameRequest(std::optional<uint32_t> swapImage, boo
   request.pose = &pose_;
   for (const Viewport& vp : viewports_) {
     if (!vp.width) continue;
-    render::FrameSettings settings{vp.width, vp.height, viewOf(vp), {0.02f, 0.02f, 0.025f}, gpu::kDefaultMaxInterfaces};
+    render::FrameSettings settings{vp.width, vp.height, viewOf(vp), glm::vec3(scene::kDefaultBackground), gpu::kDefaultMaxInterfaces};
     render::RasterOptions raster;
     raster.wireframe = toggles_.wireframe;
-    render::fitDepthRange(settings.view, boundsLo_, boundsHi_, raster);
     size_t index = size_t(&vp - viewports_.data());
     if (index < maps_.size()) raster.refractionMap = maps_[index].get();
     render::ViewRequest view =

@@ -6,6 +6,7 @@
 #include "cli/options.h"
 #include "io/image_file.h"
 #include "io/json.h"
+#include "io/version.h"
 #include "render/method.h"
 
 #include <cmath>
@@ -66,9 +67,9 @@ int main(int argc, char** argv) {
   for (const render::MethodInfo& m : render::methods()) methods.emplace_back(m.name);
   app.add_option_function<std::string>(
          "--method", [&o](const std::string& name) { o.method = *render::methodFromName(name); },
-         "how glass is drawn (default masked); refraction-map is baked\n"
-         "when picked and B bakes it again; the overlay's drop-down\n"
-         "switches it")
+         "how glass is drawn (default masked):\n" + render::methodHelp() +
+             "refraction-map is baked when picked and B bakes it again;\n"
+             "the overlay's drop-down switches it")
       ->type_name("M")
       ->check(CLI::IsMember(methods));
   app.add_flag_callback("--no-vsync", [&o] { o.vsync = false; }, "present as fast as the GPU renders");
@@ -103,7 +104,12 @@ int main(int argc, char** argv) {
     // Before any window opens or frame is drawn: files that could not be written at the end.
     if (!o.screenshot.empty()) io::checkWritable(o.screenshot);
     if (!o.json.empty()) io::checkWritable(o.json);
-    return viewer::runViewer(o);
+    o.quiet = cli::quiet();
+    try {
+      return viewer::runViewer(o);
+    } catch (const viewer::OptionError& e) {
+      throw cli::UsageError{e.message};
+    }
   };
   return cli::runCommandLine(app, argc, argv, run);
 }

@@ -4,7 +4,6 @@
 // and the reports together. The other parts are listed in viewer_state.h.
 #include "viewer_state.h"
 
-#include "cli/options.h"
 #include "io/environment.h"
 #include "scene/gltf_loader.h"
 #include "scene/procedural_eye.h"
@@ -52,12 +51,12 @@ Viewer::Viewer(const ViewerOptions& options) : options_(options) {
   } else {
     initial = std::make_unique<scene::Scene>(scene::loadGltf(options.scene, options.load));
   }
-  if (!cli::quiet()) {
+  if (!options.quiet) {
     for (const std::string& w : initial->warnings) std::fprintf(stderr, "snell-view: note: %s\n", w.c_str());
   }
   if (options.camera >= 0 && size_t(options.camera) >= initial->cameras.size()) {
-    throw cli::UsageError{"--camera " + std::to_string(options.camera) + ": the scene has " +
-                          std::to_string(initial->cameras.size()) + " camera(s)"};
+    throw OptionError{"--camera " + std::to_string(options.camera) + ": the scene has " +
+                      std::to_string(initial->cameras.size()) + " camera(s)"};
   }
 
   vk::ContextDesc desc = io::contextDescFromEnvironment();

@@ -28,11 +28,18 @@ struct ViewerOptions {
   int camera = -1;                 ///< glTF camera; -1: camera 0 if any, else the orbit rig framing the scene
   double time = 0.0;
   render::Method method = render::Method::Masked;  ///< how glass is drawn (render/method.h)
+  bool quiet = false;              ///< no load notes on standard error
+};
+
+/// An option the scene cannot honour (a --camera it lacks): main() reports it
+/// as bad usage, exit 2.
+struct OptionError {
+  std::string message;
 };
 
 /// Runs the viewer; returns the process exit code (non-zero when the
 /// validation layer reported anything). A --camera the scene lacks throws
-/// cli::UsageError; a scene that fails to load, std::runtime_error.
+/// OptionError; a scene that fails to load, std::runtime_error.
 int runViewer(const ViewerOptions& options);
 
 /// The mouse, trackpad and key bindings, as --help and the overlay list them

@@ -6,7 +6,7 @@
 layout(local_size_x_id = kScanSpecWorkgroupSize) in;
 layout(constant_id = kScanSpecItemsPerThread) const uint ITEMS_PER_THREAD = 8;
 layout(constant_id = kScanSpecMaxSubgroups) const uint MAX_SUBGROUPS = 32;
-#include "common/workgroup.glsl"
+#include "../common/workgroup.glsl"
 
 layout(push_constant) uniform Push { ScanPush pc; };
 layout(std430, binding = kScanBindingData) readonly buffer Data { uint data[]; };

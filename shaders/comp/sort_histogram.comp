@@ -10,7 +10,7 @@ layout(local_size_x_id = kSortSpecWorkgroupSize) in;
 layout(constant_id = kSortSpecKeysPerThread) const uint KEYS_PER_THREAD = 8;
 layout(constant_id = kSortSpecMaxSubgroups) const uint MAX_SUBGROUPS = 32;
 layout(constant_id = kSortSpecKeyWords) const uint KEY_WORDS = 1;
-#include "common/workgroup.glsl"
+#include "../common/workgroup.glsl"
 
 layout(push_constant) uniform Push { SortPush pc; };
 layout(std430, binding = kSortBindingKeysIn) readonly buffer KeysIn { uint keysIn[]; };

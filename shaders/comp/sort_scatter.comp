@@ -17,7 +17,7 @@ layout(local_size_x_id = kSortSpecWorkgroupSize) in;
 layout(constant_id = kSortSpecKeysPerThread) const uint KEYS_PER_THREAD = 8;
 layout(constant_id = kSortSpecMaxSubgroups) const uint MAX_SUBGROUPS = 32;
 layout(constant_id = kSortSpecKeyWords) const uint KEY_WORDS = 1;
-#include "common/workgroup.glsl"
+#include "../common/workgroup.glsl"
 
 layout(push_constant) uniform Push { SortPush pc; };
 // 64-bit keys are also read and written as uvec2 through a second view of the

@@ -29,7 +29,7 @@ layout(std430, binding = kTraceBindingPixels) readonly buffer Pixels {
 // Hit, the surface at a hit, shading and the path of one pixel, shared with
 // the driver's ray tracing pipeline (src/peer/driver_tracer.h); this shader
 // brings traceClosest, its own traversal.
-#include "common/path.glsl"
+#include "../common/path.glsl"
 
 const uint kStackSize = 64u;
 

@@ -1,7 +1,7 @@
 // The scene binding set: what every pass that reads the scene binds, at the
 // same slots everywhere (the trace, the driver's ray tracing, the raster
 // pass), and the layouts of its records. shaders/common/scene.glsl declares
-// these buffers and reads vertices from them; SceneGpu::bindings() (with the
+// these buffers and reads vertices from them; SceneGpu::appendBindings() (with the
 // renderer's instances and lights) fills them. A pass's own bindings start at
 // kSceneBindingCount.
 #ifndef SNELL_SCENE_H

@@ -437,8 +437,6 @@ struct Renderer::Impl {
   scene::Pose pose;
   std::map<size_t, glm::dmat4> transforms;  ///< setTransform's, kept over setTime
   std::optional<KeptVertices> kept;
-  /// Per mesh of a host scene: the box its vertices are in (kept: measured at markDirty).
-  std::vector<std::pair<glm::vec3, glm::vec3>> bounds;
   std::unique_ptr<render::Renderer> renderer;
   /// The refraction-map method's map, baked at the first frame that draws it.
   render::RefractionMapBuffer map;
@@ -457,9 +455,6 @@ struct Renderer::Impl {
     o.framesInFlight = options.framesInFlight;
     o.passTimes = options.passTimes;
     o.host = scene.host;
-    for (const scene::Shape& shape : scene.scene.shapes) {
-      if (shape.host) bounds.emplace_back(shape.host->lo, shape.host->hi);
-    }
     if (scene.keptVertices > 0) {
       KeptVertices& k = kept.emplace();
       k.count = scene.keptVertices;
@@ -535,7 +530,6 @@ struct Renderer::Impl {
     method = render::methodName(m);
     render::RasterOptions raster;
     if (viewport && view.transparentBackground) settings.background = glm::vec3(0.0f), settings.backgroundAlpha = 0.0f;
-    if (viewport) fitDepth(settings.view, raster);
     if (m == render::Method::RefractionMap) {
       bakeMap(settings);
       raster.refractionMap = &map;
@@ -555,29 +549,8 @@ struct Renderer::Impl {
     }
     render::FrameSettings traced = settings;
     traced.backgroundAlpha = 1.0f;
-    map = bake::uploadRefractionMap(context, bake::bakeRefraction(context, *renderer, pose, traced));
+    map = bake::uploadRefractionMap(context, bake::bakeRefraction(*renderer, pose, traced));
     renderer->invalidateViews();
-  }
-
-  // Near and far planes around the scene, every frame, so cheaply: a glTF
-  // scene's rest boxes as its pose moves them (not its deformed vertices), a
-  // host scene's boxes (promised, or measured where snell keeps the vertices).
-  void fitDepth(const scene::View& view, render::RasterOptions& raster) const {
-    glm::dvec3 lo(INFINITY), hi(-INFINITY);
-    if (bounds.empty()) {
-      scene::approximateBounds(scene.scene, pose, lo, hi);
-    } else {
-      for (const scene::DrawItem& item : pose.items) {
-        const auto& [blo, bhi] = bounds[size_t(item.shape)];
-        if (!(blo.x <= bhi.x)) return;  // a mesh promised no box: keep the wide default planes
-        for (int corner = 0; corner < 8; ++corner) {
-          glm::dvec3 p(corner & 1 ? bhi.x : blo.x, corner & 2 ? bhi.y : blo.y, corner & 4 ? bhi.z : blo.z);
-          p = glm::dvec3(item.world * glm::dvec4(p, 1.0));
-          lo = glm::min(lo, p), hi = glm::max(hi, p);
-        }
-      }
-    }
-    if (lo.x <= hi.x) render::fitDepthRange(view, lo, hi, raster);
   }
 
   void note(const render::FrameResult& result) {
@@ -649,7 +622,7 @@ void Renderer::markDirty(int mesh) {
     impl_->kept->pending.insert(mesh);
     const scene::HostVertices& h = *impl_->scene.scene.shapes[size_t(mesh)].host;
     const auto* xyz = reinterpret_cast<const float*>(impl_->kept->staging.mapped().data());
-    auto& [lo, hi] = impl_->bounds[size_t(mesh)];
+    glm::vec3 lo, hi;
     boundsOf(xyz + size_t(h.first) * 3, h.count, lo, hi);
     impl_->renderer->setShapeBounds(mesh, glm::dvec3(lo), glm::dvec3(hi));
   });

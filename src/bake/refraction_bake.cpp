@@ -75,9 +75,9 @@ RefractionBake bakeFromAov(uint32_t width, uint32_t height, const std::vector<gp
   return bake;
 }
 
-RefractionBake bakeRefraction(vk::Context& context, render::Renderer& renderer, const scene::Pose& pose,
+RefractionBake bakeRefraction(render::Renderer& renderer, const scene::Pose& pose,
                               const render::FrameSettings& settings) {
-  render::RenderedFrame frame = render::renderFrame(context, renderer, pose, settings, true);
+  render::RenderedFrame frame = render::renderFrame(renderer, pose, settings, true);
   return bakeFromAov(frame.width, frame.height, frame.aov, renderer.scene());
 }
 
@@ -296,7 +296,7 @@ DecodedMap bakeThroughGradient(vk::Context& context, const scene::Scene& scene, 
   render::FrameSettings plain = settings;
   plain.background = glm::vec3(0.0f);
   plain.optics.fresnel = false;
-  render::RenderedFrame frame = render::renderFrame(context, renderer, gradientPose, plain);
+  render::RenderedFrame frame = render::renderFrame(renderer, gradientPose, plain);
   DecodedMap map;
   map.width = frame.width;
   map.height = frame.height;

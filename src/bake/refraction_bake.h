@@ -54,7 +54,7 @@ RefractionBake bakeFromAov(uint32_t width, uint32_t height, const std::vector<gp
                            const scene::Scene& scene);
 
 /// Traces every pixel of `settings` at `pose` and bakes it (waits for the GPU).
-RefractionBake bakeRefraction(vk::Context& context, render::Renderer& renderer, const scene::Pose& pose,
+RefractionBake bakeRefraction(render::Renderer& renderer, const scene::Pose& pose,
                               const render::FrameSettings& settings);
 
 /// One line for a user: "N glass pixels; L land on 'iris' (its texture 'x',

@@ -2,6 +2,7 @@
 // Sky paper's "refraction reference map" without a DCC in the loop.
 #include "cli/commands.h"
 
+#include "bake/map_file.h"
 #include "bake/refraction_bake.h"
 #include "io/image_file.h"
 #include "render/renderer.h"
@@ -41,7 +42,7 @@ int runBake(const Options& o) {
   std::string summary;
   {
     render::Renderer renderer(*context, scene, pose);
-    bake::RefractionBake baked = bake::bakeRefraction(*context, renderer, pose, settings);
+    bake::RefractionBake baked = bake::bakeRefraction(renderer, pose, settings);
     if (material) baked.behindMaterial = *material;
     summary = bake::describe(baked, scene);
     if (baked.count(bake::Coverage::Lands) == 0) {
@@ -51,7 +52,7 @@ int runBake(const Options& o) {
     map = o.dcc ? bake::bakeThroughGradient(*context, scene, pose, settings, baked, o.gradientSize, true)
                 : bake::storedMap(baked, scene);
   }
-  io::writeMapFile(o.output, bake::encodeMap(map, *o.encoding), *o.encoding);
+  bake::writeMapFile(o.output, bake::encodeMap(map, *o.encoding), *o.encoding);
   double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   std::printf("wrote %s: %ux%u %s map (%s route), %s at %g s, %s, %.2f s\n  %s\n", o.output.c_str(), o.shot.width,
               o.shot.height, bake::encodingName(*o.encoding), o.dcc ? "dcc" : "direct", view.description.c_str(),

@@ -40,7 +40,7 @@ void measure(vk::Context& context, const scene::Scene& scene, const std::string&
   render::Renderer renderer(context, scene, pose);
   // One small frame deforms the shapes into the buffers the trees are built from.
   render::FrameSettings settings{8, 8, scene::resolveView(scene, pose, {}), {}, gpu::kDefaultMaxInterfaces};
-  render::renderFrame(context, renderer, pose, settings);
+  render::renderFrame(renderer, pose, settings);
   const render::SceneGpu& gpuScene = renderer.sceneGpu();
   std::vector<uint32_t> sizes;
   for (const render::GeometryRange& g : gpuScene.geometries) sizes.push_back(g.triangleCount);

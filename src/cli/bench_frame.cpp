@@ -12,6 +12,7 @@
 #include "scene/procedural_eye.h"
 #include "scene/scene_summary.h"
 #include "scene/view.h"
+#include "vk/pass_names.h"
 
 #include <algorithm>
 #include <chrono>
@@ -37,7 +38,7 @@ struct Options {
 
 // The refraction work these tables quote: the refraction passes, and the
 // deform that trees and trace both wait for.
-bool refractionPass(const std::string& name) { return name == "deform" || render::isRefractionPass(name); }
+bool refractionPass(const std::string& name) { return name == pass::kDeform || render::isRefractionPass(name); }
 
 // The view turned `degrees` about the vertical axis through `centre`: an orbit.
 scene::View orbited(scene::View v, const glm::dvec3& centre, double degrees) {
@@ -141,11 +142,11 @@ int runFrame(const Options& o) {
               static_cast<unsigned long long>(summary.triangles), width, height, mode.c_str());
 
   double duration = std::max(scene::animationDuration(scene), 1e-3);
-  scene::Pose layout = scene::evaluate(scene, 0.0);
+  scene::Pose firstPose = scene::evaluate(scene, 0.0);
   glm::dvec3 lo, hi;
-  scene::approximateBounds(scene, layout, lo, hi);
+  scene::approximateBounds(scene, firstPose, lo, hi);
   const glm::dvec3 centre = lo.x <= hi.x ? 0.5 * (lo + hi) : glm::dvec3(0.0);
-  render::Renderer renderer(*context, scene, layout);
+  render::Renderer renderer(*context, scene, firstPose);
   std::map<std::string, std::vector<double>> times;
   std::vector<std::string> order;
   std::vector<double> totals, refractionTotals, walls;
@@ -160,14 +161,11 @@ int runFrame(const Options& o) {
     scene::View camera = scene::resolveView(scene, pose, {});
     // A swing of 30 degrees either way, not a full circle: the side that faces the camera stays in view.
     if (o.orbit) camera = orbited(camera, centre, 30.0 * std::sin(double(f) * 2.0 * 3.14159265358979 / 240.0));
-    view.settings = {width, height, camera, {0.02f, 0.02f, 0.025f}, gpu::kDefaultMaxInterfaces};
+    view.settings = {width, height, camera, glm::vec3(scene::kDefaultBackground), gpu::kDefaultMaxInterfaces};
     if (viewport) {
       view.output = render::ViewOutput::Composite;
       view.masked = masked;
       view.raster.refraction = refraction;
-      glm::dvec3 lo, hi;
-      scene::approximateBounds(scene, pose, lo, hi);
-      render::fitDepthRange(view.settings.view, lo, hi, view.raster);
     }
     render::FrameRequest request;
     request.pose = &pose;
@@ -189,10 +187,10 @@ int runFrame(const Options& o) {
     bool measured = f >= warmup;
     double total = 0, refractionTotal = 0;
     for (const vk::PassTime& p : result.passes) {
-      if (!measured && !(f == 0 && p.name == "blas build")) continue;
+      if (!measured && !(f == 0 && p.name == pass::kBlasBuild)) continue;
       if (!times.count(p.name)) order.push_back(p.name);
       times[p.name].push_back(p.milliseconds);
-      if (p.name == "blas build" && f == 0) continue;
+      if (p.name == pass::kBlasBuild && f == 0) continue;
       total += p.milliseconds;
       if (refractionPass(p.name)) refractionTotal += p.milliseconds;
     }

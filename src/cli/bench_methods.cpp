@@ -4,6 +4,7 @@
 #include "cli/commands.h"
 
 #include "bake/refraction_bake.h"
+#include "io/image_compare.h"
 #include "io/image_file.h"
 #include "io/json.h"
 #include "io/progress.h"
@@ -15,6 +16,7 @@
 #include "scene/procedural_eye.h"
 #include "scene/view.h"
 #include "stress/stress.h"
+#include "vk/pass_names.h"
 
 #include <glm/gtc/constants.hpp>
 
@@ -47,13 +49,7 @@ struct Options {
 // Times of each method come from this many passes over the sequence.
 constexpr uint32_t kTimingRounds = 3;
 
-struct Error {
-  double sumSquares = 0;  ///< of channel differences, in 1/255 units
-  uint64_t channels = 0, pixels = 0, over1 = 0, over8 = 0;
-  int maximum = 0;
-  double rmse() const { return channels ? std::sqrt(sumSquares / double(channels)) / 255.0 : 0.0; }
-  double share(uint64_t n) const { return pixels ? double(n) / double(pixels) : 0.0; }
-};
+using Error = io::ImageDifference;
 
 struct Frame {
   double time = 0;
@@ -88,27 +84,11 @@ struct MethodResult {
 
 // Adds a frame's differences to the row's errors; returns the frame's own glass error.
 Error accumulate(const io::Rgb8Image& got, const Frame& frame, Error& glass, Error& image, double& worstWithin1) {
-  Error frameError, frameGlass;
-  for (size_t i = 0; i < size_t(got.width) * got.height; ++i) {
-    int worst = 0;
-    double squares = 0;
-    for (int c = 0; c < 3; ++c) {
-      int d = std::abs(int(got.rgb[3 * i + c]) - int(frame.reference.rgb[3 * i + c]));
-      worst = std::max(worst, d);
-      squares += double(d) * d;
-    }
-    for (Error* e : {&image, &frameError, frame.transmissive[i] ? &glass : nullptr,
-                     frame.transmissive[i] ? &frameGlass : nullptr}) {
-      if (!e) continue;
-      e->sumSquares += squares;
-      e->channels += 3;
-      e->pixels += 1;
-      e->over1 += worst > 1;
-      e->over8 += worst > 8;
-      e->maximum = std::max(e->maximum, worst);
-    }
-  }
-  worstWithin1 = std::min(worstWithin1, 1.0 - frameError.share(frameError.over1));
+  Error frameImage = io::compareImages(got, frame.reference);
+  Error frameGlass = io::compareImages(got, frame.reference, &frame.transmissive);
+  image.add(frameImage);
+  glass.add(frameGlass);
+  worstWithin1 = std::min(worstWithin1, 1.0 - frameImage.share(frameImage.over1));
   return frameGlass;
 }
 
@@ -234,11 +214,7 @@ std::shared_ptr<const std::vector<Frame>> makeFrames(const scene::Scene& scene, 
     frame.time = duration * along;
     frame.pose = scene::evaluate(scene, frame.time);
     frame.view = orbitView(scene, frame.pose, start, glm::radians(80.0) * along);
-    // Fitted once here, so the timed loop does no work per triangle on the host.
-    glm::dvec3 lo, hi;
-    scene::sceneBounds(scene, frame.pose, lo, hi);
     frame.raster.offsetStrength = s.offsetStrength;
-    render::fitDepthRange(frame.view, lo, hi, frame.raster);
     if (!s.reference) continue;
     ref::ReferenceSettings settings;
     settings.width = s.width;
@@ -381,10 +357,10 @@ int runMethods(const Options& o) {
     if (results[m].info.method == render::Method::RefractionMap) {
       // Baked once, by the trace, at the first frame's pose and view; every frame after drifts from it.
       const Frame& first = results[m].frames->at(0);
-      render::FrameSettings settings{width, height, first.view, glm::vec3(0.02f, 0.02f, 0.025f), maxInterfaces};
+      render::FrameSettings settings{width, height, first.view, glm::vec3(scene::kDefaultBackground), maxInterfaces};
       settings.optics = results[m].optics;
       auto bakeStart = std::chrono::steady_clock::now();
-      bake::RefractionBake baked = bake::bakeRefraction(*context, *renderers[m], first.pose, settings);
+      bake::RefractionBake baked = bake::bakeRefraction(*renderers[m], first.pose, settings);
       results[m].map = std::make_shared<render::RefractionMapBuffer>(bake::uploadRefractionMap(*context, baked));
       results[m].bakeMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - bakeStart).count();
     }
@@ -394,7 +370,7 @@ int runMethods(const Options& o) {
   };
   auto request = [&](const MethodResult& row, uint32_t f, bool readback) {
     const Frame& frame = row.frames->at(f);
-    render::FrameSettings settings{width, height, frame.view, glm::vec3(0.02f, 0.02f, 0.025f), maxInterfaces};
+    render::FrameSettings settings{width, height, frame.view, glm::vec3(scene::kDefaultBackground), maxInterfaces};
     settings.optics = row.optics;
     render::RasterOptions raster = frame.raster;
     raster.refractionMap = row.map.get();
@@ -512,7 +488,7 @@ int runMethods(const Options& o) {
   if (optics) {
     // Each feature's price: the trace pass against the plain bend's, same frames, same run.
     auto traceMs = [](const MethodResult& r) {
-      auto it = r.passMs.find("trace");
+      auto it = r.passMs.find(pass::kTrace);
       return it == r.passMs.end() ? 0.0 : io::median(it->second);
     };
     double plain = traceMs(results.at(0));
@@ -554,7 +530,7 @@ int runMethods(const Options& o) {
       auto it = r.passMs.find(pass);
       return it == r.passMs.end() ? 0.0 : io::median(it->second);
     };
-    double ours = traceMs(*traced, "trace"), theirs = traceMs(*driver, "driver trace");
+    double ours = traceMs(*traced, pass::kTrace), theirs = traceMs(*driver, pass::kDriverTrace);
     std::printf("rays per second, trace against driver-rt on the same frames: %.3fx (trace %.4f ms, driver %.4f ms)\n",
                 ours > 0 ? theirs / ours : 0.0, ours, theirs);
   }
@@ -631,10 +607,11 @@ void addBenchMethods(CLI::App& bench, Runner& run) {
       "the largest difference, over the pixels whose first hit in the reference is\n"
       "transmissive, and over the whole image.\n"
       "\n"
-      "methods: trace, trace-1, masked, iris-plane, normal-offset, refraction-map\n"
-      "(a map baked by the trace at the first frame, read by every frame after: a\n"
-      "table shows its glass error against animation time beside the others'), none, and\n"
-      "driver-rt, the peer: the same rays and shading code with the hits found by\n"
+      "methods:\n" +
+      render::methodHelp() +
+      "refraction-map's map is baked by the trace at the first frame and read by every\n"
+      "frame after: a table shows its glass error against animation time beside the\n"
+      "others'. driver-rt, the peer, runs the same rays and shading code with the hits found by\n"
       "the driver's own ray tracing (VK_KHR_ray_tracing_pipeline), where the device\n"
       "has it (not lavapipe: reported unsupported). For it the table adds the share\n"
       "of pixels whose first hit (instance, triangle) agrees with trace's, and its\n"
@@ -666,11 +643,7 @@ void addBenchMethods(CLI::App& bench, Runner& run) {
                   "refractive faces a traced ray may cross (default 8, at most 1024)")
       ->type_name("N")
       ->check(CLI::Range(0u, 1024u));
-  sub->add_option("--offset-strength", o->offsetStrength, "normal-offset's displacement in image heights (0.02)")
-      ->type_name("S")
-      ->check([](const std::string& value) -> std::string {
-        return std::isfinite(std::strtof(value.c_str(), nullptr)) ? "" : "expects a finite number, got " + value;
-      });
+  addOffsetStrength(*sub, o->offsetStrength);
   // The procedural eye's own limits (scene::checkEyeOptions), named after these options.
   sub->add_option("--eye-resolution", o->eye.resolution, "segments of the procedural eye, 8-2048 (default 64)")
       ->type_name("N")

@@ -17,6 +17,7 @@
 #include "scene/procedural_eye.h"
 #include "scene/view.h"
 #include "vk/commands.h"
+#include "vk/pass_names.h"
 #include "vk/upload_arena.h"
 
 #include <algorithm>
@@ -105,30 +106,27 @@ std::vector<uint64_t> counts(const std::vector<double>& list) {
 
 // The refraction work these tables quote: the refraction passes, and the
 // deform that trees and trace both wait for.
-bool refractionPass(const std::string& name) { return name == "deform" || render::isRefractionPass(name); }
+bool refractionPass(const std::string& name) { return name == pass::kDeform || render::isRefractionPass(name); }
 
 CrowdRow measureCrowd(vk::Context& context, uint32_t characters, uint32_t width, uint32_t height, uint32_t frames) {
   scene::EyeOptions options;
   options.crowd = characters;
   scene::Scene scene = scene::makeEye(options);
   double duration = std::max(scene::animationDuration(scene), 1e-3);
-  scene::Pose layout = scene::evaluate(scene, 0.0);
-  render::Renderer renderer(context, scene, layout);
+  scene::Pose firstPose = scene::evaluate(scene, 0.0);
+  render::Renderer renderer(context, scene, firstPose);
   CrowdRow row;
   row.characters = characters;
-  for (const scene::DrawItem& item : layout.items) row.triangles += scene.shapes[size_t(item.shape)].triangleCount();
+  for (const scene::DrawItem& item : firstPose.items) row.triangles += scene.shapes[size_t(item.shape)].triangleCount();
   std::map<std::string, std::vector<double>> passes;
   std::vector<double> totals, refraction, pixels;
   const uint32_t warmup = 5;
   for (uint32_t f = 0; f < warmup + frames; ++f) {
     scene::Pose pose = scene::evaluate(scene, std::fmod(double(f) / 24.0, duration));
     render::ViewRequest view;
-    view.settings = {width, height, scene::resolveView(scene, pose, {}), {0.02f, 0.02f, 0.025f},
+    view.settings = {width, height, scene::resolveView(scene, pose, {}), glm::vec3(scene::kDefaultBackground),
                      gpu::kDefaultMaxInterfaces};
     view.output = render::ViewOutput::Composite;
-    glm::dvec3 lo, hi;
-    scene::approximateBounds(scene, pose, lo, hi);
-    render::fitDepthRange(view.settings.view, lo, hi, view.raster);
     render::FrameRequest request;
     request.pose = &pose;
     request.views = {view};
@@ -267,11 +265,11 @@ int runScale(const Options& o) {
   }
   for (uint64_t characters : crowds) {
     CrowdRow r = measureCrowd(*context, static_cast<uint32_t>(characters), width, height, frames);
-    auto pass = [&](const char* name) { return r.passMs.count(name) ? r.passMs.at(name) : 0.0; };
-    double trace = pass("trace");
+    auto passMs = [&](const char* name) { return r.passMs.count(name) ? r.passMs.at(name) : 0.0; };
+    double trace = passMs(pass::kTrace);
     std::printf("%6u %10llu %7.3f %7.3f %7.3f %7.3f %7.3f %7.3f %8.3f %8.3f %10.0f %7.2f %6.1f\n", r.characters,
-                static_cast<unsigned long long>(r.triangles), pass("deform"), pass("blas refit"), pass("tlas"),
-                pass("raster depth"), trace, pass("raster shading"), r.frameMs, r.refractionMs, r.pixelsTraced,
+                static_cast<unsigned long long>(r.triangles), passMs(pass::kDeform), passMs(pass::kBlasRefit), passMs(pass::kTlas),
+                passMs(pass::kRasterDepth), trace, passMs(pass::kRasterShading), r.frameMs, r.refractionMs, r.pixelsTraced,
                 trace > 0 ? r.pixelsTraced / trace / 1e6 : 0.0, r.treeBytesPerTriangle);
     std::fflush(stdout);
     crowdRows.push_back(std::move(r));

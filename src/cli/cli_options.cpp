@@ -246,6 +246,12 @@ CLI::Option* addTextureBudget(CLI::App& app, uint64_t& bytes) {
       ->check(CLI::Range(uint64_t(1), uint64_t(1) << 20));
 }
 
+CLI::Option* addOffsetStrength(CLI::App& app, float& strength) {
+  char text[96];
+  std::snprintf(text, sizeof text, "normal-offset's displacement in image heights (%g)", double(strength));
+  return app.add_option("--offset-strength", strength, text)->type_name("S")->check(CLI::Range(-10.0f, 10.0f));
+}
+
 void ShotOptions::addTo(CLI::App& app) {
   app.add_option("scene", input, "the glTF file (.gltf or .glb)")->type_name("SCENE");
   app.add_flag("--eye", eye, "the procedural eye instead of a file");

@@ -8,7 +8,7 @@
 #include "render/method.h"
 #include "render/renderer.h"
 #include "scene/evaluate.h"
-#include "scene/gltf_writer.h"
+#include "scene/png.h"
 #include "scene/texture_mips.h"
 
 #include <algorithm>
@@ -214,7 +214,7 @@ int runExportWeb(const Options& o) {
   std::unique_ptr<vk::Context> context = o.shot.openContext("export-web");
   render::FrameSettings settings{o.shot.width, o.shot.height, view, o.shot.background, o.shot.maxInterfaces};
   render::Renderer renderer(*context, scene, pose);
-  bake::RefractionBake baked = bake::bakeRefraction(*context, renderer, pose, settings);
+  bake::RefractionBake baked = bake::bakeRefraction(renderer, pose, settings);
   if (material) baked.behindMaterial = *material;
   if (baked.count(bake::Coverage::Lands) == 0) {
     throw std::runtime_error("export-web: " + view.description + ": " + bake::describe(baked, scene) +
@@ -224,9 +224,6 @@ int runExportWeb(const Options& o) {
   // The viewport's picture at the baked pose, for everything but the glass that lands.
   render::RefractionMapBuffer map = bake::uploadRefractionMap(*context, baked);
   render::RasterOptions raster;
-  glm::dvec3 lo, hi;
-  scene::sceneBounds(scene, pose, lo, hi);
-  render::fitDepthRange(view, lo, hi, raster);
   raster.refractionMap = &map;
   render::ViewRequest request = render::methodView(render::Method::RefractionMap, settings, raster);
   request.readback.enabled = true;

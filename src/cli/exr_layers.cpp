@@ -2,6 +2,7 @@
 #include "cli/exr_layers.h"
 
 #include "io/json.h"
+#include "io/version.h"
 #include "scene/evaluate.h"
 
 #include <glm/gtc/packing.hpp>

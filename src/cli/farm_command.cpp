@@ -9,6 +9,7 @@
 #include "io/image_file.h"
 #include "io/json.h"
 #include "io/progress.h"
+#include "io/version.h"
 
 #include <algorithm>
 #include <cctype>

@@ -78,6 +78,8 @@ const CLI::Validator& positiveCount();
 /// Options whose values are parsed here, with errors naming the option.
 CLI::Option* addSize(CLI::App& app, const std::string& name, uint32_t& width, uint32_t& height, const std::string& description);
 CLI::Option* addTextureBudget(CLI::App& app, uint64_t& bytes);
+/// --offset-strength S (-10 to 10): normal-offset's displacement, its default the one `strength` holds.
+CLI::Option* addOffsetStrength(CLI::App& app, float& strength);
 
 /// Parses WxH (each 1..65536) or throws UsageError naming the option.
 void parseSize(const std::string& option, const std::string& value, uint32_t& width, uint32_t& height);
@@ -93,7 +95,7 @@ struct ShotOptions {
   scene::ViewRequest view;
   double time = 0.0;
   uint32_t maxInterfaces = gpu::kDefaultMaxInterfaces;
-  glm::vec3 background{0.02f, 0.02f, 0.025f};
+  glm::vec3 background{scene::kDefaultBackground};
   scene::LoadOptions load;
 
   /// Adds SCENE, --eye, --size, --camera, --look-at, --fov, --time,

@@ -103,22 +103,12 @@ void addOptions(CLI::App& render, RenderOptions& o) {
              throw UsageError{"--method takes auto or one of " + render::methodNames() + ", got '" + name + "'"};
            }
          },
-         "how refraction is drawn (default auto): auto (trace,\n"
-         "or driver-rt where the first frames time it faster;\n"
-         "EXR and AOV need trace, so there it is trace), trace,\n"
-         "trace-1 (bends at the first interface only), masked\n"
-         "(the viewport: raster, glass pixels traced),\n"
-         "iris-plane and normal-offset (raster, no trace),\n"
-         "refraction-map (raster, no trace: the texture\n"
-         "behind the glass read where a map baked by the\n"
-         "trace at --bake-time says, as the scene moves on),\n"
-         "none (glass seen straight through), driver-rt\n"
-         "(the trace's rays through the driver's own ray\n"
-         "tracing, where the GPU has it)")
+         "how refraction is drawn (default auto):\n"
+         "  auto  trace, or driver-rt where the first frames time it\n"
+         "        faster (EXR and AOV need trace: there it is trace)\n" +
+             render::methodHelp() + "refraction-map's map is baked by the trace at --bake-time")
       ->type_name("M");
-  render.add_option("--offset-strength", o.raster.offsetStrength, "normal-offset's displacement in image heights (0.02)")
-      ->type_name("S")
-      ->check(CLI::Range(-10.0f, 10.0f));
+  addOffsetStrength(render, o.raster.offsetStrength);
   render.add_option("--environment", o.environment,
                     "what glass reflects: an equirectangular HDR, EXR or PNG\n(+Y up, -Z in the middle; default: a studio gradient)")
       ->type_name("FILE")

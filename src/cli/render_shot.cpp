@@ -13,6 +13,7 @@
 #include "scene/gltf_loader.h"
 #include "vk/context.h"
 #include "vk/error.h"
+#include "vk/pass_names.h"
 
 #include <atomic>
 #include <chrono>
@@ -88,8 +89,8 @@ void printStats(long frameNumber, const render::FrameStats& s, const std::vector
 
 // The GPU passes that build or refit trees (and sort for them), for bench shot.
 bool isTreePass(const std::string& name) {
-  return name == "blas build" || name == "blas refit" || name == "tlas" || name == "histogram" || name == "scan" ||
-         name == "scatter";
+  return name == pass::kBlasBuild || name == pass::kBlasRefit || name == pass::kTlas || name == pass::kSortHistogram || name == pass::kSortScan ||
+         name == pass::kSortScatter;
 }
 
 // The frames still to render. Workers take the next as they finish one, so a
@@ -197,8 +198,8 @@ class Worker {
     render::RendererOptions options;
     options.passTimes = o_.stats || o_.autoMethod || o_.timePasses;  // timestamps only where someone reads them
     options.independentFrames = true;  // a frame's pixels are the same whichever worker, chunk or retry draws it
-    scene::Pose layout = scene::evaluate(scene, shot_.frames.front().second);
-    renderer_ = std::make_unique<render::Renderer>(*context_, scene, layout, options);
+    scene::Pose firstPose = scene::evaluate(scene, shot_.frames.front().second);
+    renderer_ = std::make_unique<render::Renderer>(*context_, scene, firstPose, options);
     chooser_.emplace(context_->caps().driverRayTracing, false, shot_.frames.size());
     // A farm task's log says which GPU of the node it drew and why.
     if (shot_.frames.size() > 1 && !quiet()) {
@@ -216,7 +217,7 @@ class Worker {
       scene::View bakeView = o_.shot.resolveView("render", scene, bakePose);
       render::FrameSettings settings{o_.shot.width, o_.shot.height, bakeView, o_.shot.background, o_.shot.maxInterfaces};
       settings.optics = o_.optics;
-      bake::RefractionBake baked = bake::bakeRefraction(*context_, *renderer_, bakePose, settings);
+      bake::RefractionBake baked = bake::bakeRefraction(*renderer_, bakePose, settings);
       map_ = bake::uploadRefractionMap(*context_, baked);
       raster_.refractionMap = &map_;
       if (id_ == 0) std::printf("baked the refraction map at %g s: %s\n", t, bake::describe(baked, scene).c_str());
@@ -257,9 +258,6 @@ class Worker {
       settings.optics = o_.optics;
       if (o_.exr()) settings.backgroundAlpha = 0.0f;  // a composite's coverage: the raster clears alpha to 0
       render::RasterOptions raster = raster_;
-      glm::dvec3 lo, hi;
-      scene::sceneBounds(scene, pose, lo, hi);
-      render::fitDepthRange(view, lo, hi, raster);
       render::Method method = o_.autoMethod ? chooser_->next() : *o_.method;
       drawnWith = render::methodName(method);
       // Coverage (EXR alpha) comes from the trace's AOV, so an EXR trace asks for it.

@@ -3,6 +3,7 @@
 #include "cli/commands.h"
 
 #include "io/json.h"
+#include "io/version.h"
 
 namespace snell::cli {
 

@@ -1,11 +1,11 @@
-// PNG through snell's own encoder (src/scene/gltf_writer.h) and tinygltf's
+// PNG through snell's own encoder (src/scene/png.h) and tinygltf's
 // decoder, EXR through OpenImageIO where the build has it; the rename makes
 // every write all-or-nothing. Without OpenImageIO the binary carries to a
 // machine that has only the Vulkan loader (the GPU benchmarks do that).
 #include "io/image_file.h"
 
-#include "io/json.h"
-#include "scene/gltf_writer.h"
+#include "io/version.h"
+#include "scene/png.h"
 #include "scene/scene.h"
 
 #if SNELL_WITH_OPENIMAGEIO
@@ -61,12 +61,6 @@ Rgb8Image toSrgb8(const LinearImage& image) {
 }
 
 namespace {
-
-std::string lowerExtension(const std::string& path) {
-  std::string ext = fs::path(path).extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
-  return ext;
-}
 
 // The folder `path` goes in; throws naming the path when it does not exist.
 fs::path existingFolder(const std::string& path) {
@@ -309,75 +303,71 @@ void writePngRgba8(const std::string& path, uint32_t width, uint32_t height, con
   writeAtomically(path, [&](const std::string& temp) { writeBytes(path, temp, scene::encodePng(width, height, rgba)); });
 }
 
-void writeMapFile(const std::string& path, const bake::MapPixels& pixels, bake::Encoding encoding) {
-  std::string ext = lowerExtension(path);
-  const char* wanted = encoding == bake::Encoding::Exr ? ".exr" : ".png";
-  if (ext != wanted) {
-    throw std::runtime_error(path + ": a " + bake::encodingName(encoding) + " map is written as " + wanted + ", not '" +
-                             ext + "'");
-  }
-#if !SNELL_WITH_OPENIMAGEIO
-  if (encoding == bake::Encoding::Exr) throw std::runtime_error(path + ": this build has no OpenImageIO, so no EXR");
-#endif
-  writeAtomically(path, [&](const std::string& temp) {
-    switch (encoding) {
-      case bake::Encoding::Sky8: writeBytes(path, temp, scene::encodePng(pixels.width, pixels.height, pixels.sky8)); return;
-      case bake::Encoding::Rg16: writeBytes(path, temp, scene::encodePng16(pixels.width, pixels.height, pixels.rg16)); return;
-      case bake::Encoding::Exr: {
-#if SNELL_WITH_OPENIMAGEIO
-        OIIO::ImageSpec spec(int(pixels.width), int(pixels.height), 4, OIIO::TypeDesc::FLOAT);
-        spec.channelnames = {"R", "G", "B", "A"};
-        spec.attribute("compression", "zip");
-        spec.attribute("snell:content", "refraction map: R, G the UV; A 1 lands, 0.5 marked, 0 not glass");
-        auto out = OIIO::ImageOutput::create(temp);
-        if (!out) throw std::runtime_error(path + ": cannot write EXR (" + OIIO::geterror() + ")");
-        if (!out->open(temp, spec) || !out->write_image(OIIO::TypeDesc::FLOAT, pixels.rgba32f.data()) || !out->close()) {
-          throw std::runtime_error(path + ": " + out->geterror());
-        }
-#endif
-        return;
-      }
-    }
-  });
+void writeBytesFile(const std::string& path, const std::vector<uint8_t>& bytes) {
+  writeAtomically(path, [&](const std::string& temp) { writeBytes(path, temp, bytes); });
 }
 
-bake::MapPixels readMapFile(const std::string& path, bake::Encoding& encoding) {
-  bake::MapPixels pixels;
-  if (lowerExtension(path) == ".exr") {
+void writeRgbaFloatExr(const std::string& path, uint32_t width, uint32_t height, const std::vector<float>& rgba,
+                       const std::string& content) {
+  if (lowerExtension(path) != ".exr") throw std::runtime_error(path + ": not an .exr name");
 #if SNELL_WITH_OPENIMAGEIO
-    auto in = OIIO::ImageInput::open(path);
-    if (!in) throw std::runtime_error(path + ": cannot read the map (" + OIIO::geterror() + ")");
-    const OIIO::ImageSpec& spec = in->spec();
-    if (spec.nchannels != 4 || spec.width <= 0 || spec.height <= 0) {
-      throw std::runtime_error(path + ": a refraction map has 4 channels (RGBA), this has " + std::to_string(spec.nchannels));
+  writeAtomically(path, [&](const std::string& temp) {
+    OIIO::ImageSpec spec(int(width), int(height), 4, OIIO::TypeDesc::FLOAT);
+    spec.channelnames = {"R", "G", "B", "A"};
+    spec.attribute("compression", "zip");
+    if (!content.empty()) spec.attribute("snell:content", content);
+    auto out = OIIO::ImageOutput::create(temp);
+    if (!out) throw std::runtime_error(path + ": cannot write EXR (" + OIIO::geterror() + ")");
+    if (!out->open(temp, spec) || !out->write_image(OIIO::TypeDesc::FLOAT, rgba.data()) || !out->close()) {
+      throw std::runtime_error(path + ": " + out->geterror());
     }
-    pixels.width = uint32_t(spec.width);
-    pixels.height = uint32_t(spec.height);
-    pixels.rgba32f.resize(size_t(pixels.width) * pixels.height * 4);
-    if (!in->read_image(0, 0, 0, 4, OIIO::TypeDesc::FLOAT, pixels.rgba32f.data())) {
-      throw std::runtime_error(path + ": cannot read the map's pixels (" + in->geterror() + ")");
-    }
-    encoding = bake::Encoding::Exr;
-    return pixels;
+  });
 #else
-    throw std::runtime_error(path + ": this build has no OpenImageIO, so no EXR");
+  (void)width, (void)height, (void)rgba, (void)content;
+  throw std::runtime_error(path + ": this build has no OpenImageIO, so no EXR");
 #endif
+}
+
+std::vector<float> readRgbaFloatExr(const std::string& path, uint32_t& width, uint32_t& height) {
+#if SNELL_WITH_OPENIMAGEIO
+  auto in = OIIO::ImageInput::open(path);
+  if (!in) throw std::runtime_error(path + ": cannot read (" + OIIO::geterror() + ")");
+  const OIIO::ImageSpec& spec = in->spec();
+  if (spec.nchannels != 4 || spec.width <= 0 || spec.height <= 0) {
+    throw std::runtime_error(path + ": 4 channels (RGBA) were expected, this has " + std::to_string(spec.nchannels));
   }
+  width = uint32_t(spec.width);
+  height = uint32_t(spec.height);
+  std::vector<float> rgba(size_t(width) * height * 4);
+  if (!in->read_image(0, 0, 0, 4, OIIO::TypeDesc::FLOAT, rgba.data())) {
+    throw std::runtime_error(path + ": cannot read the pixels (" + in->geterror() + ")");
+  }
+  return rgba;
+#else
+  (void)width, (void)height;
+  throw std::runtime_error(path + ": this build has no OpenImageIO, so no EXR");
+#endif
+}
+
+PngRgba readPngRgba(const std::string& path) {
   tinygltf::Image decoded = decodeImageFile(path);
   if (decoded.component != 4 || (decoded.bits != 8 && decoded.bits != 16)) {
-    throw std::runtime_error(path + ": a refraction map is an RGBA PNG of 8 or 16 bits");
+    throw std::runtime_error(path + ": an RGBA PNG of 8 or 16 bits was expected");
   }
-  pixels.width = uint32_t(decoded.width);
-  pixels.height = uint32_t(decoded.height);
+  PngRgba png{uint32_t(decoded.width), uint32_t(decoded.height), uint32_t(decoded.bits), {}, {}};
   if (decoded.bits == 8) {
-    encoding = bake::Encoding::Sky8;
-    pixels.sky8.assign(decoded.image.begin(), decoded.image.end());
+    png.rgba8.assign(decoded.image.begin(), decoded.image.end());
   } else {
-    encoding = bake::Encoding::Rg16;
-    pixels.rg16.resize(decoded.image.size() / 2);
-    std::memcpy(pixels.rg16.data(), decoded.image.data(), decoded.image.size());  // stb gives native-endian samples
+    png.rgba16.resize(decoded.image.size() / 2);
+    std::memcpy(png.rgba16.data(), decoded.image.data(), decoded.image.size());  // stb gives native-endian samples
   }
-  return pixels;
+  return png;
+}
+
+std::string lowerExtension(const std::string& path) {
+  std::string ext = fs::path(path).extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+  return ext;
 }
 
 void checkWritable(const std::string& path) {

@@ -3,7 +3,6 @@
 // a failed or interrupted write leaves nothing behind.
 #pragma once
 
-#include "bake/refraction_bake.h"
 #include "scene/optics.h"
 
 #include <glm/glm.hpp>
@@ -58,15 +57,28 @@ uint8_t linearToSrgb8(float linear);
 /// PNG ignores alpha (8-bit sRGB, opaque); EXR keeps it.
 void writeImage(const std::string& path, const LinearImage& image, const ImageExtras& extras = {});
 
-/// Writes a refraction map file as `encoding` asks (rg16 and sky8: PNG,
-/// 16-bit and 8-bit RGBA; exr: float RGBA), complete or not at all. Throws
-/// std::runtime_error naming the file when its extension does not fit.
-void writeMapFile(const std::string& path, const bake::MapPixels& pixels, bake::Encoding encoding);
-/// Reads one back; the encoding follows from the file (8-bit PNG: sky8,
-/// 16-bit PNG: rg16, EXR: exr).
-bake::MapPixels readMapFile(const std::string& path, bake::Encoding& encoding);
 /// Writes RGBA bytes to a PNG as they are (no colour conversion).
 void writePngRgba8(const std::string& path, uint32_t width, uint32_t height, const std::vector<uint8_t>& rgba);
+/// Writes bytes already encoded (a PNG's, say): complete, or not at all.
+void writeBytesFile(const std::string& path, const std::vector<uint8_t>& bytes);
+/// Writes 4 float channels (R, G, B, A: data, not colour) to a zip-compressed
+/// EXR, with `content` in its "snell:content" attribute. Throws naming the
+/// file where the build has no OpenImageIO.
+void writeRgbaFloatExr(const std::string& path, uint32_t width, uint32_t height, const std::vector<float>& rgba,
+                       const std::string& content);
+/// Reads one back as floats; anything but 4 channels is an error naming the file.
+std::vector<float> readRgbaFloatExr(const std::string& path, uint32_t& width, uint32_t& height);
+
+/// An RGBA PNG's samples as stored: 8 or 16 bits (native-endian) per channel.
+struct PngRgba {
+  uint32_t width = 0, height = 0, bits = 8;
+  std::vector<uint8_t> rgba8;
+  std::vector<uint16_t> rgba16;
+};
+PngRgba readPngRgba(const std::string& path);
+
+/// The path's extension in lower case, with its dot (".png").
+std::string lowerExtension(const std::string& path);
 
 /// Writes `text` to `path` the same way: complete, or not at all.
 void writeTextFile(const std::string& path, const std::string& text);

@@ -1,14 +1,11 @@
 #include "io/json.h"
 
 #include "io/image_file.h"
+#include "io/version.h"
 
 #include <algorithm>
 #include <ctime>
 #include <vector>
-
-#ifndef SNELL_VERSION
-#error "SNELL_VERSION comes from CMake's project version"
-#endif
 
 namespace snell::io {
 
@@ -40,8 +37,6 @@ std::string commandLine() {
   for (const std::string& w : recordedWords()) line += (line.empty() ? "" : " ") + shellQuoted(w);
   return line;
 }
-
-const char* version() { return SNELL_VERSION; }
 
 Json deviceJson(const vk::DeviceFacts& device) {
   char api[32];

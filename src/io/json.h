@@ -23,9 +23,6 @@ std::string commandLine();
 /// A word as a POSIX shell reads it back as one word: as it is, or in single quotes.
 std::string shellQuoted(const std::string& word);
 
-/// snell's version, as `snell --version` prints it.
-const char* version();
-
 /// The device and its driver, as every head carries them.
 Json deviceJson(const vk::DeviceFacts& device);
 

@@ -1,6 +1,7 @@
 #include "peer/driver_tracer.h"
 
 #include "vk/error.h"
+#include "vk/pass_names.h"
 
 #include "driver_trace.spv.h"
 #include "driver_trace_hit.spv.h"
@@ -60,13 +61,13 @@ void DriverTracer::recordUpdate(vk::Commands& commands, vk::UploadArena& arena,
   if (!built_) {
     std::vector<DriverBlas*> all;
     for (auto& b : blas_) all.push_back(b.get());
-    commands.beginPass("driver blas build");
+    commands.beginPass(pass::kDriverBlasBuild);
     DriverBlas::recordBatch(commands, all, false);
     commands.endPass();
   } else if (!moved.empty()) {
     std::vector<DriverBlas*> some;
     for (uint32_t g : moved) some.push_back(blas_[g].get());
-    commands.beginPass("driver blas update");
+    commands.beginPass(pass::kDriverBlasUpdate);
     DriverBlas::recordBatch(commands, some, true);
     commands.endPass();
   }
@@ -84,7 +85,7 @@ void DriverTracer::recordUpdate(vk::Commands& commands, vk::UploadArena& arena,
     t.flags = VK_GEOMETRY_INSTANCE_TRIANGLE_FACING_CULL_DISABLE_BIT_KHR;
     t.accelerationStructureReference = blas_.at(instances[i].geometry)->address();
   }
-  commands.beginPass("driver tlas");
+  commands.beginPass(pass::kDriverTlas);
   if (!top.empty()) arena.copy(commands, top, tlas_->instances());
   tlas_->recordBuild(commands, static_cast<uint32_t>(top.size()));
   commands.endPass();
@@ -93,7 +94,7 @@ void DriverTracer::recordUpdate(vk::Commands& commands, vk::UploadArena& arena,
 void DriverTracer::recordTrace(vk::Commands& commands, std::span<const vk::BufferBinding> buffers,
                                const gpu::TracePush& push) {
   DriverTracePush p{push, tlas_->address(), 0};
-  commands.beginPass("driver trace");
+  commands.beginPass(pass::kDriverTrace);
   program_->trace(commands, buffers, p, push.width, push.height);
   commands.endPass();
   // The image and AOV, written by ray tracing shaders, for whatever reads them next (readback, display).

@@ -19,7 +19,7 @@ namespace snell::ref {
 struct ReferenceSettings {
   uint32_t width = 0, height = 0;  ///< pixels
   scene::View view;                ///< taken as given: rays come from it exactly as trace.h says
-  glm::dvec3 background{0.02, 0.02, 0.025};  ///< linear RGB a miss sees
+  glm::dvec3 background{scene::kDefaultBackground};  ///< linear RGB a miss sees
   uint32_t maxInterfaces = gpu::kDefaultMaxInterfaces;  ///< refractive faces one ray may cross
   uint32_t maxBends = gpu::kAllBends;  ///< boundaries that bend; later ones are crossed straight
   unsigned threads = 0;  ///< 0: std::thread::hardware_concurrency()

@@ -28,7 +28,7 @@ vk::Buffer uploaded(vk::Context& context, const std::vector<T>& data, const std:
 
 }  // namespace
 
-DeformPass::DeformPass(vk::Context& context, const scene::Scene& scene, const scene::Pose& layout,
+DeformPass::DeformPass(vk::Context& context, const scene::Scene& scene, const scene::Pose& pose,
                        const std::function<DeformSlot(int item)>& slots)
     : context_(context), scene_(scene) {
   program_ = std::make_unique<vk::ComputeProgram>(
@@ -38,8 +38,8 @@ DeformPass::DeformPass(vk::Context& context, const scene::Scene& scene, const sc
   std::vector<glm::uvec4> joints;
   std::vector<glm::vec4> skinWeights;
   uint32_t ownVertices = 0, weightCapacity = 0, jointCapacity = 0;
-  for (size_t i = 0; i < layout.items.size(); ++i) {
-    const scene::DrawItem& item = layout.items[i];
+  for (size_t i = 0; i < pose.items.size(); ++i) {
+    const scene::DrawItem& item = pose.items[i];
     if (!item.deforms()) continue;
     const scene::Shape& shape = scene.shapes[size_t(item.shape)];
     ShapeData& data = shapes_[size_t(item.shape)];

@@ -42,10 +42,10 @@ struct DeformOutput {
 class DeformPass {
  public:
   /// Uploads every shape that some item deforms and an output per deforming
-  /// item of `layout` (a pose of `scene` at any time: which items exist does
+  /// item of `pose` (a pose of `scene` at any time: which items exist does
   /// not depend on time). `slots` gives the output slice of each deforming
   /// item (by pose item index); without it the pass owns one pair of buffers.
-  DeformPass(vk::Context& context, const scene::Scene& scene, const scene::Pose& layout,
+  DeformPass(vk::Context& context, const scene::Scene& scene, const scene::Pose& pose,
              const std::function<DeformSlot(int item)>& slots = {});
 
   /// Where a skinned item's deformed positions are measured from: its first

@@ -16,7 +16,7 @@ namespace snell::render {
 struct FrameSettings {
   uint32_t width = 0, height = 0;
   scene::View view;
-  glm::vec3 background{0.02f, 0.02f, 0.025f};
+  glm::vec3 background{scene::kDefaultBackground};
   uint32_t maxInterfaces = gpu::kDefaultMaxInterfaces;
   /// Interfaces that bend the ray; past them it crosses glass straight
   /// (1: the talk's single bend towards the iris; 0: refraction off).

@@ -1,10 +1,10 @@
-// Every struct in shaders/shared/ is read by GLSL with std430 rules; these
-// checks fail the build if the C++ view of a layout drifts from the budget its
-// header states.
+// Every struct in shaders/shared/ that the render layer shares with GLSL is
+// read with std430 rules; these checks fail the build if the C++ view of a
+// layout drifts from the budget its header states (the viewer checks its own
+// present.h in viewer/display.cpp).
 #include "shared/bvh.h"
 #include "shared/deform.h"
 #include "shared/prefix_sum.h"
-#include "shared/present.h"
 #include "shared/radix_sort.h"
 #include "shared/raster.h"
 #include "shared/scene.h"
@@ -56,7 +56,6 @@ static_assert(sizeof(TraceAov) == 64 && offsetof(TraceAov, nodeVisits) == 20 && 
 static_assert(sizeof(GpuRay) == 32 && offsetof(GpuRay, direction) == 16);
 static_assert(sizeof(TracePixelListHeader) == 32 && offsetof(TracePixelListHeader, dispatchX) == kTracePixelListDispatchOffset);
 static_assert(sizeof(TraceCompactPush) == 16 && offsetof(TraceCompactPush, pad0) == 12);
-static_assert(sizeof(PresentPush) == 48 && offsetof(PresentPush, gate) == 16 && offsetof(PresentPush, flags) == 32);
 static_assert(sizeof(RasterPush) == 112 && offsetof(RasterPush, offsetStrength) == 96 && offsetof(RasterPush, flags) == 80 && offsetof(RasterPush, lightCount) == 84);
 static_assert(sizeof(RasterPush) == 112 && offsetof(RasterPush, mapWidth) == 100);
 static_assert(sizeof(RefractionTexel) == 48 && offsetof(RefractionTexel, weight) == 16 && offsetof(RefractionTexel, material) == 40);

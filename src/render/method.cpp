@@ -1,30 +1,42 @@
 #include "render/method.h"
+#include "vk/pass_names.h"
 
 #include <algorithm>
 #include <cstdio>
+#include <cstring>
+#include <stdexcept>
+#include <string>
 
 namespace snell::render {
 
 const std::vector<MethodInfo>& methods() {
+  using enum ViewOutput;
   static const std::vector<MethodInfo> all = {
-      {Method::Trace, "trace", "traced, every pixel, refracting at every interface"},
-      {Method::TraceOnce, "trace-1", "traced, refracting at the first interface only"},
+      {Method::Trace, "trace", "traced, every pixel, refracting at every interface", Trace, ScreenSpace::Off, true, 0,
+       false, false},
+      {Method::TraceOnce, "trace-1", "traced, refracting at the first interface only", Trace, ScreenSpace::Off, true, 1},
       {Method::Masked, "masked", "viewport: raster, glass pixels traced"},
-      {Method::IrisPlane, "iris-plane", "viewport: refracted once onto the plane behind the glass, no trace"},
-      {Method::NormalOffset, "normal-offset", "viewport: picture behind the glass offset by the normal, no trace"},
-      {Method::RefractionMap, "refraction-map", "viewport: a refraction map baked at another pose, no trace"},
-      {Method::None, "none", "viewport: glass seen straight through"},
-      {Method::DriverRt, "driver-rt", "traced like trace, hits from the driver's ray tracing pipeline (the peer)"},
+      {Method::IrisPlane, "iris-plane", "viewport: refracted once onto the plane behind the glass, no trace", Composite,
+       ScreenSpace::IrisPlane},
+      {Method::NormalOffset, "normal-offset", "viewport: picture behind the glass offset by the normal, no trace",
+       Composite, ScreenSpace::NormalOffset},
+      {Method::RefractionMap, "refraction-map", "viewport: a refraction map baked at another pose, no trace", Composite,
+       ScreenSpace::RefractionMap},
+      {Method::None, "none", "viewport: glass seen straight through", Composite, ScreenSpace::Off, false},
+      {Method::DriverRt, "driver-rt", "traced like trace, hits from the driver's ray tracing pipeline (the peer)", Trace,
+       ScreenSpace::Off, true, 0, true, false},
   };
   return all;
 }
 
-const char* methodName(Method method) {
+const MethodInfo& methodInfo(Method method) {
   for (const MethodInfo& m : methods()) {
-    if (m.method == method) return m.name;
+    if (m.method == method) return m;
   }
-  return "?";
+  throw std::invalid_argument("no method " + std::to_string(int(method)));
 }
+
+const char* methodName(Method method) { return methodInfo(method).name; }
 
 std::optional<Method> methodFromName(std::string_view name) {
   for (const MethodInfo& m : methods()) {
@@ -39,45 +51,37 @@ std::string methodNames() {
   return names;
 }
 
-bool drawsComposite(Method method) {
-  return method != Method::Trace && method != Method::TraceOnce && method != Method::DriverRt;
+std::string methodHelp() {
+  size_t width = 0;
+  for (const MethodInfo& m : methods()) width = std::max(width, std::strlen(m.name));
+  std::string help;
+  for (const MethodInfo& m : methods()) {
+    help += "  " + std::string(m.name) + std::string(width + 2 - std::strlen(m.name), ' ') + m.summary + "\n";
+  }
+  return help;
 }
 
+bool drawsComposite(Method method) { return methodInfo(method).output == ViewOutput::Composite; }
+
 ViewRequest methodView(Method method, const FrameSettings& settings, const RasterOptions& raster) {
+  const MethodInfo& m = methodInfo(method);
   ViewRequest view;
   view.settings = settings;
   view.raster = raster;
-  view.raster.screenSpace = ScreenSpace::Off;
-  switch (method) {
-    case Method::Trace: break;
-    case Method::DriverRt: view.driverTrace = true; break;
-    case Method::TraceOnce: view.settings.maxBends = 1; break;
-    case Method::Masked: view.output = ViewOutput::Composite; break;
-    case Method::IrisPlane:
-      view.output = ViewOutput::Composite;
-      view.raster.screenSpace = ScreenSpace::IrisPlane;
-      break;
-    case Method::NormalOffset:
-      view.output = ViewOutput::Composite;
-      view.raster.screenSpace = ScreenSpace::NormalOffset;
-      break;
-    case Method::RefractionMap:
-      view.output = ViewOutput::Composite;
-      view.raster.screenSpace = ScreenSpace::RefractionMap;
-      break;
-    case Method::None:
-      view.output = ViewOutput::Composite;
-      view.raster.refraction = false;
-      break;
-  }
+  view.output = m.output;
+  view.raster.screenSpace = m.screenSpace;
+  if (!m.refraction) view.raster.refraction = false;
+  if (m.maxBends) view.settings.maxBends = m.maxBends;
+  view.driverTrace = m.driverTrace;
   return view;
 }
 
 ViewRequest methodViewport(Method method, const FrameSettings& settings, const RasterOptions& raster) {
   ViewRequest view = methodView(method, settings, raster);
-  if (method == Method::Trace || method == Method::TraceOnce || method == Method::DriverRt) {
+  const MethodInfo& m = methodInfo(method);
+  if (m.output == ViewOutput::Trace) {
     view.output = ViewOutput::Composite;
-    view.masked = method == Method::TraceOnce;
+    view.masked = m.viewportMasked;
   }
   return view;
 }
@@ -102,9 +106,9 @@ Method AutoMethod::next() const {
 
 void AutoMethod::note(Method drawn, const std::vector<vk::PassTime>& passes) {
   if (chosen_) return;
-  const char* pass = drawn == Method::DriverRt ? "driver trace" : "trace";
+  const char* timed = drawn == Method::DriverRt ? pass::kDriverTrace : pass::kTrace;
   for (const vk::PassTime& p : passes) {
-    if (p.name == pass) (drawn == Method::DriverRt ? driverMs_ : traceMs_).push_back(p.milliseconds);
+    if (p.name == timed) (drawn == Method::DriverRt ? driverMs_ : traceMs_).push_back(p.milliseconds);
   }
   // Each method's first frame warms its caches (12 ms against 2 ms after, on the H100): it does not count.
   if (int(traceMs_.size()) < kTrials + 1 || int(driverMs_.size()) < kTrials + 1) return;
@@ -126,7 +130,7 @@ std::string AutoMethod::describe() const {
 }
 
 bool isRefractionPass(const std::string& passName) {
-  return passName != "deform" && passName != "raster depth" && passName != "raster shading";
+  return passName != pass::kDeform && passName != pass::kRasterDepth && passName != pass::kRasterShading;
 }
 
 }  // namespace snell::render

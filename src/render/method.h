@@ -27,28 +27,41 @@ enum class Method {
   DriverRt,      ///< traced like `trace`, the hits found by the driver's own ray tracing (the peer)
 };
 
+/// A method is this one entry: what it is called, what --help says of it, and
+/// the view it asks the Renderer for. Adding a method is adding an entry (and
+/// its enumerator); methodView(), the commands' help and the viewer's
+/// drop-down follow from the table.
 struct MethodInfo {
   Method method;
   const char* name;     ///< as typed on the command line
   const char* summary;  ///< one line for --help and charts
+  ViewOutput output = ViewOutput::Composite;     ///< whose image it is: the trace's, or the viewport's
+  ScreenSpace screenSpace = ScreenSpace::Off;    ///< a composite's approximation instead of the trace
+  bool refraction = true;                        ///< off: glass seen straight through
+  uint32_t maxBends = 0;                         ///< bends before crossing straight; 0: as the settings say
+  bool driverTrace = false;                      ///< hits from the driver's ray tracing (the peer)
+  bool viewportMasked = true;                    ///< a traced method in the viewport: trace the glass pixels alone
 };
 
 /// Every method, cheapest last; driver-rt, the peer, after them.
 const std::vector<MethodInfo>& methods();
+const MethodInfo& methodInfo(Method method);
 const char* methodName(Method method);
 std::optional<Method> methodFromName(std::string_view name);
 /// "trace, trace-1, ..." for messages.
 std::string methodNames();
+/// One line per method, "  NAME  summary", for the commands' --help.
+std::string methodHelp();
 
 /// Whether the method needs the driver's ray tracing (vk::ContextDesc::driverRayTracing).
-inline bool needsDriverRayTracing(Method method) { return method == Method::DriverRt; }
+inline bool needsDriverRayTracing(Method method) { return methodInfo(method).driverTrace; }
 
 /// Whether the method's image is the viewport composite (raster) rather than the trace image.
 bool drawsComposite(Method method);
 
 /// The view that draws `settings` with `method`. `raster` carries the
-/// composite's depth range and options (fitDepthRange) and, for
-/// refraction-map, the baked map; the method sets the rest.
+/// composite's options (its depth range only to override the Renderer's fit)
+/// and, for refraction-map, the baked map; the method sets the rest.
 ViewRequest methodView(Method method, const FrameSettings& settings, const RasterOptions& raster);
 
 /// The same, always as the viewport composite (the viewer's): `trace` traces

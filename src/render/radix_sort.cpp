@@ -3,6 +3,7 @@
 
 #include "shared/radix_sort.h"
 #include "vk/error.h"
+#include "vk/pass_names.h"
 
 #include "sort_histogram.spv.h"
 #include "sort_scatter.spv.h"
@@ -120,17 +121,17 @@ void RadixSort::record(vk::Commands& commands, const vk::Buffer& keys, const vk:
   const vk::Buffer* keysOut = &scratch.keys;
   const vk::Buffer* valuesIn = &values;
   const vk::Buffer* valuesOut = &scratch.values;
-  for (uint32_t pass = 0; pass < passes; ++pass) {
-    gpu::SortPush push{static_cast<uint32_t>(count), blocks, pass * gpu::kSortRadixBits, 0};
-    if (stepTiming_) commands.beginPass("histogram");
+  for (uint32_t digit = 0; digit < passes; ++digit) {
+    gpu::SortPush push{static_cast<uint32_t>(count), blocks, digit * gpu::kSortRadixBits, 0};
+    if (stepTiming_) commands.beginPass(pass::kSortHistogram);
     histogram_->dispatchGroups(commands,
                                {{gpu::kSortBindingKeysIn, keysIn}, {gpu::kSortBindingHistogram, &scratch.histogram}},
                                push, blocks);
     commands.computeToCompute();
-    if (stepTiming_) commands.beginPass("scan");
+    if (stepTiming_) commands.beginPass(pass::kSortScan);
     scan_.record(commands, scratch.histogram, uint64_t(blocks) * gpu::kSortRadix, scratch.scan);
     commands.computeToCompute();
-    if (stepTiming_) commands.beginPass("scatter");
+    if (stepTiming_) commands.beginPass(pass::kSortScatter);
     scatter_->dispatchGroups(commands,
                              {{gpu::kSortBindingKeysIn, keysIn},
                               {gpu::kSortBindingKeysOut, keysOut},

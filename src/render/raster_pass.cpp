@@ -2,6 +2,7 @@
 #include "render/raster_pass.h"
 
 #include "vk/error.h"
+#include "vk/pass_names.h"
 
 #include "raster_depth.spv.h"
 #include "raster_fragment.spv.h"
@@ -13,8 +14,9 @@
 
 namespace snell::render {
 
-void fitDepthRange(const scene::View& view, const glm::dvec3& lo, const glm::dvec3& hi, RasterOptions& options) {
-  if (!(lo.x <= hi.x && lo.y <= hi.y && lo.z <= hi.z)) return;  // nothing drawn: any range will do
+DepthRange fitDepthRange(const scene::View& view, const glm::dvec3& lo, const glm::dvec3& hi) {
+  DepthRange range;
+  if (!(lo.x <= hi.x && lo.y <= hi.y && lo.z <= hi.z)) return range;  // nothing drawn: any range will do
   double nearest = std::numeric_limits<double>::infinity(), farthest = -nearest;
   for (int corner = 0; corner < 8; ++corner) {
     glm::dvec3 p((corner & 1) ? hi.x : lo.x, (corner & 2) ? hi.y : lo.y, (corner & 4) ? hi.z : lo.z);
@@ -25,15 +27,16 @@ void fitDepthRange(const scene::View& view, const glm::dvec3& lo, const glm::dve
   double size = std::max(glm::length(hi - lo), 1e-30);
   if (view.orthographic) {
     // The trace sees everything along the ray, in front of the eye or not.
-    options.nearPlane = nearest - 0.01 * size;
-    options.farPlane = farthest + 0.01 * size;
+    range.nearPlane = nearest - 0.01 * size;
+    range.farPlane = farthest + 0.01 * size;
   } else {
     // Reverse Z in float keeps depth precision however small the near plane:
     // a millionth of the scene clips nothing the trace would show.
-    options.nearPlane = std::max(nearest, 1e-6 * size);
-    options.nearPlane = std::min(options.nearPlane, 1e-3 * std::max(farthest, size));
-    options.farPlane = farthest;
+    range.nearPlane = std::max(nearest, 1e-6 * size);
+    range.nearPlane = std::min(range.nearPlane, 1e-3 * std::max(farthest, size));
+    range.farPlane = farthest;
   }
+  return range;
 }
 
 RasterPass::RasterPass(vk::Context& context)
@@ -79,20 +82,19 @@ gpu::RasterPush RasterPass::push(const RasterScene& scene, const FrameSettings& 
   gpu::RasterPush push{};
   push.right = glm::vec4(glm::vec3(v.right), float(1.0 / (v.halfHeight * aspect)));
   push.up = glm::vec4(glm::vec3(v.up), float(1.0 / v.halfHeight));
-  push.forward = glm::vec4(glm::vec3(v.forward), float(options.nearPlane));
-  push.eye = glm::vec4(glm::vec3(v.eye - scene.origin), float(options.farPlane));
+  const DepthRange depth = options.depth.value_or(DepthRange{});
+  push.forward = glm::vec4(glm::vec3(v.forward), float(depth.nearPlane));
+  push.eye = glm::vec4(glm::vec3(v.eye - scene.origin), float(depth.farPlane));
   push.wireColor = options.wireColor;
   push.flags = v.orthographic ? gpu::kRasterFlagOrthographic : 0u;
   push.lightCount = scene.lightCount;
   push.shiftX = float(v.shift.x);
   push.shiftY = float(v.shift.y);
-  if (options.refraction && options.screenSpace == ScreenSpace::NormalOffset) push.flags |= gpu::kRasterFlagNormalOffset;
-  if (options.refraction && options.screenSpace == ScreenSpace::IrisPlane) push.flags |= gpu::kRasterFlagIrisPlane;
+  if (options.refraction) push.flags |= uint32_t(options.screenSpace);
   if (options.refraction && options.screenSpace == ScreenSpace::RefractionMap) {
     if (!options.refractionMap || options.refractionMap->width == 0 || options.refractionMap->height == 0) {
       throw vk::VulkanError("raster pass: the refraction-map method needs a baked map (RasterOptions::refractionMap)");
     }
-    push.flags |= gpu::kRasterFlagRefractionMap;
     push.mapWidth = options.refractionMap->width;
     push.mapHeight = options.refractionMap->height;
   }
@@ -116,7 +118,7 @@ void RasterPass::drawItems(vk::Commands& commands, const vk::GraphicsProgram& pr
 void RasterPass::recordDepth(vk::Commands& commands, const RasterScene& scene, const FrameSettings& settings,
                              const RasterOptions& options, const vk::Image& depth, const vk::Image* mask,
                              const vk::Image& colorTarget) const {
-  recordDepthPass(commands, scene, settings, options, depth, mask, colorTarget, 0u, "raster depth");
+  recordDepthPass(commands, scene, settings, options, depth, mask, colorTarget, 0u, pass::kRasterDepth);
 }
 
 void RasterPass::recordDepthPass(vk::Commands& commands, const RasterScene& scene, const FrameSettings& settings,
@@ -144,7 +146,7 @@ void RasterPass::recordDepthPass(vk::Commands& commands, const RasterScene& scen
 void RasterPass::recordShading(vk::Commands& commands, const RasterScene& scene, const FrameSettings& settings,
                                const RasterOptions& options, const vk::Image& traceImage, const vk::Image& target,
                                const vk::Image& depth, const vk::Image& behindDepth) const {
-  recordShadingPass(commands, scene, settings, options, traceImage, target, depth, behindDepth, "raster shading");
+  recordShadingPass(commands, scene, settings, options, traceImage, target, depth, behindDepth, pass::kRasterShading);
 }
 
 void RasterPass::recordShadingPass(vk::Commands& commands, const RasterScene& scene, const FrameSettings& settings,

@@ -19,6 +19,7 @@
 #include <glm/glm.hpp>
 
 #include <memory>
+#include <optional>
 #include <span>
 
 namespace snell::render {
@@ -29,11 +30,16 @@ inline constexpr VkFormat kDepthFormat = VK_FORMAT_D32_SFLOAT;
 inline constexpr VkFormat kMaskFormat = VK_FORMAT_R32_UINT;
 
 /// How transmissive fragments find what they show, when nothing is traced.
-enum class ScreenSpace {
-  Off,           ///< the trace image at the fragment's own pixel
-  NormalOffset,  ///< the picture behind the glass, displaced by the shading normal (GPU Gems 2, ch. 19)
-  IrisPlane,     ///< the picture behind the glass where the refracted ray meets the plane through it
-  RefractionMap, ///< a baked refraction map (RasterOptions::refractionMap), the texture behind read where it says
+/// Each value is the raster shader's flag for it (shared/raster.h), so a new
+/// approximation is a flag, its shading and a value here.
+enum class ScreenSpace : uint32_t {
+  Off = 0,  ///< the trace image at the fragment's own pixel
+  /// The picture behind the glass, displaced by the shading normal (GPU Gems 2, ch. 19).
+  NormalOffset = gpu::kRasterFlagNormalOffset,
+  /// The picture behind the glass where the refracted ray meets the plane through it.
+  IrisPlane = gpu::kRasterFlagIrisPlane,
+  /// A baked refraction map (RasterOptions::refractionMap), the texture behind read where it says.
+  RefractionMap = gpu::kRasterFlagRefractionMap,
 };
 
 /// A baked refraction map on the GPU, as the raster pass reads it: one
@@ -41,6 +47,13 @@ enum class ScreenSpace {
 struct RefractionMapBuffer {
   vk::Buffer texels;
   uint32_t width = 0, height = 0;
+};
+
+/// Perspective: the near and far planes' distances. Orthographic: the depth
+/// range along the view's forward axis.
+struct DepthRange {
+  double nearPlane = 1e-3, farPlane = 1e3;
+  friend bool operator==(const DepthRange&, const DepthRange&) = default;
 };
 
 struct RasterOptions {
@@ -58,15 +71,15 @@ struct RasterOptions {
   /// Draws every triangle's edges over the shaded image.
   bool wireframe = false;
   glm::vec4 wireColor{0.95f, 0.8f, 0.3f, 0.35f};  ///< blended over the image by its alpha
-  /// Perspective: the near plane's distance. Orthographic: the depth range
-  /// along the view's forward axis. fitDepthRange() picks them from the scene.
-  double nearPlane = 1e-3, farPlane = 1e3;
+  /// The depth range drawn; unset, the Renderer fits it each frame to its
+  /// items' bounding spheres at the frame's pose (fitDepthRange()).
+  std::optional<DepthRange> depth;
   friend bool operator==(const RasterOptions&, const RasterOptions&) = default;
 };
 
-/// Near and far planes that hold everything within [lo, hi] seen from `view`
-/// (nearPlane/farPlane of RasterOptions).
-void fitDepthRange(const scene::View& view, const glm::dvec3& lo, const glm::dvec3& hi, RasterOptions& options);
+/// Near and far planes that hold everything within [lo, hi] seen from `view`;
+/// the default range where the box is empty.
+DepthRange fitDepthRange(const scene::View& view, const glm::dvec3& lo, const glm::dvec3& hi);
 
 /// What the raster pass draws: the scene's buffers and the frame's instances and lights.
 struct RasterScene {

@@ -3,6 +3,7 @@
 #include "render/renderer.h"
 
 #include "vk/error.h"
+#include "vk/pass_names.h"
 
 #include <glm/gtc/packing.hpp>
 
@@ -81,12 +82,12 @@ struct Renderer::Update {
   bool buildTop = false, refitTop = false;
 };
 
-Renderer::Renderer(vk::Context& context, const scene::Scene& scene, const scene::Pose& layout, RendererOptions options)
+Renderer::Renderer(vk::Context& context, const scene::Scene& scene, const scene::Pose& pose, RendererOptions options)
     : context_(context), sceneModel_(scene), options_(options),
-      scene_(uploadScene(context, scene, layout, options.host.positions ? &options.host : nullptr)), bounds_(scene),
+      scene_(uploadScene(context, scene, pose, options.host.positions ? &options.host : nullptr)), bounds_(scene),
       rebuilds_(scene_.geometries.size(), options.rebuildGrowth) {
   if (options_.framesInFlight == 0) throw std::invalid_argument("renderer: framesInFlight must be at least 1");
-  deform_ = std::make_unique<DeformPass>(context, scene, layout, [&](int item) {
+  deform_ = std::make_unique<DeformPass>(context, scene, pose, [&](int item) {
     for (const GeometryRange& g : scene_.geometries) {
       if (g.item == item) return DeformSlot{&scene_.positions, &scene_.normals, g.firstVertex};
     }
@@ -97,15 +98,15 @@ Renderer::Renderer(vk::Context& context, const scene::Scene& scene, const scene:
   std::string name = scene.source.empty() ? std::string("scene") : scene.source;
   size_t lightNodes = 0;
   for (const scene::Node& node : scene.nodes) lightNodes += node.light >= 0 ? 1 : 0;
-  instances_ = vk::Buffer(context, {std::max<size_t>(layout.items.size(), 1) * sizeof(gpu::GpuInstance),
+  instances_ = vk::Buffer(context, {std::max<size_t>(pose.items.size(), 1) * sizeof(gpu::GpuInstance),
                                     kStorage | VK_BUFFER_USAGE_VERTEX_BUFFER_BIT, vk::MemoryDomain::Device,
                                     name + " instances"});
   lights_ = vk::Buffer(context, {std::max<size_t>(lightNodes, 1) * sizeof(gpu::GpuLight), kStorage,
                                  vk::MemoryDomain::Device, name + " lights"});
   for (char r : scene_.itemRefractive) refractive_ = refractive_ || r;
 
-  items_.resize(layout.items.size());
-  itemDeformOutput_.assign(layout.items.size(), ~0u);
+  items_.resize(pose.items.size());
+  itemDeformOutput_.assign(pose.items.size(), ~0u);
   for (size_t o = 0; o < deform_->outputs().size(); ++o) {
     itemDeformOutput_[size_t(deform_->outputs()[o].item)] = static_cast<uint32_t>(o);
   }
@@ -319,7 +320,7 @@ void Renderer::recordUpdate(vk::Commands& commands, Slot& slot, const scene::Pos
                        VK_PIPELINE_STAGE_FRAGMENT_SHADER_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT,
                    VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_TRANSFER_READ_BIT | VK_ACCESS_TRANSFER_WRITE_BIT);
   if (!u.deform.empty()) {
-    commands.beginPass("deform");
+    commands.beginPass(pass::kDeform);
     deform_->record(commands, pose, slot.arena, u.deform);
     commands.endPass();
   }
@@ -331,7 +332,7 @@ void Renderer::recordUpdate(vk::Commands& commands, Slot& slot, const scene::Pos
   if (!u.trees) return;
   BvhInputs triangles{&scene_.positions, &scene_.indices, nullptr, nullptr};
   if (!u.build.empty()) {
-    commands.beginPass("blas build");
+    commands.beginPass(pass::kBlasBuild);
     builder_->recordBuild(commands, *blas_, triangles, u.build, slot.arena);
     commands.endPass();
   }
@@ -339,14 +340,14 @@ void Renderer::recordUpdate(vk::Commands& commands, Slot& slot, const scene::Pos
     // Counts the triangles the refit finds non-finite (it covers every tree built this frame too).
     commands.fillBuffer(blas_->dropped, 0);
     commands.transferToCompute();
-    commands.beginPass("blas refit");
+    commands.beginPass(pass::kBlasRefit);
     builder_->recordRefit(commands, *blas_, triangles, u.refit, slot.arena);
     commands.endPass();
   }
   slot.refitGroups = u.refit;
   slot.builtGroups = u.build;
   if (u.refitTop) {
-    commands.beginPass("tlas");
+    commands.beginPass(pass::kTlas);
     BvhInputs top{nullptr, nullptr, &instances_, blas_.get()};
     if (u.buildTop) builder_->recordBuild(commands, *tlas_, top, {}, slot.arena);
     builder_->recordRefit(commands, *tlas_, top, {}, slot.arena);
@@ -392,21 +393,28 @@ void Renderer::recordView(vk::Commands& commands, Slot& slot, size_t index, cons
     if (request.output == ViewOutput::Trace) {
       recordTrace(commands, request, view, false, stats);
     } else {
-      bool glass = request.raster.refraction && refractive_ && transmissiveInView(settings);
-      bool traces = glass && request.raster.screenSpace == ScreenSpace::Off;
+      RasterOptions raster = request.raster;
+      if (!raster.depth) {
+        // Near and far planes around the items' spheres at this pose: loose
+        // enough for any deformation, and reverse Z keeps the precision.
+        glm::dvec3 lo, hi;
+        bounds_.box(lo, hi);
+        raster.depth = fitDepthRange(settings.view, lo, hi);
+      }
+      bool glass = raster.refraction && refractive_ && transmissiveInView(settings);
+      bool traces = glass && raster.screenSpace == ScreenSpace::Off;
       bool masked = traces && request.masked;
       // A screen-space method draws what lies behind the glass first, into the trace image.
-      if (glass && !traces && request.raster.screenSpace != ScreenSpace::RefractionMap) {
-        raster_->recordBehind(commands, scene, settings, request.raster, view.images.depth, view.images.mask,
-                              view.images.trace);
+      if (glass && !traces && raster.screenSpace != ScreenSpace::RefractionMap) {
+        raster_->recordBehind(commands, scene, settings, raster, view.images.depth, view.images.mask, view.images.trace);
       }
-      raster_->recordDepth(commands, scene, settings, request.raster, view.images.depth,
-                           masked ? &view.images.mask : nullptr, view.images.composite);
+      raster_->recordDepth(commands, scene, settings, raster, view.images.depth, masked ? &view.images.mask : nullptr,
+                           view.images.composite);
       if (traces) {
         recordTrace(commands, request, view, masked, stats);
         if (masked) slot.maskedViews.push_back(index);
       }
-      raster_->recordShading(commands, scene, settings, request.raster, view.images.trace, view.images.composite,
+      raster_->recordShading(commands, scene, settings, raster, view.images.trace, view.images.composite,
                              view.images.depth, view.images.mask);
     }
     view.rendered = true;
@@ -449,8 +457,8 @@ uint64_t Renderer::submit(const FrameRequest& request) {
   if (!request.pose) throw std::invalid_argument("renderer: a frame needs a pose");
   const scene::Pose& pose = *request.pose;
   if (pose.items.size() != scene_.itemGeometry.size()) {
-    throw vk::VulkanError("renderer: the pose has " + std::to_string(pose.items.size()) + " draw items; it was built for " +
-                          std::to_string(scene_.itemGeometry.size()));
+    throw std::invalid_argument("renderer: the pose has " + std::to_string(pose.items.size()) +
+                                " draw items; it was built for " + std::to_string(scene_.itemGeometry.size()));
   }
   for (const ViewRequest& v : request.views) {
     checkImageSize(context_, v.settings.width, v.settings.height);
@@ -693,17 +701,15 @@ RenderedFrame renderOneView(Renderer& renderer, const scene::Pose& pose, const V
 
 }  // namespace
 
-RenderedFrame renderFrame(vk::Context&, Renderer& renderer, const scene::Pose& pose, const FrameSettings& settings,
-                          bool withAov) {
+RenderedFrame renderFrame(Renderer& renderer, const scene::Pose& pose, const FrameSettings& settings, bool withAov) {
   ViewRequest view;
   view.settings = settings;
   view.aov = withAov;
   return renderOneView(renderer, pose, view, nullptr);
 }
 
-CompositeFrame renderComposite(vk::Context&, Renderer& renderer, const scene::Pose& pose,
-                               const FrameSettings& settings, const RasterOptions& options, bool withAov,
-                               bool masked) {
+CompositeFrame renderComposite(Renderer& renderer, const scene::Pose& pose, const FrameSettings& settings,
+                               const RasterOptions& options, bool withAov, bool masked) {
   ViewRequest view;
   view.settings = settings;
   view.output = ViewOutput::Composite;

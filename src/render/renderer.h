@@ -158,9 +158,9 @@ struct ViewImages {
 
 class Renderer {
  public:
-  /// Uploads the scene for the draw items of `layout`. Builds no tree and
+  /// Uploads the scene for the draw items of `pose`. Builds no tree and
   /// no trace pipeline until a frame needs them.
-  Renderer(vk::Context& context, const scene::Scene& scene, const scene::Pose& layout, RendererOptions options = {});
+  Renderer(vk::Context& context, const scene::Scene& scene, const scene::Pose& pose, RendererOptions options = {});
   ~Renderer();
   Renderer(const Renderer&) = delete;
   Renderer& operator=(const Renderer&) = delete;
@@ -271,8 +271,8 @@ struct RenderedFrame {
 };
 
 /// Renders one view's trace of every pixel and reads it back (waits for the GPU).
-RenderedFrame renderFrame(vk::Context& context, Renderer& renderer, const scene::Pose& pose,
-                          const FrameSettings& settings, bool withAov = false);
+RenderedFrame renderFrame(Renderer& renderer, const scene::Pose& pose, const FrameSettings& settings,
+                          bool withAov = false);
 
 /// A traced frame and its raster composite, read back (tests, `snell render --viewport`).
 struct CompositeFrame {
@@ -281,9 +281,8 @@ struct CompositeFrame {
 };
 
 /// Renders one viewport composite (update, trace, raster) and reads both images back.
-CompositeFrame renderComposite(vk::Context& context, Renderer& renderer, const scene::Pose& pose,
-                               const FrameSettings& settings, const RasterOptions& options, bool withAov = false,
-                               bool masked = false);
+CompositeFrame renderComposite(Renderer& renderer, const scene::Pose& pose, const FrameSettings& settings,
+                               const RasterOptions& options, bool withAov = false, bool masked = false);
 
 /// Checks a requested image size against the device: throws
 /// std::invalid_argument saying what is wrong.

@@ -212,7 +212,7 @@ static void checkHostShapes(const scene::Scene& scene, const HostBuffers& host) 
   }
 }
 
-SceneGpu uploadScene(vk::Context& context, const scene::Scene& scene, const scene::Pose& layout,
+SceneGpu uploadScene(vk::Context& context, const scene::Scene& scene, const scene::Pose& pose,
                      const HostBuffers* host) {
   if (host) checkHostShapes(scene, *host);
   // Refused before anything is allocated where the device cannot hold it (the
@@ -223,8 +223,8 @@ SceneGpu uploadScene(vk::Context& context, const scene::Scene& scene, const scen
   SceneGpu gpu;
   std::vector<int> shapeGeometry(scene.shapes.size(), -1);
   uint64_t vertices = 0, triangles = 0;
-  for (size_t i = 0; i < layout.items.size(); ++i) {
-    const scene::DrawItem& item = layout.items[i];
+  for (size_t i = 0; i < pose.items.size(); ++i) {
+    const scene::DrawItem& item = pose.items[i];
     const scene::Shape& shape = scene.shapes[size_t(item.shape)];
     if (!item.deforms() && shapeGeometry[size_t(item.shape)] >= 0) {
       gpu.itemGeometry.push_back(static_cast<uint32_t>(shapeGeometry[size_t(item.shape)]));

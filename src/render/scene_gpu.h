@@ -59,11 +59,11 @@ struct HostBuffers {
   uint32_t vertexCapacity = 0;
 };
 
-/// Uploads the scene for the draw items of `layout` (which items exist does not
+/// Uploads the scene for the draw items of `pose` (which items exist does not
 /// change with time). Throws std::runtime_error naming the scene when it is
 /// larger than the device's buffers can hold. With `host`, positions and
 /// normals are the host's buffers, and every shape must be a host shape.
-SceneGpu uploadScene(vk::Context& context, const scene::Scene& scene, const scene::Pose& layout,
+SceneGpu uploadScene(vk::Context& context, const scene::Scene& scene, const scene::Pose& pose,
                      const HostBuffers* host = nullptr);
 
 }  // namespace snell::render

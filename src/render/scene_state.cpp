@@ -105,6 +105,18 @@ bool SceneBounds::anyInView(const FrameSettings& settings, const std::vector<cha
   return false;
 }
 
+void SceneBounds::box(glm::dvec3& lo, glm::dvec3& hi) const {
+  lo = glm::dvec3(INFINITY), hi = glm::dvec3(-INFINITY);
+  for (const Sphere& s : items_) {
+    if (!std::isfinite(s.radius)) {
+      lo = glm::dvec3(INFINITY), hi = glm::dvec3(-INFINITY);
+      return;
+    }
+    lo = glm::min(lo, s.centre - s.radius);
+    hi = glm::max(hi, s.centre + s.radius);
+  }
+}
+
 void SceneBounds::reach(const glm::dvec3& eye, double& nearest, double& farthest) const {
   nearest = INFINITY, farthest = 0.0;
   for (const Sphere& s : items_) {

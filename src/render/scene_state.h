@@ -28,6 +28,9 @@ class SceneBounds {
   /// Whether any item marked in `refractive` may be in the view's frustum
   /// (conservative; true before the first place()).
   bool anyInView(const FrameSettings& settings, const std::vector<char>& refractive) const;
+  /// The box around every item's sphere as the last place() left them; empty
+  /// (lo > hi) before it, with no items, or where a host shape promised no box.
+  void box(glm::dvec3& lo, glm::dvec3& hi) const;
   /// The distance from `eye` to the nearest item's sphere, and to the farthest sphere's far side.
   void reach(const glm::dvec3& eye, double& nearest, double& farthest) const;
 

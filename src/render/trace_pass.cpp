@@ -1,4 +1,5 @@
 #include "render/trace_pass.h"
+#include "vk/pass_names.h"
 
 #include "trace.spv.h"
 #include "trace_compact.spv.h"
@@ -141,7 +142,7 @@ uint64_t TracePass::record(vk::Commands& commands, const TraceInputs& in, const 
     commands.transferToCompute();
     gpu::TraceCompactPush compact{settings.width, settings.height, p.tilesX, 0};
     uint64_t tiles = uint64_t(p.tilesX) * tilesY;
-    commands.beginPass("trace list");
+    commands.beginPass(pass::kTraceList);
     compact_->dispatchGroups(commands,
                              {{gpu::kTraceBindingMask, nullptr, target.mask}, {gpu::kTraceBindingPixels, target.pixels}},
                              compact, (tiles + gpu::kTraceCompactTiles - 1) / gpu::kTraceCompactTiles);
@@ -152,7 +153,7 @@ uint64_t TracePass::record(vk::Commands& commands, const TraceInputs& in, const 
     traced = uint64_t(settings.width) * settings.height;
   }
   const vk::ComputeProgram& trace = program(p.optics, p.flags);
-  commands.beginPass("trace");
+  commands.beginPass(pass::kTrace);
   std::vector<vk::BufferBinding> bindings = pathBindings(in, settings, target);
   bindings.insert(bindings.end(), {{gpu::kTraceBindingTlasNodes, &in.tlas->nodes},
                                    {gpu::kTraceBindingTlasGroups, &in.tlas->groups},

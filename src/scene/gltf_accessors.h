@@ -2,7 +2,7 @@
 // reading that never touches a byte outside its buffer view.
 #pragma once
 
-#include "scene/gltf_loader.h"
+#include "scene/scene.h"
 
 #include <tiny_gltf.h>
 

@@ -5,17 +5,10 @@
 
 #include "scene/scene.h"
 
-#include <stdexcept>
 #include <string>
 #include <vector>
 
 namespace snell::scene {
-
-/// A file that cannot become a scene; the message starts with the file's path.
-class SceneError : public std::runtime_error {
- public:
-  using std::runtime_error::runtime_error;
-};
 
 struct LoadOptions {
   /// The glTF scene to use: an index or a name; empty means the file's default

@@ -17,9 +17,4 @@ namespace snell::scene {
 /// SceneError (also for any other extension).
 void saveGltf(const Scene& scene, const std::string& path);
 
-/// An RGBA8 image as a PNG file's bytes (stb's encoder: filtered and deflated).
-std::vector<uint8_t> encodePng(uint32_t width, uint32_t height, const std::vector<uint8_t>& rgba);
-/// A 16-bit RGBA image as a PNG file's bytes (filtered per row and deflated by stb).
-std::vector<uint8_t> encodePng16(uint32_t width, uint32_t height, const std::vector<uint16_t>& rgba);
-
 }  // namespace snell::scene

@@ -8,13 +8,34 @@
 #include <glm/gtc/quaternion.hpp>
 
 #include <cmath>
+#include <cstdio>
 #include <cstdint>
 #include <limits>
 #include <optional>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
 namespace snell::scene {
+
+/// A file that cannot become a scene, or a scene that cannot be used; the
+/// message starts with the file's path.
+class SceneError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+/// Linear RGB where nothing is drawn, unless a command or a host asks for
+/// another: the GPU's frames, the CPU reference and every command's default.
+/// (The public API, include/snell/snell.h, states the same value for hosts.)
+inline const glm::dvec3 kDefaultBackground{0.02, 0.02, 0.025};
+
+/// Bytes as "12.3 MiB", for messages and summaries.
+inline std::string mebibytes(uint64_t bytes) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.1f MiB", static_cast<double>(bytes) / (1024.0 * 1024.0));
+  return text;
+}
 
 /// A decoded texture, always RGBA8 (sRGB or linear is the material's business).
 struct Texture {

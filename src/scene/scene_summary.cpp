@@ -2,6 +2,7 @@
 #include "scene/scene_summary.h"
 
 #include "scene/texture_mips.h"
+#include "shared/bvh.h"
 
 #include <algorithm>
 #include <cstdio>
@@ -12,13 +13,14 @@ namespace snell::scene {
 
 namespace {
 
-// Budgets per element on the GPU (see DESIGN.md, the frame's passes).
+// What each element takes on the GPU, for a figure before anything is
+// uploaded; Renderer::memoryBytes() measures the real one once it is.
 constexpr uint64_t kRestBytesPerVertex = 24 + 8;     // position + normal, one UV set
 constexpr uint64_t kIndexBytesPerTriangle = 12;
 constexpr uint64_t kMorphBytesPerVertexTarget = 24;  // position + normal delta
 constexpr uint64_t kSkinBytesPerVertex = 32;         // 4 joints (u32) + 4 weights
 constexpr uint64_t kDeformedBytesPerVertex = 24;     // deformed position + normal
-constexpr uint64_t kBvhBytesPerTriangle = 64;        // LBVH: 2n - 1 nodes of 32 bytes
+constexpr uint64_t kBvhBytesPerTriangle = sizeof(gpu::BvhNode);  // n - 1 nodes; a leaf is a child reference
 constexpr uint64_t kTraceBytesPerPixel = 8 + 4 + 4;  // rgba16f trace, rgba8 viewport, depth
 
 /// Calls `visit(node, instanceCount)` for every node under the scene's roots.
@@ -33,12 +35,6 @@ void forEachNode(const Scene& scene, const std::function<void(const Node&, size_
 }
 
 }  // namespace
-
-std::string mebibytes(uint64_t bytes) {
-  char text[32];
-  std::snprintf(text, sizeof text, "%.1f MiB", static_cast<double>(bytes) / (1024.0 * 1024.0));
-  return text;
-}
 
 SceneSummary summarize(const Scene& scene, uint32_t width, uint32_t height) {
   SceneSummary s;

@@ -18,9 +18,6 @@ struct SceneSummary {
   uint64_t totalBytes() const { return geometryBytes + deformBytes + bvhBytes + textureBytes + imageBytes; }
 };
 
-/// `bytes` as "12.3 MiB".
-std::string mebibytes(uint64_t bytes);
-
 SceneSummary summarize(const Scene& scene, uint32_t width = 1920, uint32_t height = 1080);
 
 /// The human-readable report of `snell info`.

@@ -1,8 +1,5 @@
 #include "scene/texture_mips.h"
 
-#include "scene/gltf_loader.h"
-#include "scene/scene_summary.h"
-
 #include <algorithm>
 #include <cmath>
 #include <map>

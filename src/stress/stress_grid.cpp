@@ -351,8 +351,8 @@ Result run(vk::Context& context, const Case& c) {
   r.group = c.group;
   try {
     scene::Scene s = c.makeScene();
-    scene::Pose layout = scene::evaluate(s, c.time);
-    render::Renderer renderer(context, s, layout);
+    scene::Pose firstPose = scene::evaluate(s, c.time);
+    render::Renderer renderer(context, s, firstPose);
     for (uint32_t frame = 0; frame < c.frames; ++frame) {
       scene::Pose pose = scene::evaluate(s, c.time);
       if (c.morph) c.morph(pose, frame);
@@ -367,7 +367,7 @@ Result run(vk::Context& context, const Case& c) {
         settings.rays.resize(size_t(c.width) * c.height);
         c.aim(s, pose, settings.rays, aimedDistance);
       }
-      render::RenderedFrame gpu = render::renderFrame(context, renderer, pose, settings, true);
+      render::RenderedFrame gpu = render::renderFrame(renderer, pose, settings, true);
       ref::ReferenceSettings rs;
       rs.width = c.width;
       rs.height = c.height;

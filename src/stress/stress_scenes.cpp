@@ -1,9 +1,8 @@
 // Scenes for the stability grid, built in code so every case is exact and
 // small enough to trace on the CPU in double.
 #include "scene/procedural_eye.h"
+#include "scene/scene_builder.h"
 #include "stress/stress.h"
-
-#include <glm/gtc/constants.hpp>
 
 #include <cmath>
 #include <limits>
@@ -11,11 +10,6 @@
 namespace snell::stress {
 
 namespace {
-
-int addMaterial(scene::Scene& s, const scene::Material& m) {
-  s.materials.push_back(m);
-  return int(s.materials.size()) - 1;
-}
 
 scene::Material glass(float ior) {
   scene::Material m;
@@ -34,46 +28,12 @@ scene::Material selfLit(const glm::vec3& colour) {
   return m;
 }
 
-// Adds `shape` as a root node of its own; smooth normals are computed when absent.
-int addShape(scene::Scene& s, scene::Shape shape) {
-  if (shape.normals.empty()) {
-    shape.normals.assign(shape.positions.size(), glm::vec3(0.0f));
-    for (size_t t = 0; t + 2 < shape.indices.size(); t += 3) {
-      const glm::vec3& a = shape.positions[shape.indices[t]];
-      glm::vec3 n = glm::cross(shape.positions[shape.indices[t + 1]] - a, shape.positions[shape.indices[t + 2]] - a);
-      for (int k = 0; k < 3; ++k) shape.normals[shape.indices[t + size_t(k)]] += n;
-    }
-    for (glm::vec3& n : shape.normals) {
-      float l = glm::length(n);
-      n = std::isfinite(l) && l > 0.0f ? n / l : glm::vec3(0.0f, 0.0f, 1.0f);
-    }
-  }
-  s.shapes.push_back(std::move(shape));
-  scene::Mesh mesh;
-  mesh.name = s.shapes.back().name;
-  mesh.shapes = {int(s.shapes.size()) - 1};
-  mesh.weights.assign(s.shapes.back().targets.size(), 0.0f);
-  s.meshes.push_back(mesh);
-  scene::Node node;
-  node.name = mesh.name;
-  node.mesh = int(s.meshes.size()) - 1;
-  s.nodes.push_back(node);
-  s.roots.push_back(int(s.nodes.size()) - 1);
-  return int(s.nodes.size()) - 1;
-}
-
-void quad(scene::Shape& shape, glm::vec3 a, glm::vec3 b, glm::vec3 c, glm::vec3 d) {
-  uint32_t base = uint32_t(shape.positions.size());
-  shape.positions.insert(shape.positions.end(), {a, b, c, d});
-  shape.indices.insert(shape.indices.end(), {base, base + 1, base + 2, base, base + 2, base + 3});
-}
-
 // A wall of self-lit coloured tiles at z = depth facing +z, `half` wide each
 // way: sharp colour edges make any bend of a refracted ray show.
 void addBackdrop(scene::Scene& s, float half, float depth) {
   const glm::vec3 colours[4] = {{0.9f, 0.2f, 0.1f}, {0.1f, 0.3f, 0.9f}, {0.95f, 0.85f, 0.2f}, {0.1f, 0.7f, 0.3f}};
   int materials[4];
-  for (int i = 0; i < 4; ++i) materials[i] = addMaterial(s, selfLit(colours[i]));
+  for (int i = 0; i < 4; ++i) materials[i] = scene::addMaterial(s, selfLit(colours[i]));
   const int tiles = 8;
   float step = 2.0f * half / tiles;
   for (int i = 0; i < 4; ++i) {
@@ -84,41 +44,12 @@ void addBackdrop(scene::Scene& s, float half, float depth) {
       for (int x = 0; x < tiles; ++x) {
         if ((x + 2 * y) % 4 != i) continue;
         float x0 = -half + float(x) * step, y0 = -half + float(y) * step;
-        quad(shape, {x0, y0, depth}, {x0 + step, y0, depth}, {x0 + step, y0 + step, depth}, {x0, y0 + step, depth});
+        scene::addQuad(shape, {x0, y0, depth}, {x0 + step, y0, depth}, {x0 + step, y0 + step, depth},
+                       {x0, y0 + step, depth});
       }
     }
-    addShape(s, shape);
+    scene::addRootShape(s, shape);
   }
-}
-
-scene::Shape uvSphere(uint32_t segments, float radius) {
-  scene::Shape shape;
-  shape.name = "sphere";
-  uint32_t rings = std::max(segments / 2, 2u);
-  // Poles are single shared vertices: no gap where the fans meet.
-  shape.positions.push_back({0, 0, radius});
-  for (uint32_t r = 1; r < rings; ++r) {
-    float theta = glm::pi<float>() * float(r) / float(rings);
-    for (uint32_t k = 0; k < segments; ++k) {
-      float phi = 2.0f * glm::pi<float>() * float(k) / float(segments);
-      shape.positions.push_back(radius * glm::vec3(std::sin(theta) * std::cos(phi), std::sin(theta) * std::sin(phi),
-                                                   std::cos(theta)));
-    }
-  }
-  uint32_t south = uint32_t(shape.positions.size());
-  shape.positions.push_back({0, 0, -radius});
-  auto at = [&](uint32_t r, uint32_t k) { return 1 + (r - 1) * segments + k % segments; };
-  for (uint32_t k = 0; k < segments; ++k) {
-    shape.indices.insert(shape.indices.end(), {0, at(1, k), at(1, k + 1)});
-    shape.indices.insert(shape.indices.end(), {south, at(rings - 1, k + 1), at(rings - 1, k)});
-  }
-  for (uint32_t r = 1; r + 1 < rings; ++r) {
-    for (uint32_t k = 0; k < segments; ++k) {
-      shape.indices.insert(shape.indices.end(), {at(r, k), at(r + 1, k), at(r + 1, k + 1)});
-      shape.indices.insert(shape.indices.end(), {at(r, k), at(r + 1, k + 1), at(r, k + 1)});
-    }
-  }
-  return shape;
 }
 
 }  // namespace
@@ -179,9 +110,9 @@ void addIorTexture(scene::Material& m, int texture) {
 scene::Scene sphereScene(uint32_t segments, float ior) {
   scene::Scene s;
   s.source = "stress sphere";
-  scene::Shape shape = uvSphere(segments, 1.0f);
-  shape.material = addMaterial(s, glass(ior));
-  addShape(s, shape);
+  scene::Shape shape = scene::uvSphere(segments, 1.0f);
+  shape.material = scene::addMaterial(s, glass(ior));
+  scene::addRootShape(s, shape);
   addBackdrop(s, 3.0f, -3.0f);
   return s;
 }
@@ -191,7 +122,7 @@ scene::Scene cubeScene(uint32_t n, float ior) {
   s.source = "stress cube";
   scene::Shape shape;
   shape.name = "cube";
-  shape.material = addMaterial(s, glass(ior));
+  shape.material = scene::addMaterial(s, glass(ior));
   // Six faces, each an (n+1)^2 vertex grid; the faces' border vertices are
   // welded so that the cube is one closed, indexed surface.
   auto vertex = [&](glm::vec3 p) {
@@ -224,7 +155,7 @@ scene::Scene cubeScene(uint32_t n, float ior) {
   // Smooth normals (addShape averages them): flat ones would need split
   // vertices, which open the cube. Near its edges the interpolated normal
   // bends rays as a slightly rounded cube would; both tracers see the same.
-  addShape(s, shape);
+  scene::addRootShape(s, shape);
   addBackdrop(s, 4.0f, -4.0f);
   return s;
 }
@@ -234,7 +165,7 @@ scene::Scene slabScene(float thickness, float ior) {
   s.source = "stress slab";
   scene::Shape shape;
   shape.name = "slab";
-  shape.material = addMaterial(s, glass(ior));
+  shape.material = scene::addMaterial(s, glass(ior));
   float t = thickness;
   glm::vec3 c[8] = {{-1, -1, 0}, {1, -1, 0}, {1, 1, 0}, {-1, 1, 0}, {-1, -1, t}, {1, -1, t}, {1, 1, t}, {-1, 1, t}};
   shape.positions.assign(c, c + 8);
@@ -245,7 +176,7 @@ scene::Scene slabScene(float thickness, float ior) {
   shape.normals.assign(8, glm::vec3(0.0f));
   for (int i = 0; i < 4; ++i) shape.normals[size_t(i)] = {0, 0, -1};
   for (int i = 4; i < 8; ++i) shape.normals[size_t(i)] = {0, 0, 1};
-  addShape(s, shape);
+  scene::addRootShape(s, shape);
   addBackdrop(s, 2.0f, -1.0f);
   return s;
 }
@@ -255,8 +186,8 @@ scene::Scene degenerateScene() {
   s.source = "stress degenerate triangles";
   scene::Shape shape;
   shape.name = "degenerate";
-  shape.material = addMaterial(s, glass(1.5f));
-  quad(shape, {-0.5f, -0.5f, 0}, {0.5f, -0.5f, 0}, {0.5f, 0.5f, 0}, {-0.5f, 0.5f, 0});
+  shape.material = scene::addMaterial(s, glass(1.5f));
+  scene::addQuad(shape, {-0.5f, -0.5f, 0}, {0.5f, -0.5f, 0}, {0.5f, 0.5f, 0}, {-0.5f, 0.5f, 0});
   uint32_t n = uint32_t(shape.positions.size());
   // Zero area: three collinear points, and a triangle with a repeated vertex.
   shape.positions.insert(shape.positions.end(), {{-0.4f, 0.1f, 0.2f}, {0.0f, 0.1f, 0.2f}, {0.4f, 0.1f, 0.2f}});
@@ -267,7 +198,7 @@ scene::Scene degenerateScene() {
   uint32_t m = uint32_t(shape.positions.size());
   shape.positions.insert(shape.positions.end(), {{-0.5f, -0.2f, 0.1f}, {0.5f, -0.2f, 0.1f}, {0.0f, -0.2f + 1e-7f, 0.1f}});
   shape.indices.insert(shape.indices.end(), {m, m + 1, m + 2});
-  addShape(s, shape);
+  scene::addRootShape(s, shape);
   addBackdrop(s, 1.0f, -1.0f);
   return s;
 }
@@ -277,10 +208,10 @@ scene::Scene collapsedScene() {
   s.source = "stress collapsed shape";
   scene::Shape shape;
   shape.name = "point";
-  shape.material = addMaterial(s, glass(1.5f));
+  shape.material = scene::addMaterial(s, glass(1.5f));
   shape.positions.assign(30, glm::vec3(0.1f, 0.2f, 0.3f));
   for (uint32_t i = 0; i < 30; ++i) shape.indices.push_back(i);
-  addShape(s, shape);
+  scene::addRootShape(s, shape);
   addBackdrop(s, 1.0f, -1.0f);
   return s;
 }
@@ -290,7 +221,7 @@ scene::Scene gridScene(uint64_t count) {
   s.source = "stress grid of " + std::to_string(count) + " triangles";
   scene::Material grey;
   grey.baseColorFactor = {0.7f, 0.7f, 0.7f, 1.0f};
-  int material = addMaterial(s, grey);
+  int material = scene::addMaterial(s, grey);
   scene::Shape shape;
   shape.name = "grid";
   shape.material = material;
@@ -305,22 +236,22 @@ scene::Scene gridScene(uint64_t count) {
     shape.indices.insert(shape.indices.end(), {base, base + 1, base + 2});
   }
   shape.normals.assign(shape.positions.size(), glm::vec3(0, 0, 1));
-  addShape(s, shape);
+  scene::addRootShape(s, shape);
   return s;
 }
 
 scene::Scene morphingSphereScene(float ior) {
   scene::Scene s;
   s.source = "stress morphing sphere";
-  scene::Shape shape = uvSphere(32, 1.0f);
-  shape.material = addMaterial(s, glass(ior));
+  scene::Shape shape = scene::uvSphere(32, 1.0f);
+  shape.material = scene::addMaterial(s, glass(ior));
   scene::MorphTarget squash, insideOut;
   for (const glm::vec3& p : shape.positions) {
     squash.positions.push_back({0.0f, 0.0f, -0.99f * p.z});
     insideOut.positions.push_back(-2.0f * p);
   }
   shape.targets = {squash, insideOut};
-  addShape(s, shape);
+  scene::addRootShape(s, shape);
   addBackdrop(s, 3.0f, -3.0f);
   return s;
 }
@@ -328,8 +259,8 @@ scene::Scene morphingSphereScene(float ior) {
 scene::Scene nonFiniteMorphScene(uint32_t& poisonedTriangles) {
   scene::Scene s;
   s.source = "stress non-finite deformation";
-  scene::Shape shape = uvSphere(24, 1.0f);
-  shape.material = addMaterial(s, glass(1.5f));
+  scene::Shape shape = scene::uvSphere(24, 1.0f);
+  shape.material = scene::addMaterial(s, glass(1.5f));
   scene::MorphTarget poison;
   poison.positions.assign(shape.positions.size(), glm::vec3(0.0f));
   // A band of vertices in the upper half goes to NaN, one vertex to infinity.
@@ -347,7 +278,7 @@ scene::Scene nonFiniteMorphScene(uint32_t& poisonedTriangles) {
     poisonedTriangles += bad ? 1 : 0;
   }
   shape.targets = {poison};
-  addShape(s, shape);
+  scene::addRootShape(s, shape);
   s.meshes.back().weights = {1.0f};
   addBackdrop(s, 3.0f, -3.0f);
   return s;

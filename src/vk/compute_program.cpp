@@ -8,12 +8,11 @@
 
 namespace snell::vk {
 
-ComputeProgram::ComputeProgram(Context& context, const ComputeProgramDesc& desc) : context_(&context), name_(desc.name) {
-  try {
-    reflection_ = reflectShader(desc.spirv, desc.specialization, desc.name);
-  } catch (const std::runtime_error& e) {
-    throw VulkanError(e.what());
-  }
+ComputeProgram::ComputeProgram(Context& context, const ComputeProgramDesc& desc)
+    : context_(&context), name_(desc.name),
+      reflection_(reflectProgramShader(desc.spirv, desc.specialization, desc.name)),
+      layout_(context, desc.name, std::span(&desc.spirv, 1), {}, reflection_.bindings, VK_SHADER_STAGE_COMPUTE_BIT,
+              reflection_.pushConstantBytes) {
   const DeviceCaps& caps = context.caps();
   uint64_t invocations = uint64_t(reflection_.localSize[0]) * reflection_.localSize[1] * reflection_.localSize[2];
   if (invocations > caps.maxComputeWorkgroupInvocations) {
@@ -24,28 +23,6 @@ ComputeProgram::ComputeProgram(Context& context, const ComputeProgramDesc& desc)
     throw VulkanError("program '" + name_ + "': full subgroups need a workgroup width that is a multiple of " +
                       std::to_string(caps.maxSubgroupSize));
   }
-  if (reflection_.pushConstantBytes > caps.maxPushConstantsSize) {
-    throw VulkanError("program '" + name_ + "' has " + std::to_string(reflection_.pushConstantBytes) +
-                      " bytes of push constants; the device allows " + std::to_string(caps.maxPushConstantsSize));
-  }
-
-  VkDevice device = context.device();
-  VkShaderModuleCreateInfo moduleInfo{VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO};
-  moduleInfo.codeSize = desc.spirv.size_bytes();
-  moduleInfo.pCode = desc.spirv.data();
-  VK_CHECK(vkCreateShaderModule(device, &moduleInfo, nullptr, &module_));
-  context.setName(VK_OBJECT_TYPE_SHADER_MODULE, module_, name_);
-
-  setLayout_ = createSetLayout(context, reflection_.bindings, VK_SHADER_STAGE_COMPUTE_BIT, name_);
-
-  VkPushConstantRange range{VK_SHADER_STAGE_COMPUTE_BIT, 0, reflection_.pushConstantBytes};
-  VkPipelineLayoutCreateInfo layoutInfo{VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO};
-  layoutInfo.setLayoutCount = 1;
-  layoutInfo.pSetLayouts = &setLayout_;
-  layoutInfo.pushConstantRangeCount = reflection_.pushConstantBytes ? 1 : 0;
-  layoutInfo.pPushConstantRanges = &range;
-  VK_CHECK(vkCreatePipelineLayout(device, &layoutInfo, nullptr, &pipelineLayout_));
-  context.setName(VK_OBJECT_TYPE_PIPELINE_LAYOUT, pipelineLayout_, name_);
 
   std::vector<VkSpecializationMapEntry> entries;
   std::vector<uint32_t> values;
@@ -57,8 +34,8 @@ ComputeProgram::ComputeProgram(Context& context, const ComputeProgramDesc& desc)
       desc.requireFullSubgroups ? VK_PIPELINE_SHADER_STAGE_CREATE_REQUIRE_FULL_SUBGROUPS_BIT : 0;
   VkPipelineCreateFlags pipelineFlags = caps.pipelineStatistics ? VK_PIPELINE_CREATE_CAPTURE_STATISTICS_BIT_KHR : 0;
   // The compile runs on its own thread; what it reads is copied into it or lives as long as this program.
-  pending_ = context.compileAsync(name_, [&context, module = module_, layout = pipelineLayout_, entries, values,
-                                         stageFlags, pipelineFlags](VkPipeline* pipeline) {
+  pending_ = context.compileAsync(name_, [&context, module = layout_.module(0), layout = layout_.pipelineLayout(), entries,
+                                         values, stageFlags, pipelineFlags](VkPipeline* pipeline) {
     VkSpecializationInfo specInfo{static_cast<uint32_t>(entries.size()), entries.data(),
                                   values.size() * sizeof(uint32_t), values.data()};
     VkPipelineShaderStageCreateInfo stage{VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO};
@@ -81,22 +58,14 @@ VkPipeline ComputeProgram::pipeline() const {
 }
 
 ComputeProgram::~ComputeProgram() {
-  VkDevice device = context_->device();
   VkPipeline handle = VK_NULL_HANDLE;
   try {
     handle = pipeline();  // a compile still running finishes first: it reads the module and layout
   } catch (...) {
     // The compile failed: its first use reported it, or nothing used it; there is no pipeline to destroy.
   }
-  VkPipelineLayout layout = pipelineLayout_;
-  VkDescriptorSetLayout setLayout = setLayout_;
-  VkShaderModule module = module_;
-  context_->retire([=] {
-    if (handle) vkDestroyPipeline(device, handle, nullptr);
-    vkDestroyPipelineLayout(device, layout, nullptr);
-    vkDestroyDescriptorSetLayout(device, setLayout, nullptr);
-    vkDestroyShaderModule(device, module, nullptr);
-  });
+  // The pipeline goes first; the layout member retires the module and layouts after it.
+  if (handle) context_->retire([device = context_->device(), handle] { vkDestroyPipeline(device, handle, nullptr); });
 }
 
 std::vector<std::string> ComputeProgram::statistics() const {
@@ -138,20 +107,11 @@ std::vector<std::string> ComputeProgram::statistics() const {
 void ComputeProgram::record(Commands& commands, std::span<const BufferBinding> buffers, const void* push,
                             size_t pushBytes, uint64_t groups, const Buffer* indirect,
                             VkDeviceSize indirectOffset) const {
-  if (pushBytes != reflection_.pushConstantBytes && !(reflection_.pushConstantBytes == 0 && push == nullptr)) {
-    throw VulkanError("program '" + name_ + "' takes " + std::to_string(reflection_.pushConstantBytes) +
-                      " bytes of push constants; the call gave " + std::to_string(pushBytes));
-  }
+  layout_.checkPush(push, pushBytes);
   if (groups == 0 && !indirect) return;
-  VkDescriptorSet set =
-      writeSet(commands, setLayout_, reflection_.bindings, buffers, name_);
-
+  layout_.bind(commands, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline(), buffers);
+  layout_.push(commands, push);
   VkCommandBuffer cmd = commands.handle();
-  vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline());
-  vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, pipelineLayout_, 0, 1, &set, 0, nullptr);
-  if (reflection_.pushConstantBytes) {
-    vkCmdPushConstants(cmd, pipelineLayout_, VK_SHADER_STAGE_COMPUTE_BIT, 0, reflection_.pushConstantBytes, push);
-  }
   commands.noteDispatch();
   if (indirect) {
     vkCmdDispatchIndirect(cmd, indirect->handle(), indirectOffset);

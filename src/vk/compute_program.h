@@ -7,11 +7,13 @@
 #include "vk/commands.h"
 #include "vk/context.h"
 #include "vk/descriptors.h"
+#include "vk/program_layout.h"
 #include "vk/spirv_reflect.h"
 
 #include <vulkan/vulkan.h>
 
 #include <array>
+#include <future>
 #include <cstdint>
 #include <initializer_list>
 #include <span>
@@ -82,9 +84,7 @@ class ComputeProgram {
   Context* context_;
   std::string name_;
   ShaderReflection reflection_;
-  VkShaderModule module_ = VK_NULL_HANDLE;
-  VkDescriptorSetLayout setLayout_ = VK_NULL_HANDLE;
-  VkPipelineLayout pipelineLayout_ = VK_NULL_HANDLE;
+  ProgramLayout layout_;
   /// Compiled on a thread of its own (Context::compileAsync); the first use waits for it.
   VkPipeline pipeline() const;
   std::shared_future<VkPipeline> pending_;

@@ -9,49 +9,35 @@ namespace snell::vk {
 
 namespace {
 
-ShaderReflection reflect(std::span<const uint32_t> spirv, const std::string& name) {
-  try {
-    return reflectShader(spirv, {}, name);
-  } catch (const std::runtime_error& e) {
-    throw VulkanError(e.what());
-  }
-}
+constexpr VkShaderStageFlags kStages = VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT;
 
-VkShaderModule createModule(Context& context, std::span<const uint32_t> spirv, const std::string& name) {
-  VkShaderModuleCreateInfo info{VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO};
-  info.codeSize = spirv.size_bytes();
-  info.pCode = spirv.data();
-  VkShaderModule module = VK_NULL_HANDLE;
-  VK_CHECK(vkCreateShaderModule(context.device(), &info, nullptr, &module));
-  context.setName(VK_OBJECT_TYPE_SHADER_MODULE, module, name);
-  return module;
+// Both stages see every binding and the whole push-constant block: one layout, one set.
+ProgramLayout layoutOf(Context& context, const GraphicsProgramDesc& desc) {
+  ShaderReflection vertex = reflectProgramShader(desc.vertexSpirv, {}, desc.name + " (vertex)");
+  ShaderReflection fragment = reflectProgramShader(desc.fragmentSpirv, {}, desc.name + " (fragment)");
+  std::vector<ReflectedBinding> bindings = vertex.bindings;
+  for (const ReflectedBinding& b : fragment.bindings) {
+    auto same = std::find_if(bindings.begin(), bindings.end(),
+                             [&](const ReflectedBinding& o) { return o.set == b.set && o.binding == b.binding; });
+    if (same == bindings.end()) {
+      bindings.push_back(b);
+    } else if (same->type != b.type) {
+      throw VulkanError("program '" + desc.name + "': binding " + std::to_string(b.binding) +
+                        " has different types in its vertex and fragment shaders");
+    }
+  }
+  std::sort(bindings.begin(), bindings.end(),
+            [](const ReflectedBinding& a, const ReflectedBinding& b) { return a.binding < b.binding; });
+  const std::span<const uint32_t> spirv[] = {desc.vertexSpirv, desc.fragmentSpirv};
+  const char* const names[] = {"vertex", "fragment"};
+  return ProgramLayout(context, desc.name, spirv, names, std::move(bindings), kStages,
+                       std::max(vertex.pushConstantBytes, fragment.pushConstantBytes));
 }
 
 }  // namespace
 
 GraphicsProgram::GraphicsProgram(Context& context, const GraphicsProgramDesc& desc)
-    : context_(&context), name_(desc.name) {
-  ShaderReflection vertex = reflect(desc.vertexSpirv, desc.name + " (vertex)");
-  ShaderReflection fragment = reflect(desc.fragmentSpirv, desc.name + " (fragment)");
-  // Both stages see every binding and the whole push-constant block: one layout, one set.
-  bindings_ = vertex.bindings;
-  for (const ReflectedBinding& b : fragment.bindings) {
-    auto same = std::find_if(bindings_.begin(), bindings_.end(),
-                             [&](const ReflectedBinding& o) { return o.set == b.set && o.binding == b.binding; });
-    if (same == bindings_.end()) {
-      bindings_.push_back(b);
-    } else if (same->type != b.type) {
-      throw VulkanError("program '" + name_ + "': binding " + std::to_string(b.binding) +
-                        " has different types in its vertex and fragment shaders");
-    }
-  }
-  std::sort(bindings_.begin(), bindings_.end(),
-            [](const ReflectedBinding& a, const ReflectedBinding& b) { return a.binding < b.binding; });
-  pushConstantBytes_ = std::max(vertex.pushConstantBytes, fragment.pushConstantBytes);
-  if (pushConstantBytes_ > context.caps().maxPushConstantsSize) {
-    throw VulkanError("program '" + name_ + "' has " + std::to_string(pushConstantBytes_) +
-                      " bytes of push constants; the device allows " + std::to_string(context.caps().maxPushConstantsSize));
-  }
+    : context_(&context), name_(desc.name), layout_(layoutOf(context, desc)) {
   if (desc.polygonMode != VK_POLYGON_MODE_FILL && !context.caps().fillModeNonSolid) {
     throw VulkanError("program '" + name_ + "' draws lines, which this device cannot (fillModeNonSolid)");
   }
@@ -59,23 +45,9 @@ GraphicsProgram::GraphicsProgram(Context& context, const GraphicsProgramDesc& de
     throw VulkanError("program '" + name_ + "' needs dynamic rendering, which this device was created without");
   }
 
-  VkDevice device = context.device();
-  const VkShaderStageFlags stages = VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT;
-  vertex_ = createModule(context, desc.vertexSpirv, name_ + " vertex");
-  fragment_ = createModule(context, desc.fragmentSpirv, name_ + " fragment");
-  setLayout_ = createSetLayout(context, bindings_, stages, name_);
-  VkPushConstantRange range{stages, 0, pushConstantBytes_};
-  VkPipelineLayoutCreateInfo layoutInfo{VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO};
-  layoutInfo.setLayoutCount = 1;
-  layoutInfo.pSetLayouts = &setLayout_;
-  layoutInfo.pushConstantRangeCount = pushConstantBytes_ ? 1 : 0;
-  layoutInfo.pPushConstantRanges = &range;
-  VK_CHECK(vkCreatePipelineLayout(device, &layoutInfo, nullptr, &pipelineLayout_));
-  context.setName(VK_OBJECT_TYPE_PIPELINE_LAYOUT, pipelineLayout_, name_);
-
   // The compile runs on its own thread (Context::compileAsync): the state is built there from copies.
-  pending_ = context.compileAsync(name_, [&context, desc, vertex = vertex_, fragment = fragment_,
-                                         layout = pipelineLayout_](VkPipeline* pipeline) {
+  pending_ = context.compileAsync(name_, [&context, desc, vertex = layout_.module(0), fragment = layout_.module(1),
+                                         layout = layout_.pipelineLayout()](VkPipeline* pipeline) {
     VkPipelineShaderStageCreateInfo shaderStages[2] = {
         {VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO, nullptr, 0, VK_SHADER_STAGE_VERTEX_BIT, vertex, "main"},
         {VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO, nullptr, 0, VK_SHADER_STAGE_FRAGMENT_BIT, fragment, "main"}};
@@ -146,49 +118,30 @@ VkPipeline GraphicsProgram::pipeline() const {
 }
 
 GraphicsProgram::~GraphicsProgram() {
-  VkDevice device = context_->device();
   VkPipeline handle = VK_NULL_HANDLE;
   try {
     handle = pipeline();  // a compile still running finishes first: it reads the modules and layout
   } catch (...) {
     // The compile failed: its first use reported it; there is no pipeline to destroy.
   }
-  VkPipelineLayout layout = pipelineLayout_;
-  VkDescriptorSetLayout setLayout = setLayout_;
-  VkShaderModule vertex = vertex_, fragment = fragment_;
-  context_->retire([=] {
-    if (handle) vkDestroyPipeline(device, handle, nullptr);
-    vkDestroyPipelineLayout(device, layout, nullptr);
-    vkDestroyDescriptorSetLayout(device, setLayout, nullptr);
-    vkDestroyShaderModule(device, vertex, nullptr);
-    vkDestroyShaderModule(device, fragment, nullptr);
-  });
+  // The pipeline goes first; the layout member retires the modules and layouts after it.
+  if (handle) context_->retire([device = context_->device(), handle] { vkDestroyPipeline(device, handle, nullptr); });
 }
 
 void GraphicsProgram::bind(Commands& commands, std::span<const BufferBinding> resources, VkRect2D area) const {
-  VkDescriptorSet set = writeSet(commands, setLayout_, bindings_, resources, name_);
-  VkCommandBuffer cmd = commands.handle();
-  vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, pipeline());
-  vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, pipelineLayout_, 0, 1, &set, 0, nullptr);
+  layout_.bind(commands, VK_PIPELINE_BIND_POINT_GRAPHICS, pipeline(), resources);
   VkViewport viewport{float(area.offset.x), float(area.offset.y), float(area.extent.width), float(area.extent.height),
                       0.0f, 1.0f};
-  vkCmdSetViewport(cmd, 0, 1, &viewport);
-  vkCmdSetScissor(cmd, 0, 1, &area);
+  vkCmdSetViewport(commands.handle(), 0, 1, &viewport);
+  vkCmdSetScissor(commands.handle(), 0, 1, &area);
 }
 
 void GraphicsProgram::record(Commands& commands, const void* push, size_t pushBytes, uint32_t vertexCount,
                              uint32_t firstVertex, uint32_t instance) const {
-  if (pushBytes != pushConstantBytes_) {
-    throw VulkanError("program '" + name_ + "' takes " + std::to_string(pushConstantBytes_) +
-                      " bytes of push constants; the call gave " + std::to_string(pushBytes));
-  }
+  layout_.checkPush(push, pushBytes);
   if (vertexCount == 0) return;
-  VkCommandBuffer cmd = commands.handle();
-  if (pushConstantBytes_) {
-    vkCmdPushConstants(cmd, pipelineLayout_, VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT, 0,
-                       pushConstantBytes_, push);
-  }
-  vkCmdDraw(cmd, vertexCount, 1, firstVertex, instance);
+  layout_.push(commands, push);
+  vkCmdDraw(commands.handle(), vertexCount, 1, firstVertex, instance);
   commands.noteDraw();
 }
 

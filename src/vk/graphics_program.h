@@ -8,6 +8,7 @@
 #include "vk/commands.h"
 #include "vk/context.h"
 #include "vk/descriptors.h"
+#include "vk/program_layout.h"
 #include "vk/spirv_reflect.h"
 
 #include <vulkan/vulkan.h>
@@ -61,11 +62,7 @@ class GraphicsProgram {
 
   Context* context_;
   std::string name_;
-  std::vector<ReflectedBinding> bindings_;
-  uint32_t pushConstantBytes_ = 0;
-  VkShaderModule vertex_ = VK_NULL_HANDLE, fragment_ = VK_NULL_HANDLE;
-  VkDescriptorSetLayout setLayout_ = VK_NULL_HANDLE;
-  VkPipelineLayout pipelineLayout_ = VK_NULL_HANDLE;
+  ProgramLayout layout_;
   /// Compiled on a thread of its own (Context::compileAsync); the first use waits for it.
   VkPipeline pipeline() const;
   std::shared_future<VkPipeline> pending_;

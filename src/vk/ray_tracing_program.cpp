@@ -13,40 +13,28 @@ constexpr VkShaderStageFlags kStages =
 
 VkDeviceSize alignUp(VkDeviceSize value, VkDeviceSize alignment) { return (value + alignment - 1) / alignment * alignment; }
 
+// Only the ray generation shader may bind resources, so its bindings are the program's.
+ProgramLayout layoutOf(Context& context, const RayTracingProgramDesc& desc) {
+  if (!context.caps().driverRayTracing) {
+    throw VulkanError("program '" + desc.name +
+                      "': this device offers no ray tracing pipelines (VK_KHR_ray_tracing_pipeline)");
+  }
+  ShaderReflection raygen = reflectProgramShader(desc.raygen, {}, desc.name);
+  for (std::span<const uint32_t> other : {desc.miss, desc.closestHit}) {
+    if (!reflectProgramShader(other, {}, desc.name).bindings.empty()) {
+      throw VulkanError("program '" + desc.name + "': only the ray generation shader may bind resources");
+    }
+  }
+  const std::span<const uint32_t> spirv[] = {desc.raygen, desc.miss, desc.closestHit};
+  const char* const names[] = {"raygen", "miss", "closest hit"};
+  return ProgramLayout(context, desc.name, spirv, names, raygen.bindings, kStages, raygen.pushConstantBytes);
+}
+
 }  // namespace
 
 RayTracingProgram::RayTracingProgram(Context& context, const RayTracingProgramDesc& desc)
-    : context_(&context), name_(desc.name) {
-  if (!context.caps().driverRayTracing) {
-    throw VulkanError("program '" + name_ + "': this device offers no ray tracing pipelines (VK_KHR_ray_tracing_pipeline)");
-  }
-  try {
-    reflection_ = reflectShader(desc.raygen, {}, desc.name);
-    for (std::span<const uint32_t> other : {desc.miss, desc.closestHit}) {
-      if (!reflectShader(other, {}, desc.name).bindings.empty()) {
-        throw std::runtime_error("program '" + name_ + "': only the ray generation shader may bind resources");
-      }
-    }
-  } catch (const std::runtime_error& e) {
-    throw VulkanError(e.what());
-  }
+    : context_(&context), name_(desc.name), layout_(layoutOf(context, desc)) {
   VkDevice device = context.device();
-  const std::span<const uint32_t> code[3] = {desc.raygen, desc.miss, desc.closestHit};
-  for (int i = 0; i < 3; ++i) {
-    VkShaderModuleCreateInfo moduleInfo{VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO};
-    moduleInfo.codeSize = code[i].size_bytes();
-    moduleInfo.pCode = code[i].data();
-    VK_CHECK(vkCreateShaderModule(device, &moduleInfo, nullptr, &modules_[i]));
-  }
-  setLayout_ = createSetLayout(context, reflection_.bindings, kStages, name_);
-  VkPushConstantRange range{kStages, 0, reflection_.pushConstantBytes};
-  VkPipelineLayoutCreateInfo layoutInfo{VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO};
-  layoutInfo.setLayoutCount = 1;
-  layoutInfo.pSetLayouts = &setLayout_;
-  layoutInfo.pushConstantRangeCount = reflection_.pushConstantBytes ? 1 : 0;
-  layoutInfo.pPushConstantRanges = &range;
-  VK_CHECK(vkCreatePipelineLayout(device, &layoutInfo, nullptr, &pipelineLayout_));
-
   const VkShaderStageFlagBits stages[3] = {VK_SHADER_STAGE_RAYGEN_BIT_KHR, VK_SHADER_STAGE_MISS_BIT_KHR,
                                            VK_SHADER_STAGE_CLOSEST_HIT_BIT_KHR};
   VkPipelineShaderStageCreateInfo stageInfo[3];
@@ -54,7 +42,7 @@ RayTracingProgram::RayTracingProgram(Context& context, const RayTracingProgramDe
   for (uint32_t i = 0; i < 3; ++i) {
     stageInfo[i] = {VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO};
     stageInfo[i].stage = stages[i];
-    stageInfo[i].module = modules_[i];
+    stageInfo[i].module = layout_.module(i);
     stageInfo[i].pName = "main";
     groups[i] = {VK_STRUCTURE_TYPE_RAY_TRACING_SHADER_GROUP_CREATE_INFO_KHR};
     groups[i].type = i == 2 ? VK_RAY_TRACING_SHADER_GROUP_TYPE_TRIANGLES_HIT_GROUP_KHR
@@ -70,7 +58,7 @@ RayTracingProgram::RayTracingProgram(Context& context, const RayTracingProgramDe
   pipelineInfo.groupCount = 3;
   pipelineInfo.pGroups = groups;
   pipelineInfo.maxPipelineRayRecursionDepth = 1;  // the ray generation shader loops; hits do not recurse
-  pipelineInfo.layout = pipelineLayout_;
+  pipelineInfo.layout = layout_.pipelineLayout();
   auto create = reinterpret_cast<PFN_vkCreateRayTracingPipelinesKHR>(
       vkGetDeviceProcAddr(device, "vkCreateRayTracingPipelinesKHR"));
   auto handlesOf = reinterpret_cast<PFN_vkGetRayTracingShaderGroupHandlesKHR>(
@@ -105,31 +93,16 @@ RayTracingProgram::RayTracingProgram(Context& context, const RayTracingProgramDe
 }
 
 RayTracingProgram::~RayTracingProgram() {
-  VkDevice device = context_->device();
-  VkPipeline pipeline = pipeline_;
-  VkPipelineLayout layout = pipelineLayout_;
-  VkDescriptorSetLayout setLayout = setLayout_;
-  VkShaderModule modules[3] = {modules_[0], modules_[1], modules_[2]};
-  context_->retire([=] {
-    vkDestroyPipeline(device, pipeline, nullptr);
-    vkDestroyPipelineLayout(device, layout, nullptr);
-    vkDestroyDescriptorSetLayout(device, setLayout, nullptr);
-    for (VkShaderModule m : modules) vkDestroyShaderModule(device, m, nullptr);
-  });
+  // The pipeline goes first; the layout member retires the modules and layouts after it.
+  context_->retire([device = context_->device(), pipeline = pipeline_] { vkDestroyPipeline(device, pipeline, nullptr); });
 }
 
 void RayTracingProgram::record(Commands& commands, std::span<const BufferBinding> buffers, const void* push,
                                size_t pushBytes, uint32_t width, uint32_t height) const {
-  if (pushBytes != reflection_.pushConstantBytes) {
-    throw VulkanError("program '" + name_ + "' takes " + std::to_string(reflection_.pushConstantBytes) +
-                      " bytes of push constants; the call gave " + std::to_string(pushBytes));
-  }
-  VkDescriptorSet set =
-      writeSet(commands, setLayout_, reflection_.bindings, buffers, name_);
+  layout_.checkPush(push, pushBytes);
+  layout_.bind(commands, VK_PIPELINE_BIND_POINT_RAY_TRACING_KHR, pipeline_, buffers);
+  layout_.push(commands, push);
   VkCommandBuffer cmd = commands.handle();
-  vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_RAY_TRACING_KHR, pipeline_);
-  vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_RAY_TRACING_KHR, pipelineLayout_, 0, 1, &set, 0, nullptr);
-  vkCmdPushConstants(cmd, pipelineLayout_, kStages, 0, reflection_.pushConstantBytes, push);
   commands.noteDispatch();
   traceRays_(cmd, &raygenRegion_, &missRegion_, &hitRegion_, &callableRegion_, width, height, 1);
 }

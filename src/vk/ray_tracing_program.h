@@ -8,6 +8,7 @@
 #include "vk/commands.h"
 #include "vk/context.h"
 #include "vk/descriptors.h"
+#include "vk/program_layout.h"
 #include "vk/spirv_reflect.h"
 
 #include <vulkan/vulkan.h>
@@ -43,10 +44,7 @@ class RayTracingProgram {
 
   Context* context_;
   std::string name_;
-  ShaderReflection reflection_;  ///< the ray generation shader's: it holds every binding
-  VkShaderModule modules_[3] = {};
-  VkDescriptorSetLayout setLayout_ = VK_NULL_HANDLE;
-  VkPipelineLayout pipelineLayout_ = VK_NULL_HANDLE;
+  ProgramLayout layout_;  ///< the ray generation shader's bindings: only it binds resources
   VkPipeline pipeline_ = VK_NULL_HANDLE;
   Buffer table_;
   VkStridedDeviceAddressRegionKHR raygenRegion_{}, missRegion_{}, hitRegion_{}, callableRegion_{};

@@ -31,8 +31,8 @@ Hit traceClosest(vec3 origin, vec3 dir, uint skipInstance, uint skipPrim, float 
 // The global index of the first triangle of the instance's geometry.
 uint firstTriangleOf(uint instance);
 
-#include "../../common/scene.glsl"
-#include "../../common/shading.glsl"
+#include "scene.glsl"
+#include "shading.glsl"
 #include "optics.glsl"
 
 // ------------------------------------------------------------------ shading

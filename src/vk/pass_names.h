@@ -1,0 +1,25 @@
+// The names of the timed passes of a frame (vk::PassTime::name, the JSON
+// reports' "passes"): the passes begin under these names and the benchmarks
+// and the auto method find them by the same constants, so a renamed pass
+// cannot silently drop out of a table.
+#pragma once
+
+namespace snell::pass {
+
+inline constexpr const char* kDeform = "deform";
+inline constexpr const char* kBlasBuild = "blas build";
+inline constexpr const char* kBlasRefit = "blas refit";
+inline constexpr const char* kTlas = "tlas";
+inline constexpr const char* kSortHistogram = "histogram";
+inline constexpr const char* kSortScan = "scan";
+inline constexpr const char* kSortScatter = "scatter";
+inline constexpr const char* kTraceList = "trace list";
+inline constexpr const char* kTrace = "trace";
+inline constexpr const char* kRasterDepth = "raster depth";
+inline constexpr const char* kRasterShading = "raster shading";
+inline constexpr const char* kDriverBlasBuild = "driver blas build";
+inline constexpr const char* kDriverBlasUpdate = "driver blas update";
+inline constexpr const char* kDriverTlas = "driver tlas";
+inline constexpr const char* kDriverTrace = "driver trace";
+
+}  // namespace snell::pass
