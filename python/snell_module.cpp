@@ -86,6 +86,13 @@ py::array_t<double> fromMat4(const snell::Mat4& m) {
   return a;
 }
 
+// "  NAME  summary" per method, for View's docstring.
+std::string methodList() {
+  std::string list;
+  for (const snell::MethodDescription& d : snell::methods()) list += "  " + d.name + "  " + d.summary + "\n";
+  return list;
+}
+
 // The API's own default, so the module's keyword default cannot drift from it.
 const snell::Vec3 kDefaultBackground = snell::View{}.background;
 
@@ -272,9 +279,25 @@ py::array vertexView(const std::shared_ptr<RendererState>& state, float* data, u
 }  // namespace
 
 PYBIND11_MODULE(_snell, m) {
+  // pybind11 keeps the pointer it is given: the text lives as long as the module.
+  static const std::string kViewDoc =
+      "The camera: the scene's camera `camera` (an index), else view_matrix (world to camera)\n"
+      "with projection (OpenGL: perspective or orthographic, off-centre for lens shift; its\n"
+      "aspect must be width/height), else a look-at from eye to target with yfov radians.\n"
+      "viewport=True draws the viewport composite: rasterised, with only the glass traced.\n"
+      "method: auto (trace, or driver-rt where it times faster) or one of snell.methods():\n" +
+      methodList();
   m.doc() = "snell: refraction through deforming meshes, ray traced by Vulkan compute.";
   py::register_exception<snell::Error>(m, "Error", PyExc_RuntimeError);
   m.def("version", &snell::version, "snell's version, 'major.minor.patch'.");
+  m.def(
+      "methods",
+      [] {
+        std::vector<std::pair<std::string, std::string>> all;
+        for (const snell::MethodDescription& d : snell::methods()) all.emplace_back(d.name, d.summary);
+        return all;
+      },
+      "The ways of drawing glass View(method=...) takes: (name, one-line summary) pairs.");
 
   py::class_<PyDevice>(m, "Device", "The GPU snell runs on (a Vulkan device of its own).")
       .def(py::init([](const std::string& device, bool validation, bool interop, bool driverRayTracing) {
@@ -489,13 +512,8 @@ PYBIND11_MODULE(_snell, m) {
            "eye"_a = std::vector<float>{0, 0, 3}, "target"_a = std::vector<float>{0, 0, 0},
            "up"_a = std::vector<float>{0, 1, 0}, "yfov"_a = 0.6981317f, "viewport"_a = false, "method"_a = "auto",
            "max_interfaces"_a = 8, "fresnel"_a = true, "dispersion"_a = true, "volume"_a = true,
-           "background"_a = std::vector<float>(kDefaultBackground.begin(), kDefaultBackground.end()), "transparent_background"_a = false,
-           "The camera: the scene's camera `camera` (an index), else view_matrix (world to camera)\n"
-           "with projection (OpenGL: perspective or orthographic, off-centre for lens shift; its\n"
-           "aspect must be width/height), else a look-at from eye to target with yfov radians.\n"
-           "viewport=True draws the viewport composite: rasterised, with only the glass traced.\n"
-           "method: auto (trace, or driver-rt where it times faster), trace, trace-1, iris-plane,\n"
-           "normal-offset, refraction-map, none or driver-rt.")
+           "background"_a = std::vector<float>(kDefaultBackground.begin(), kDefaultBackground.end()),
+           "transparent_background"_a = false, kViewDoc.c_str())
       .def_readwrite("width", &snell::View::width)
       .def_readwrite("height", &snell::View::height)
       .def_readwrite("camera", &snell::View::sceneCamera)

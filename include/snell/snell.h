@@ -35,6 +35,15 @@ namespace snell {
 /// The library's version, "major.minor.patch".
 const char* version();
 
+/// A way of drawing glass that View::method takes, as `snell render --method` does.
+struct MethodDescription {
+  std::string name;     ///< what View::method takes: "trace", "iris-plane", ...
+  std::string summary;  ///< one line on what it draws and what it costs
+};
+/// Every method, from the full trace to the screen-space ones, then the
+/// driver's ray tracing; "auto" (View::method's default) picks among them.
+std::vector<MethodDescription> methods();
+
 /// Every failure snell reports: bad input, a missing device feature, a Vulkan call that failed.
 class Error : public std::runtime_error {
  public:

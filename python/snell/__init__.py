@@ -29,6 +29,7 @@ from ._snell import (
     SharedImage,
     Texture,
     View,
+    methods,
     version,
 )
 
@@ -47,5 +48,6 @@ __all__ = [
     "SharedImage",
     "Texture",
     "View",
+    "methods",
     "version",
 ]

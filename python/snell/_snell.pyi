@@ -14,6 +14,9 @@ class Error(RuntimeError):
 def version() -> str:
     """snell's version, 'major.minor.patch'."""
 
+def methods() -> list[tuple[str, str]]:
+    """The ways of drawing glass View(method=...) takes: (name, one-line summary) pairs."""
+
 class Device:
     """The GPU snell runs on (a Vulkan device of its own)."""
 

@@ -67,6 +67,12 @@ Function deviceFunction(VkDevice device, const char* name) {
 
 const char* version() { return SNELL_VERSION; }
 
+std::vector<MethodDescription> methods() {
+  std::vector<MethodDescription> all;
+  for (const render::MethodInfo& m : render::methods()) all.push_back({m.name, m.summary});
+  return all;
+}
+
 // ---------------------------------------------------------------- Device
 
 struct Device::Impl {

@@ -103,10 +103,9 @@ void addOptions(CLI::App& render, RenderOptions& o) {
              throw UsageError{"--method takes auto or one of " + render::methodNames() + ", got '" + name + "'"};
            }
          },
-         "how refraction is drawn (default auto):\n"
-         "  auto  trace, or driver-rt where the first frames time it\n"
-         "        faster (EXR and AOV need trace: there it is trace)\n" +
-             render::methodHelp() + "refraction-map's map is baked by the trace at --bake-time")
+         "how refraction is drawn (default auto):\n" +
+             render::methodHelp({{"auto", "trace, or driver-rt where the first frames time it faster (for EXR and AOVs: trace)"}}) +
+             "refraction-map's map is baked by the trace at --bake-time")
       ->type_name("M");
   addOffsetStrength(render, o.raster.offsetStrength);
   render.add_option("--environment", o.environment,

@@ -51,13 +51,13 @@ std::string methodNames() {
   return names;
 }
 
-std::string methodHelp() {
+std::string methodHelp(const std::vector<std::pair<std::string, std::string>>& first) {
+  std::vector<std::pair<std::string, std::string>> lines = first;
+  for (const MethodInfo& m : methods()) lines.emplace_back(m.name, m.summary);
   size_t width = 0;
-  for (const MethodInfo& m : methods()) width = std::max(width, std::strlen(m.name));
+  for (const auto& [name, summary] : lines) width = std::max(width, name.size());
   std::string help;
-  for (const MethodInfo& m : methods()) {
-    help += "  " + std::string(m.name) + std::string(width + 2 - std::strlen(m.name), ' ') + m.summary + "\n";
-  }
+  for (const auto& [name, summary] : lines) help += "  " + name + std::string(width + 2 - name.size(), ' ') + summary + "\n";
   return help;
 }
 

@@ -12,6 +12,7 @@
 #include <optional>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 namespace snell::render {
@@ -50,8 +51,9 @@ const char* methodName(Method method);
 std::optional<Method> methodFromName(std::string_view name);
 /// "trace, trace-1, ..." for messages.
 std::string methodNames();
-/// One line per method, "  NAME  summary", for the commands' --help.
-std::string methodHelp();
+/// One line per method, "  NAME  summary", for the commands' --help; `first`
+/// lines (a command's own choices, such as auto) come before, aligned with them.
+std::string methodHelp(const std::vector<std::pair<std::string, std::string>>& first = {});
 
 /// Whether the method needs the driver's ray tracing (vk::ContextDesc::driverRayTracing).
 inline bool needsDriverRayTracing(Method method) { return methodInfo(method).driverTrace; }
