@@ -30,14 +30,8 @@ struct Options {
 
 int runBake(const Options& o) {
   io::checkWritable(o.output);
-  scene::Scene scene = o.shot.loadScene();
-  std::optional<uint32_t> material;
-  if (!o.material.empty()) material = findTexturedMaterial("bake", scene, o.material);
-  auto start = std::chrono::steady_clock::now();
-  scene::Pose pose = scene::evaluate(scene, o.shot.time);
-  scene::View view = o.shot.resolveView("bake", scene, pose);
-  std::unique_ptr<vk::Context> context = o.shot.openContext("bake");
-  render::FrameSettings settings{o.shot.width, o.shot.height, view, o.shot.background, o.shot.maxInterfaces};
+  BakeSetup setup = prepareBake("bake", o.shot, o.material);
+  const auto& [scene, material, start, pose, view, context, settings] = setup;
   bake::DecodedMap map;
   std::string summary;
   {

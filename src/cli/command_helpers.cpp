@@ -17,6 +17,18 @@ uint32_t findTexturedMaterial(const std::string& command, const scene::Scene& sc
                    std::to_string(scene.materials.size()) + " materials)"};
 }
 
+BakeSetup prepareBake(const std::string& command, const ShotOptions& shot, const std::string& material) {
+  BakeSetup b;
+  b.scene = shot.loadScene();
+  if (!material.empty()) b.material = findTexturedMaterial(command, b.scene, material);
+  b.start = std::chrono::steady_clock::now();
+  b.pose = scene::evaluate(b.scene, shot.time);
+  b.view = shot.resolveView(command, b.scene, b.pose);
+  b.context = shot.openContext(command);
+  b.settings = {shot.width, shot.height, b.view, shot.background, shot.maxInterfaces};
+  return b;
+}
+
 std::string xmlEscape(const std::string& text) {
   std::string out;
   for (char c : text) {

@@ -5,7 +5,13 @@
 
 #include "cli/options.h"
 #include "io/environment.h"
+#include "render/frame_settings.h"
+#include "scene/evaluate.h"
+#include "scene/view.h"
 
+#include <chrono>
+#include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -45,8 +51,22 @@ std::unique_ptr<CLI::App> makeSnellApp(Runner& run);
 /// texture, or a UsageError saying why there is none.
 uint32_t findTexturedMaterial(const std::string& command, const scene::Scene& scene, const std::string& wanted);
 
+/// What bake and export-web start from: the scene, the textured material
+/// behind the glass (--material, when given), the pose and view at
+/// --time, a device and the frame settings; `start` is taken once the scene
+/// is loaded, so the time they report is the bake's, not the load's.
+struct BakeSetup {
+  scene::Scene scene;
+  std::optional<uint32_t> material;
+  std::chrono::steady_clock::time_point start;
+  scene::Pose pose;
+  scene::View view;
+  std::unique_ptr<vk::Context> context;
+  render::FrameSettings settings;
+};
+BakeSetup prepareBake(const std::string& command, const ShotOptions& shot, const std::string& material);
+
 /// `text` with &, <, > and " escaped for XML, SVG and HTML.
 std::string xmlEscape(const std::string& text);
-
 
 }  // namespace snell::cli

@@ -205,14 +205,8 @@ int runExportWeb(const Options& o) {
   namespace fs = std::filesystem;
   // Nothing is made until the page is ready; a folder that cannot be made or written fails now.
   io::checkWritable(fs::is_directory(o.output) ? (fs::path(o.output) / "index.html").string() : o.output);
-  scene::Scene scene = o.shot.loadScene();
-  std::optional<uint32_t> material;
-  if (!o.material.empty()) material = findTexturedMaterial("export-web", scene, o.material);
-  auto start = std::chrono::steady_clock::now();
-  scene::Pose pose = scene::evaluate(scene, o.shot.time);
-  scene::View view = o.shot.resolveView("export-web", scene, pose);
-  std::unique_ptr<vk::Context> context = o.shot.openContext("export-web");
-  render::FrameSettings settings{o.shot.width, o.shot.height, view, o.shot.background, o.shot.maxInterfaces};
+  BakeSetup setup = prepareBake("export-web", o.shot, o.material);
+  const auto& [scene, material, start, pose, view, context, settings] = setup;
   render::Renderer renderer(*context, scene, pose);
   bake::RefractionBake baked = bake::bakeRefraction(renderer, pose, settings);
   if (material) baked.behindMaterial = *material;
