@@ -10,6 +10,10 @@
 
 #include <gtest/gtest.h>
 
+#include <cstdlib>
+#include <optional>
+#include <string>
+
 #include <numeric>
 #include <vector>
 
@@ -32,6 +36,34 @@ TEST(DeviceSurvey, ListsEveryDeviceWithAVerdict) {
   ASSERT_TRUE(report.choice.chosen);
   EXPECT_EQ(report.choice.verdicts.size(), report.devices.size());
   EXPECT_NE(report.table().find("chosen"), std::string::npos);
+}
+
+// Sets an environment variable for one scope, as it was after.
+class ScopedEnvironment {
+ public:
+  ScopedEnvironment(const char* name, const char* value) : name_(name) {
+    const char* old = std::getenv(name);
+    if (old) old_ = old;
+    value ? ::setenv(name, value, 1) : ::unsetenv(name);
+  }
+  ~ScopedEnvironment() { old_ ? ::setenv(name_, old_->c_str(), 1) : ::unsetenv(name_); }
+
+ private:
+  const char* name_;
+  std::optional<std::string> old_;
+};
+
+TEST(DeviceSurvey, SlurmsStepGpusNameTheDeviceWhenNoCudaListIsSet) {
+  // Slurm's GPU plugin sets CUDA_VISIBLE_DEVICES beside SLURM_STEP_GPUS; without it the step's list still counts.
+  ScopedEnvironment cuda("CUDA_VISIBLE_DEVICES", nullptr), ordinal("GPU_DEVICE_ORDINAL", nullptr);
+  ScopedEnvironment step("SLURM_STEP_GPUS", "0");
+  std::string why;
+  try {
+    why = vk::surveyDevices("").why;
+  } catch (const vk::VulkanError& e) {
+    why = e.what();  // a machine without a GPU (lavapipe only): GPU 0 is not there, and the error says so
+  }
+  EXPECT_NE(why.find("SLURM_STEP_GPUS=0"), std::string::npos) << why;
 }
 
 TEST(DeviceSurvey, UnknownOverrideFailsWithTheListOfDevices) {

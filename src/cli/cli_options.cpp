@@ -27,9 +27,10 @@ const char* const kHelpFooter = R"(exit codes: 0 done, 1 failed (the message say
 environment:
   SNELL_DEVICE=INDEX|UUID|NAME  the device to use (as --device; 'snell info
                            --devices' lists them)
-  CUDA_VISIBLE_DEVICES, GPU_DEVICE_ORDINAL  without SNELL_DEVICE: the GPU a
-                           launcher (Slurm, a CUDA job) gave this task, by
-                           index in PCI bus order (nvidia-smi's) or GPU-UUID
+  CUDA_VISIBLE_DEVICES, GPU_DEVICE_ORDINAL, SLURM_STEP_GPUS, SLURM_JOB_GPUS
+                           without SNELL_DEVICE: the GPU a launcher (Slurm, a
+                           CUDA job) gave this task, by index in PCI bus order
+                           (nvidia-smi's) or GPU-UUID, the first one set
   SLURM_CPUS_PER_TASK=N    lavapipe renders on N threads (unless LP_NUM_THREADS)
   SNELL_VALIDATION=1       turn on the Khronos validation layer; any message it
                            reports makes the exit code 1

@@ -37,9 +37,10 @@ bool hasInstanceExtension(const char* name) {
 
 // The GPUs a launcher gave this process, as (variable, value); a null
 // variable where none did. Unset, empty, "-1" or Slurm's "NoDevFiles": the
-// launcher gave no GPU to keep to.
+// launcher gave no GPU to keep to. Slurm's own lists come last: its GPU
+// plugin sets CUDA_VISIBLE_DEVICES beside them wherever it hands out GPUs.
 std::pair<const char*, const char*> launcherGpus() {
-  for (const char* variable : {"CUDA_VISIBLE_DEVICES", "GPU_DEVICE_ORDINAL"}) {
+  for (const char* variable : {"CUDA_VISIBLE_DEVICES", "GPU_DEVICE_ORDINAL", "SLURM_STEP_GPUS", "SLURM_JOB_GPUS"}) {
     const char* value = std::getenv(variable);
     if (!value || !*value || *value == '-' || std::strcmp(value, "NoDevFiles") == 0) continue;
     return {variable, value};
@@ -49,7 +50,7 @@ std::pair<const char*, const char*> launcherGpus() {
 
 // The device override and where it came from: the caller's (--device),
 // SNELL_DEVICE, then a launcher's GPU list. Slurm and CUDA launchers set
-// CUDA_VISIBLE_DEVICES and GPU_DEVICE_ORDINAL, which no Vulkan driver reads:
+// CUDA_VISIBLE_DEVICES, GPU_DEVICE_ORDINAL and SLURM_STEP_GPUS, which no Vulkan driver reads:
 // without them every task of a node would pile onto its first GPU.
 std::string resolveOverride(const std::string& given, std::span<const DeviceFacts> facts, std::string& why) {
   if (!given.empty()) {

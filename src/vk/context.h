@@ -33,7 +33,8 @@ struct ContextDesc {
   /// With validation: also check synchronization (missing barriers, hazards).
   bool synchronizationValidation = false;
   /// An index, a UUID or a name substring; empty means SNELL_DEVICE, then a
-  /// launcher's CUDA_VISIBLE_DEVICES or GPU_DEVICE_ORDINAL (see launcherOverride).
+  /// launcher's CUDA_VISIBLE_DEVICES, GPU_DEVICE_ORDINAL, SLURM_STEP_GPUS or SLURM_JOB_GPUS
+  /// (see launcherOverride).
   std::string deviceOverride;
   /// Ask the driver for per-pipeline statistics where it offers them.
   bool pipelineStatistics = false;
