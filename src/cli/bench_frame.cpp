@@ -6,13 +6,13 @@
 #include "io/json.h"
 
 #include "render/method.h"
+#include "render/pass_names.h"
 #include "render/renderer.h"
 #include "scene/evaluate.h"
 #include "scene/gltf_loader.h"
 #include "scene/procedural_eye.h"
 #include "scene/scene_summary.h"
 #include "scene/view.h"
-#include "vk/pass_names.h"
 
 #include <algorithm>
 #include <chrono>

@@ -10,13 +10,13 @@
 #include "io/progress.h"
 #include "ref/reference_tracer.h"
 #include "render/method.h"
+#include "render/pass_names.h"
 #include "render/renderer.h"
 #include "scene/evaluate.h"
 #include "scene/gltf_loader.h"
 #include "scene/procedural_eye.h"
 #include "scene/view.h"
 #include "stress/stress.h"
-#include "vk/pass_names.h"
 
 #include <glm/gtc/constants.hpp>
 

@@ -12,12 +12,12 @@
 #include "ref/sah_bvh.h"
 #include "render/bvh.h"
 #include "render/method.h"
+#include "render/pass_names.h"
 #include "render/renderer.h"
 #include "scene/evaluate.h"
 #include "scene/procedural_eye.h"
 #include "scene/view.h"
 #include "vk/commands.h"
-#include "vk/pass_names.h"
 #include "vk/upload_arena.h"
 
 #include <algorithm>

@@ -8,12 +8,12 @@
 #include "io/json.h"
 #include "io/progress.h"
 #include "ref/reference_tracer.h"
+#include "render/pass_names.h"
 #include "render/renderer.h"
 #include "scene/evaluate.h"
 #include "scene/gltf_loader.h"
 #include "vk/context.h"
 #include "vk/error.h"
-#include "vk/pass_names.h"
 
 #include <atomic>
 #include <chrono>

@@ -1,7 +1,7 @@
 #include "peer/driver_tracer.h"
 
+#include "peer/pass_names.h"
 #include "vk/error.h"
-#include "vk/pass_names.h"
 
 #include "driver_trace.spv.h"
 #include "driver_trace_hit.spv.h"

@@ -1,5 +1,6 @@
 #include "render/method.h"
-#include "vk/pass_names.h"
+
+#include "render/pass_names.h"
 
 #include <algorithm>
 #include <cstdio>

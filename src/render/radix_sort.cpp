@@ -1,9 +1,9 @@
 // Host side of the radix sort (shaders/comp/sort_histogram.comp, sort_scatter.comp).
 #include "render/radix_sort.h"
 
+#include "render/pass_names.h"
 #include "shared/radix_sort.h"
 #include "vk/error.h"
-#include "vk/pass_names.h"
 
 #include "sort_histogram.spv.h"
 #include "sort_scatter.spv.h"

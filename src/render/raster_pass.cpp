@@ -1,8 +1,8 @@
 // The raster pass: one draw per draw item over the trace's own buffers.
 #include "render/raster_pass.h"
 
+#include "render/pass_names.h"
 #include "vk/error.h"
-#include "vk/pass_names.h"
 
 #include "raster_depth.spv.h"
 #include "raster_fragment.spv.h"

@@ -2,8 +2,8 @@
 // follow from it, and the readbacks, recorded into one submission per frame.
 #include "render/renderer.h"
 
+#include "render/pass_names.h"
 #include "vk/error.h"
-#include "vk/pass_names.h"
 
 #include <glm/gtc/packing.hpp>
 

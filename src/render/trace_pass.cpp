@@ -1,5 +1,5 @@
 #include "render/trace_pass.h"
-#include "vk/pass_names.h"
+#include "render/pass_names.h"
 
 #include "trace.spv.h"
 #include "trace_compact.spv.h"

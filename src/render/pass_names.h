@@ -1,8 +1,10 @@
-// The names of the timed passes of a frame (vk::PassTime::name, the JSON
-// reports' "passes"): the passes begin under these names and the benchmarks
-// and the auto method find them by the same constants, so a renamed pass
-// cannot silently drop out of a table.
+// The names of a frame's timed passes (vk::PassTime::name, the JSON reports'
+// "passes"): the passes begin under these names and the benchmarks and the
+// auto method find them by the same constants, so a renamed pass cannot
+// silently drop out of a table. The driver-rt peer's are in peer/pass_names.h.
 #pragma once
+
+#include "peer/pass_names.h"
 
 namespace snell::pass {
 
@@ -17,9 +19,5 @@ inline constexpr const char* kTraceList = "trace list";
 inline constexpr const char* kTrace = "trace";
 inline constexpr const char* kRasterDepth = "raster depth";
 inline constexpr const char* kRasterShading = "raster shading";
-inline constexpr const char* kDriverBlasBuild = "driver blas build";
-inline constexpr const char* kDriverBlasUpdate = "driver blas update";
-inline constexpr const char* kDriverTlas = "driver tlas";
-inline constexpr const char* kDriverTrace = "driver trace";
 
 }  // namespace snell::pass
