@@ -234,5 +234,13 @@ TEST(BenchMethods, WritesJsonAndAChartWithOnePointPerMethodAndRefractionMatters)
   fs::remove_all(dir);
 }
 
+TEST_F(GpuTest, BenchMethodsPipelineStatsListTheTracePipelinesWhereTheDriverOffersThem) {
+  CommandRun run = runCommand(std::string(SNELL_BINARY) +
+                              " bench methods --methods trace --size 32x24 --frames 2 --no-reference --pipeline-stats");
+  ASSERT_EQ(run.exitCode, 0) << run.output;
+  bool listed = run.output.find("trace pipelines, as the driver compiled them:\n  trace (optics 0x") != std::string::npos;
+  EXPECT_EQ(listed, context().facts().pipelineStatistics) << run.output;
+}
+
 }  // namespace
 }  // namespace snell::test

@@ -42,7 +42,7 @@ struct Options {
   float offsetStrength = render::RasterOptions{}.offsetStrength;
   std::vector<std::string> methods;  ///< empty: every method
   scene::EyeOptions eye;
-  bool optics = false, noReference = false;
+  bool optics = false, noReference = false, pipelineStats = false;
   std::string json, svg, images;
 };
 
@@ -73,6 +73,7 @@ struct MethodResult {
   std::map<std::string, std::vector<double>> passMs;  ///< per pass, measured frames
   std::map<std::string, double> firstFrameMs;         ///< per pass, the warm-up frame (builds)
   uint64_t hitsCompared = 0, hitsAgreeing = 0;        ///< first hits against trace's (driver-rt)
+  std::vector<std::string> pipelineStatistics;        ///< --pipeline-stats: the trace pipelines' registers, spills
   Error glass, image;
   std::vector<double> frameGlassRmse;  ///< per frame of the sequence, in order
   double worstFrameWithin1 = 1.0;
@@ -308,6 +309,7 @@ int runMethods(const Options& o) {
   }
   vk::ContextDesc desc = io::contextDescFromEnvironment();
   desc.driverRayTracing = true;  // for driver-rt, where the device has it
+  desc.pipelineStatistics = o.pipelineStats;
   auto context = vk::Context::create(desc);
   render::checkImageSize(*context, width, height);
   std::printf("device: %s\nscene: %s, %ux%u, %u frames\n", context->facts().name.c_str(), label.c_str(), width, height,
@@ -442,7 +444,10 @@ int runMethods(const Options& o) {
         result.frameGlassRmse.push_back(glass.rmse());
       }
       if (!o.images.empty() && f + 1 == frameCount) io::writeImage(o.images + "/" + result.name + ".png", image);
-      if (f + 1 == frameCount) result.memoryBytes = renderers[m]->memoryBytes();
+      if (f + 1 == frameCount) {
+        result.memoryBytes = renderers[m]->memoryBytes();
+        result.pipelineStatistics = renderers[m]->pipelineStatistics();
+      }
     }
     if (driver && traceHits.size() == driverHits.size()) {
       for (size_t i = 0; i < traceHits.size(); ++i) driver->hitsAgreeing += traceHits[i] == driverHits[i];
@@ -465,6 +470,13 @@ int runMethods(const Options& o) {
   std::printf("(glass: pixels whose first hit in the reference is transmissive; worst frame: the lowest share of a\n"
               " frame's pixels within 1/255; GPU MiB: geometry, trees and per-frame tables, not the images)\n");
   if (!reference) std::printf("(--no-reference: errors not measured)\n");
+  if (o.pipelineStats) {
+    for (const MethodResult& r : results) {
+      if (r.pipelineStatistics.empty()) continue;
+      std::printf("%s pipelines, as the driver compiled them:\n", r.name.c_str());
+      for (const std::string& line : r.pipelineStatistics) std::printf("  %s\n", line.c_str());
+    }
+  }
   // The peer side by side: per pass, the build on the first frame, medians after.
   for (const MethodResult& r : results) {
     bool peer = r.info.method == render::Method::Trace || r.info.method == render::Method::DriverRt;
@@ -653,6 +665,8 @@ void addBenchMethods(CLI::App& bench, Runner& run) {
       ->check(CLI::Range(0u, 10000u));
   sub->add_flag("--optics", o->optics, "rows per optics feature (trace) instead of per method")->excludes(methods);
   sub->add_flag("--no-reference", o->noReference, "time only: no CPU reference, no errors (for scaling runs)");
+  sub->add_flag("--pipeline-stats", o->pipelineStats,
+                "print the driver's statistics of each trace pipeline (registers, spills), where it offers them");
   sub->add_option("--json", o->json, "write the results as JSON")->type_name("FILE");
   sub->add_option("--svg", o->svg,
                   "write a chart of time against error (log-log, the\nPareto front drawn) that a browser opens")

@@ -172,6 +172,8 @@ uint64_t Renderer::memoryBytes() const {
   return bytes;
 }
 
+std::vector<std::string> Renderer::pipelineStatistics() const { return trace_->statistics(); }
+
 double Renderer::treeBytesPerTriangle() const {
   if (!blas_ || scene_.triangleCount == 0) return 0.0;
   return double(blas_->treeBytes() + tlas_->treeBytes()) / scene_.triangleCount;

@@ -206,6 +206,8 @@ class Renderer {
   uint32_t lightCount() const { return lightCount_; }
   /// GPU memory of geometry, deformation, trees and per-frame tables (not view images).
   uint64_t memoryBytes() const;
+  /// The driver's statistics of the trace pipelines made so far (vk::ContextDesc::pipelineStatistics).
+  std::vector<std::string> pipelineStatistics() const;
   /// Bytes of tree memory (both levels) per bottom-level triangle, build scratch apart.
   double treeBytesPerTriangle() const;
 

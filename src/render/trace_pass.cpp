@@ -4,6 +4,7 @@
 #include "trace.spv.h"
 #include "trace_compact.spv.h"
 
+#include <cstdio>
 #include <stdexcept>
 #include <string>
 
@@ -195,6 +196,16 @@ uint64_t TracePass::recordDriver(vk::Commands& commands, const TraceInputs& in, 
   bindings.push_back({gpu::kTraceBindingGeometryFirst, &driver_->geometryFirst()});
   driver_->recordTrace(commands, bindings, push(in, settings, target, false));
   return uint64_t(settings.width) * settings.height;
+}
+
+std::vector<std::string> TracePass::statistics() const {
+  std::vector<std::string> lines;
+  for (const auto& [key, program] : programs_) {
+    char variant[64];
+    std::snprintf(variant, sizeof variant, "trace (optics 0x%x, flags 0x%x): ", unsigned(key >> 32), unsigned(key));
+    for (const std::string& line : program->statistics()) lines.push_back(variant + line);
+  }
+  return lines;
 }
 
 uint64_t TracePass::bytes() const { return driver_ ? driver_->bytes() : 0; }

@@ -80,6 +80,9 @@ class TracePass {
 
   /// The optics bits (gpu::kOptics*) a view of `settings` traces with: those it asks for that the scene can show.
   uint32_t opticsFor(const FrameSettings& settings) const;
+  /// The driver's statistics of each trace pipeline made so far (registers,
+  /// spills, ...), one line each, where the context captures them.
+  std::vector<std::string> statistics() const;
   /// GPU memory of the driver's structures (the environments are the views' own).
   uint64_t bytes() const;
   /// A small buffer bound where a view has no AOV, ray list or pixel list.
