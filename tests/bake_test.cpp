@@ -38,7 +38,7 @@ Baked bakeEye(vk::Context& context, double time = 0.0) {
   b.pose = scene::evaluate(b.scene, time);
   b.settings = {kWidth, kHeight, scene::resolveView(b.scene, b.pose, {}), glm::vec3(scene::kDefaultBackground), 8};
   render::Renderer renderer(context, b.scene, b.pose);
-  b.bake = bake::bakeRefraction(renderer, b.pose, b.settings);
+  b.bake = renderer.bakeRefractionMap(b.pose, b.settings);
   return b;
 }
 
@@ -106,7 +106,7 @@ TEST_F(GpuTest, TheBakedEyeMarksItsGlassAndWhereItLandsOnTheIris) {
 // glass pixel is the shine plus the weight times the same texel.
 TEST_F(GpuTest, TheMapRedrawsTheTraceAtTheBakedPoseAndView) {
   Baked b = bakeEye(context());
-  render::RefractionMapBuffer map = bake::uploadRefractionMap(context(), b.bake);
+  render::RefractionMapBuffer map = render::uploadRefractionMap(context(), b.bake);
   io::Rgb8Image drawn = drawWithMap(context(), b.scene, b.pose, b.settings, map);
   io::Rgb8Image traced = traceOf(context(), b.scene, b.pose, b.settings);
   GlassError e = glassError(drawn, traced, b.bake);
@@ -116,11 +116,41 @@ TEST_F(GpuTest, TheMapRedrawsTheTraceAtTheBakedPoseAndView) {
   EXPECT_LE(e.worst, 2);
 }
 
+// The renderer keeps the map it baked: a refraction-map view that names no
+// map of its own draws with it, as it would with the same map handed over.
+TEST_F(GpuTest, ARendererDrawsWithTheRefractionMapItBakedLast) {
+  Baked b = bakeEye(context());
+  render::Renderer renderer(context(), b.scene, b.pose);
+  renderer.bakeRefractionMap(b.pose, b.settings);
+  render::FrameRequest request;
+  request.pose = &b.pose;
+  request.views.push_back(render::methodView(render::Method::RefractionMap, b.settings, render::RasterOptions{}));
+  request.views.back().readback.enabled = true;
+  const render::FrameResult& result = renderer.wait(renderer.submit(request));
+  io::Rgb8Image kept = io::toSrgb8({kWidth, kHeight, result.views.at(0).composite});
+  render::RefractionMapBuffer map = render::uploadRefractionMap(context(), b.bake);
+  EXPECT_EQ(kept.rgb, drawWithMap(context(), b.scene, b.pose, b.settings, map).rgb);
+}
+
+TEST_F(GpuTest, TheRefractionMapMethodWithoutABakedMapIsAnError) {
+  Baked b = bakeEye(context());
+  render::Renderer renderer(context(), b.scene, b.pose);
+  render::FrameRequest request;
+  request.pose = &b.pose;
+  request.views.push_back(render::methodView(render::Method::RefractionMap, b.settings, render::RasterOptions{}));
+  try {
+    renderer.submit(request);
+    FAIL() << "a refraction-map view drew without a map";
+  } catch (const std::exception& e) {
+    EXPECT_NE(std::string(e.what()).find("Renderer::bakeRefractionMap"), std::string::npos) << e.what();
+  }
+}
+
 // Baked at 0 s and drawn at later times, the eye has moved under the map:
 // the error grows with the drift, and the method does no trace.
 TEST_F(GpuTest, TheMapsErrorGrowsAsThePoseDriftsFromTheBakedOne) {
   Baked b = bakeEye(context());
-  render::RefractionMapBuffer map = bake::uploadRefractionMap(context(), b.bake);
+  render::RefractionMapBuffer map = render::uploadRefractionMap(context(), b.bake);
   double duration = scene::animationDuration(b.scene);
   ASSERT_GT(duration, 0.0);
   std::vector<double> within;

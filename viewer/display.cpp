@@ -22,9 +22,17 @@ namespace snell::viewer {
 static_assert(sizeof(gpu::PresentPush) == 48 && offsetof(gpu::PresentPush, gate) == 16 &&
               offsetof(gpu::PresentPush, flags) == 32);
 
+// A shown viewport's view in the frame request (frameRequest): viewports
+// without a size have none.
+static size_t viewIndexOf(const std::vector<Viewport>& viewports, size_t viewport) {
+  size_t index = 0;
+  for (size_t i = 0; i < viewport; ++i) index += viewports[i].width ? 1 : 0;
+  return index;
+}
+
 // refraction-map's maps, baked by the trace at the pose and views of now
-// for viewports that have none of their size (or all, after B). The frames in
-// flight finish first: they may read the maps replaced.
+// for viewports that have none of their size (or all, after B); the renderer
+// keeps them, one per view, as the scene and the camera move on.
 void Viewer::bakeRefractionMaps() {
   bool wanted = toggles_.refraction && toggles_.method == render::Method::RefractionMap;
   if (!wanted) {
@@ -35,25 +43,21 @@ void Viewer::bakeRefractionMaps() {
   for (size_t i = 0; i < viewports_.size(); ++i) {
     const Viewport& vp = viewports_[i];
     if (!vp.width) continue;
-    const render::RefractionMapBuffer* map = i < maps_.size() ? maps_[i].get() : nullptr;
-    if (rebake_ || !map || map->width != vp.width || map->height != vp.height) due.push_back(i);
+    const render::RefractionBake& map = renderer_->refractionMap(viewIndexOf(viewports_, i));
+    if (rebake_ || map.width != vp.width || map.height != vp.height) due.push_back(i);
   }
   rebake_ = false;
   if (due.empty()) return;
   if (pendingFrame_) noteFrame(renderer_->wait(pendingFrame_), pendingCpuMs_);
   pendingFrame_ = 0;
-  renderer_->finish();
-  if (maps_.size() < viewports_.size()) maps_.resize(viewports_.size());
   for (size_t i : due) {
     const Viewport& vp = viewports_[i];
     render::FrameSettings settings{vp.width, vp.height, viewOf(vp), glm::vec3(scene::kDefaultBackground), gpu::kDefaultMaxInterfaces};
-    bake::RefractionBake baked = bake::bakeRefraction(*renderer_, pose_, settings);
-    maps_[i] = std::make_unique<render::RefractionMapBuffer>(bake::uploadRefractionMap(*context_, baked));
+    const render::RefractionBake& baked = renderer_->bakeRefractionMap(pose_, settings, viewIndexOf(viewports_, i));
     char when[32];
     std::snprintf(when, sizeof when, "%.2f s", pose_.time);
     message_ = "refraction map baked at " + std::string(when) + ": " + bake::describe(baked, *scene_);
   }
-  renderer_->invalidateViews();
 }
 
 // The frame the renderer runs: one composite view per viewport shown, then
@@ -66,8 +70,6 @@ render::FrameRequest Viewer::frameRequest(std::optional<uint32_t> swapImage, boo
     render::FrameSettings settings{vp.width, vp.height, viewOf(vp), glm::vec3(scene::kDefaultBackground), gpu::kDefaultMaxInterfaces};
     render::RasterOptions raster;
     raster.wireframe = toggles_.wireframe;
-    size_t index = size_t(&vp - viewports_.data());
-    if (index < maps_.size()) raster.refractionMap = maps_[index].get();
     render::ViewRequest view =
         render::methodViewport(toggles_.refraction ? toggles_.method : render::Method::None, settings, raster);
     // The heat map counts nodes for every pixel, so it traces them all.

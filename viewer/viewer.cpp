@@ -150,7 +150,6 @@ void Viewer::useScene(std::unique_ptr<scene::Scene> scene, int camera) {
 
   if (renderer_) vkDeviceWaitIdle(context_->device());
   pendingFrame_ = 0;  // its numbers belong to the renderer that goes
-  maps_.clear();
   renderer_ = std::move(renderer);  // the old renderer goes before the scene it refers to
   scene_ = std::move(scene);
   pose_ = std::move(pose);

@@ -167,9 +167,6 @@ class Viewer {
   render::FrameStats lastStats_;
   uint64_t pendingFrame_ = 0;  ///< the renderer's frame submitted last, not yet waited for
   double pendingCpuMs_ = 0;
-  /// refraction-map: per viewport, the map the trace baked when the method was
-  /// picked (or B pressed); it stays as the scene and the camera move on.
-  std::vector<std::unique_ptr<render::RefractionMapBuffer>> maps_;
   bool rebake_ = false;
   double fps_ = 0;
   /// The overlay's frame-time graph: the latest frames' times in ms, a ring.

@@ -444,8 +444,6 @@ struct Renderer::Impl {
   std::map<size_t, glm::dmat4> transforms;  ///< setTransform's, kept over setTime
   std::optional<KeptVertices> kept;
   std::unique_ptr<render::Renderer> renderer;
-  /// The refraction-map method's map, baked at the first frame that draws it.
-  render::RefractionMapBuffer map;
   FrameInfo last;
   std::string method;      ///< the last request's method
   std::optional<render::AutoMethod> chooser;  ///< method "auto": trace or driver-rt, timed over the first frames
@@ -536,16 +534,14 @@ struct Renderer::Impl {
     method = render::methodName(m);
     render::RasterOptions raster;
     if (viewport && view.transparentBackground) settings.background = glm::vec3(0.0f), settings.backgroundAlpha = 0.0f;
-    if (m == render::Method::RefractionMap) {
-      bakeMap(settings);
-      raster.refractionMap = &map;
-    }
+    if (m == render::Method::RefractionMap) bakeMap(settings);
     return viewport ? render::methodViewport(m, settings, raster) : render::methodView(m, settings, raster);
   }
 
   // The refraction-map method's map: the trace of this view at this pose,
-  // baked once per view size.
+  // baked once per view size; the renderer keeps it.
   void bakeMap(const render::FrameSettings& settings) {
+    const render::RefractionBake& map = renderer->refractionMap();
     if (map.width == settings.width && map.height == settings.height) return;
     if (kept && !kept->pending.empty()) {  // the bake's frame has no prologue: copy the vertices first
       render::FrameRequest flush;
@@ -555,8 +551,7 @@ struct Renderer::Impl {
     }
     render::FrameSettings traced = settings;
     traced.backgroundAlpha = 1.0f;
-    map = bake::uploadRefractionMap(context, bake::bakeRefraction(*renderer, pose, traced));
-    renderer->invalidateViews();
+    renderer->bakeRefractionMap(pose, traced);
   }
 
   void note(const render::FrameResult& result) {

@@ -11,10 +11,6 @@ namespace snell::bake {
 
 namespace {
 
-bool landsOnTexture(const gpu::RefractionTexel& t) {
-  return t.material != gpu::kNoHit && std::isfinite(t.u) && std::isfinite(t.v);
-}
-
 // A coordinate wrapped into [0, 1] the way a sampler wraps it.
 double wrapped(double x, bool repeat, bool mirror) {
   if (mirror) {
@@ -30,57 +26,6 @@ constexpr uint8_t kHalf8 = 128;
 
 }  // namespace
 
-Coverage RefractionBake::coverage(size_t pixel) const {
-  const gpu::RefractionTexel& t = texels[pixel];
-  if (t.shine.w == 0.0f) return Coverage::Empty;
-  return landsOnTexture(t) && t.material == behindMaterial ? Coverage::Lands : Coverage::Marked;
-}
-
-size_t RefractionBake::count(Coverage c) const {
-  size_t n = 0;
-  for (size_t i = 0; i < texels.size(); ++i) n += coverage(i) == c;
-  return n;
-}
-
-RefractionBake bakeFromAov(uint32_t width, uint32_t height, const std::vector<gpu::TraceAov>& aov,
-                           const scene::Scene& scene) {
-  if (aov.size() != size_t(width) * height) throw std::invalid_argument("bake: the AOVs do not fill the image");
-  RefractionBake bake;
-  bake.width = width;
-  bake.height = height;
-  bake.texels.resize(aov.size());
-  std::map<uint32_t, size_t> landings;
-  for (size_t i = 0; i < aov.size(); ++i) {
-    const gpu::TraceAov& a = aov[i];
-    gpu::RefractionTexel& t = bake.texels[i];
-    t.material = gpu::kNoHit;
-    t.u = t.v = std::numeric_limits<float>::quiet_NaN();
-    // The visible face is glass where the primary ray crossed an interface first.
-    if (a.interfaces == 0) continue;
-    t.shine = glm::vec4(a.shineR, a.shineG, a.shineB, 1.0f);
-    t.weight = glm::vec4(a.weightR, a.weightG, a.weightB, a.landingLod);
-    t.material = a.landingMaterial;
-    t.u = a.landingU;
-    t.v = a.landingV;
-    if (t.material != gpu::kNoHit && t.material >= scene.materials.size()) {
-      throw std::runtime_error("bake: pixel " + std::to_string(i) + " landed on material " + std::to_string(t.material) +
-                               " of " + std::to_string(scene.materials.size()));
-    }
-    if (landsOnTexture(t)) ++landings[t.material];
-  }
-  size_t most = 0;
-  for (const auto& [material, n] : landings) {
-    if (n > most) most = n, bake.behindMaterial = material;
-  }
-  return bake;
-}
-
-RefractionBake bakeRefraction(render::Renderer& renderer, const scene::Pose& pose,
-                              const render::FrameSettings& settings) {
-  render::RenderedFrame frame = render::renderFrame(renderer, pose, settings, true);
-  return bakeFromAov(frame.width, frame.height, frame.aov, renderer.scene());
-}
-
 std::string describe(const RefractionBake& bake, const scene::Scene& scene) {
   size_t lands = bake.count(Coverage::Lands), marked = bake.count(Coverage::Marked);
   std::string text = std::to_string(lands + marked) + " glass pixels";
@@ -93,17 +38,6 @@ std::string describe(const RefractionBake& bake, const scene::Scene& scene) {
   return text + "; " + std::to_string(lands) + " land on material " + named(m.name, bake.behindMaterial) +
          " (its texture " + named(t.name, uint32_t(m.baseColorTexture.texture)) + ", " + std::to_string(t.width) + "x" +
          std::to_string(t.height) + "), " + std::to_string(marked) + " marked (no texel of it behind)";
-}
-
-render::RefractionMapBuffer uploadRefractionMap(vk::Context& context, const RefractionBake& bake) {
-  render::RefractionMapBuffer map;
-  map.width = bake.width;
-  map.height = bake.height;
-  VkDeviceSize bytes = bake.texels.size() * sizeof(gpu::RefractionTexel);
-  map.texels = vk::Buffer(context, {bytes, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
-                                    vk::MemoryDomain::Device, "refraction map"});
-  vk::upload(context, map.texels, bake.texels.data(), bytes);
-  return map;
 }
 
 glm::dvec2 storedUv(const RefractionBake& bake, size_t pixel, const scene::Scene& scene) {

@@ -1,16 +1,11 @@
-// Baking a refraction map from the trace (issue 16): a trace of every pixel
-// at one pose and view, with its AOVs, says per pixel whether the visible
-// face is glass, where the refracted path landed and on which texture, and
-// how the traced colour splits into what the texture's colour is multiplied
-// by (weight) and what is added whatever it holds (shine). Nothing is
-// filtered or anti-aliased: a filtered map cracks.
-//
-// The map as the raster pass's refraction-map method reads it lives on the
-// GPU (render::RefractionMapBuffer); as a file it holds only the UVs and
-// their coverage, in one of refraction_map.h's encodings.
+// Refraction maps as files: the renderer bakes the map
+// (render/refraction_map.h, Renderer::bakeRefractionMap); a file holds only
+// its UVs and their coverage, in one of refraction_map.h's encodings, and the
+// DCC route bakes one through a UV gradient instead.
 #pragma once
 
 #include "bake/refraction_map.h"
+#include "render/refraction_map.h"
 #include "render/raster_pass.h"
 #include "render/renderer.h"
 #include "scene/evaluate.h"
@@ -29,40 +24,13 @@
 
 namespace snell::bake {
 
-/// What a baked pixel holds, as a map file's alpha says it.
-enum class Coverage : uint8_t {
-  Empty,   ///< the visible face is not glass (alpha 0)
-  Marked,  ///< glass, but the path lands on no texel of the texture behind (alpha 1/2): not guessed
-  Lands,   ///< glass, and the UV where its path lands on the texture behind (alpha 1)
-};
-
-struct RefractionBake {
-  uint32_t width = 0, height = 0;
-  /// Per pixel, row 0 at the top, as the raster pass reads them.
-  std::vector<gpu::RefractionTexel> texels;
-  /// The texture behind: the material whose base colour texture most paths
-  /// land on (gpu::kNoHit: none did). A map file's UVs are in its texture.
-  uint32_t behindMaterial = gpu::kNoHit;
-
-  /// Lands only where the path lands on `behindMaterial`'s texture.
-  Coverage coverage(size_t pixel) const;
-  size_t count(Coverage c) const;
-};
-
-/// The bake of a trace's AOVs (width * height, row 0 at the top).
-RefractionBake bakeFromAov(uint32_t width, uint32_t height, const std::vector<gpu::TraceAov>& aov,
-                           const scene::Scene& scene);
-
-/// Traces every pixel of `settings` at `pose` and bakes it (waits for the GPU).
-RefractionBake bakeRefraction(render::Renderer& renderer, const scene::Pose& pose,
-                              const render::FrameSettings& settings);
+// The bake is the renderer's; this layer names it as its own.
+using render::Coverage;
+using render::RefractionBake;
 
 /// One line for a user: "N glass pixels; L land on 'iris' (its texture 'x',
 /// WxH), M marked (no texel of it behind)".
 std::string describe(const RefractionBake& bake, const scene::Scene& scene);
-
-/// The bake on the GPU, for RasterOptions::refractionMap.
-render::RefractionMapBuffer uploadRefractionMap(vk::Context& context, const RefractionBake& bake);
 
 /// A pixel's UV as map files store it: wrapped into [0, 1] the way the
 /// texture behind's sampler wraps it (repeat, mirrored repeat or clamp).

@@ -208,7 +208,7 @@ int runExportWeb(const Options& o) {
   BakeSetup setup = prepareBake("export-web", o.shot, o.material);
   const auto& [scene, material, start, pose, view, context, settings] = setup;
   render::Renderer renderer(*context, scene, pose);
-  bake::RefractionBake baked = bake::bakeRefraction(renderer, pose, settings);
+  bake::RefractionBake baked = renderer.bakeRefractionMap(pose, settings);
   if (material) baked.behindMaterial = *material;
   if (baked.count(bake::Coverage::Lands) == 0) {
     throw std::runtime_error("export-web: " + view.description + ": " + bake::describe(baked, scene) +
@@ -216,10 +216,7 @@ int runExportWeb(const Options& o) {
   }
 
   // The viewport's picture at the baked pose, for everything but the glass that lands.
-  render::RefractionMapBuffer map = bake::uploadRefractionMap(*context, baked);
-  render::RasterOptions raster;
-  raster.refractionMap = &map;
-  render::ViewRequest request = render::methodView(render::Method::RefractionMap, settings, raster);
+  render::ViewRequest request = render::methodView(render::Method::RefractionMap, settings, render::RasterOptions{});
   request.readback.enabled = true;
   render::FrameRequest frame;
   frame.pose = &pose;

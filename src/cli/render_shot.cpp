@@ -217,9 +217,7 @@ class Worker {
       scene::View bakeView = o_.shot.resolveView("render", scene, bakePose);
       render::FrameSettings settings{o_.shot.width, o_.shot.height, bakeView, o_.shot.background, o_.shot.maxInterfaces};
       settings.optics = o_.optics;
-      bake::RefractionBake baked = bake::bakeRefraction(*renderer_, bakePose, settings);
-      map_ = bake::uploadRefractionMap(*context_, baked);
-      raster_.refractionMap = &map_;
+      const render::RefractionBake& baked = renderer_->bakeRefractionMap(bakePose, settings);
       if (id_ == 0) std::printf("baked the refraction map at %g s: %s\n", t, bake::describe(baked, scene).c_str());
     }
   }
@@ -350,7 +348,6 @@ class Worker {
   render::RasterOptions raster_;
   std::unique_ptr<vk::Context> context_;
   std::unique_ptr<render::Renderer> renderer_;
-  render::RefractionMapBuffer map_;
   std::optional<render::AutoMethod> chooser_;
   WorkerReport report_;
   std::exception_ptr error_;

@@ -93,7 +93,7 @@ gpu::RasterPush RasterPass::push(const RasterScene& scene, const FrameSettings& 
   if (options.refraction) push.flags |= uint32_t(options.screenSpace);
   if (options.refraction && options.screenSpace == ScreenSpace::RefractionMap) {
     if (!options.refractionMap || options.refractionMap->width == 0 || options.refractionMap->height == 0) {
-      throw vk::VulkanError("raster pass: the refraction-map method needs a baked map (RasterOptions::refractionMap)");
+      throw vk::VulkanError("raster pass: the refraction-map method needs a baked map (Renderer::bakeRefractionMap)");
     }
     push.mapWidth = options.refractionMap->width;
     push.mapHeight = options.refractionMap->height;

@@ -7,6 +7,7 @@
 #pragma once
 
 #include "render/frame_settings.h"
+#include "render/refraction_map.h"
 #include "render/scene_gpu.h"
 #include "scene/scene.h"
 #include "scene/view.h"
@@ -42,13 +43,6 @@ enum class ScreenSpace : uint32_t {
   RefractionMap = gpu::kRasterFlagRefractionMap,
 };
 
-/// A baked refraction map on the GPU, as the raster pass reads it: one
-/// gpu::RefractionTexel per baked pixel, row 0 at the top (bake/refraction_bake.h makes it).
-struct RefractionMapBuffer {
-  vk::Buffer texels;
-  uint32_t width = 0, height = 0;
-};
-
 /// Perspective: the near and far planes' distances. Orthographic: the depth
 /// range along the view's forward axis.
 struct DepthRange {
@@ -62,9 +56,10 @@ struct RasterOptions {
   bool refraction = true;
   /// With refraction: a screen-space approximation instead of the trace.
   ScreenSpace screenSpace = ScreenSpace::Off;
-  /// RefractionMap's map, owned by the caller while frames that read it are in
-  /// flight. A map baked again into the same object is new content the
-  /// renderer cannot see: call Renderer::invalidateViews() after.
+  /// RefractionMap's map: unset, the one Renderer::bakeRefractionMap last
+  /// baked. A map of the caller's own stays theirs while frames that read it
+  /// are in flight; new content in the same object is invisible to the
+  /// renderer: call Renderer::invalidateViews() after.
   const RefractionMapBuffer* refractionMap = nullptr;
   /// NormalOffset's displacement per unit of normal, in image heights.
   float offsetStrength = 0.02f;

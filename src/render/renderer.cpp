@@ -128,6 +128,24 @@ void Renderer::invalidateViews() {
   for (View& v : views_) v.rendered = false;
 }
 
+const RefractionBake& Renderer::bakeRefractionMap(const scene::Pose& pose, const FrameSettings& settings,
+                                                  size_t view) {
+  RenderedFrame frame = renderFrame(*this, pose, settings, true);
+  KeptMap map;
+  map.bake = bakeFromAov(frame.width, frame.height, frame.aov, sceneModel_);
+  map.buffer = uploadRefractionMap(context_, map.bake);
+  finish();  // no frame in flight reads the old map when it goes
+  if (maps_.size() <= view) maps_.resize(view + 1);
+  maps_[view] = std::move(map);
+  invalidateViews();  // a view that reads a kept map sees a new one through the same pointer
+  return maps_[view].bake;
+}
+
+const RefractionBake& Renderer::refractionMap(size_t view) const {
+  static const RefractionBake none;
+  return view < maps_.size() ? maps_[view].bake : none;
+}
+
 void Renderer::markDirty(int shape) {
   if (shape < 0 || size_t(shape) >= sceneModel_.shapes.size()) {
     throw std::invalid_argument("renderer: no shape " + std::to_string(shape) + " to mark dirty");
@@ -396,6 +414,9 @@ void Renderer::recordView(vk::Commands& commands, Slot& slot, size_t index, cons
       recordTrace(commands, request, view, false, stats);
     } else {
       RasterOptions raster = request.raster;
+      if (!raster.refractionMap && index < maps_.size() && maps_[index].buffer.width > 0) {
+        raster.refractionMap = &maps_[index].buffer;
+      }
       if (!raster.depth) {
         // Near and far planes around the items' spheres at this pose: loose
         // enough for any deformation, and reverse Z keeps the precision.

@@ -187,6 +187,15 @@ class Renderer {
 
   /// Forces the next frame that needs trees to rebuild every tree.
   void invalidateTrees();
+  /// The refraction-map method's map for view `view` of later frames: every
+  /// pixel of `settings` traced at `pose` with its AOVs, and baked (waits for
+  /// the GPU). The renderer keeps the last one baked per view, which that
+  /// view reads where its RasterOptions name no map of their own, and
+  /// redraws the views with it.
+  const RefractionBake& bakeRefractionMap(const scene::Pose& pose, const FrameSettings& settings, size_t view = 0);
+  /// The map kept for view `view` (empty, 0 x 0, before one is baked).
+  const RefractionBake& refractionMap(size_t view = 0) const;
+
   /// Forces the next frame to redraw every view, even one that nothing
   /// changed for (for tools that change GPU data behind the renderer's back).
   void invalidateViews();
@@ -237,6 +246,11 @@ class Renderer {
   vk::Buffer instances_, lights_;
   uint32_t lightCount_ = 0;
   bool refractive_ = false;
+  struct KeptMap {
+    RefractionBake bake;
+    RefractionMapBuffer buffer;
+  };
+  std::vector<KeptMap> maps_;  ///< per view index, baked by bakeRefractionMap
 
   // What the GPU holds, to find what changed.
   struct ItemState {
