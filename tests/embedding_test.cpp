@@ -3,6 +3,8 @@
 // deformation, and an adopted device rendering into the host's image.
 #include "hand_made_device.h"
 
+#include "io/image_compare.h"
+#include "io/image_file.h"
 #include "scene/evaluate.h"
 #include "scene/gltf_writer.h"
 #include "scene/procedural_eye.h"
@@ -170,20 +172,15 @@ struct HostEye {
   }
 };
 
-struct ImageDifference {
-  float largest = 0;
-  size_t over = 0;  ///< pixels with a channel more than the tolerance apart
-};
-
-ImageDifference compare(const std::vector<float>& a, const std::vector<float>& b, float tolerance) {
-  ImageDifference d;
-  for (size_t p = 0; p + 3 < a.size() && p + 3 < b.size(); p += 4) {
-    float worst = 0;
-    for (int c = 0; c < 3; ++c) worst = std::max(worst, std::abs(a[p + size_t(c)] - b[p + size_t(c)]));
-    d.largest = std::max(d.largest, worst);
-    if (worst > tolerance) ++d.over;
-  }
-  return d;
+// Two of the API's RGBA float images of `view` compared as PNGs would hold
+// them, by the comparator every image test uses (io/image_compare.h).
+io::ImageDifference compare(const snell::View& view, const std::vector<float>& want, const std::vector<float>& got) {
+  auto srgb = [&](const std::vector<float>& rgba) {
+    io::LinearImage image{view.width, view.height, {}, {}};
+    for (size_t p = 0; p + 3 < rgba.size(); p += 4) image.rgba.emplace_back(rgba[p], rgba[p + 1], rgba[p + 2], rgba[p + 3]);
+    return io::toSrgb8(image);
+  };
+  return io::compareImages(srgb(got), srgb(want));
 }
 
 TEST(Embedding, HostBufferMeshesFollowTheHostsDeformationLikeTheGltfMorphAndSkin) {
@@ -206,7 +203,7 @@ TEST(Embedding, HostBufferMeshesFollowTheHostsDeformationLikeTheGltfMorphAndSkin
       std::vector<float> expected = fileRenderer.read(view);
       if (first.empty()) first = expected;
       if (time > 0 && output == snell::View::Output::Trace) {
-        EXPECT_GT(compare(first, expected, 2.0f / 255.0f).over, 50u) << "the eye hardly moved: the test would not see a host that stands still";
+        EXPECT_GT(compare(view, first, expected).over1, 50u) << "the eye hardly moved: the test would not see a host that stands still";
       }
       hostEye.deformTo(time, hostRenderer);
       std::vector<float> got = hostRenderer.read(view);
@@ -215,12 +212,12 @@ TEST(Embedding, HostBufferMeshesFollowTheHostsDeformationLikeTheGltfMorphAndSkin
       }
       // Float deformation on the host against the deform pass's: the same to
       // rounding, so a few silhouette pixels at most may flip.
-      ImageDifference d = compare(expected, got, 2.0f / 255.0f);
-      EXPECT_LE(d.over, 3u) << "time " << time << (output == snell::View::Output::Trace ? " trace" : " viewport")
-                            << ": largest difference " << d.largest;
-      std::printf("time %.1f %s: %zu of %zu pixels over 2/255, largest %.5f\n", time,
-                  output == snell::View::Output::Trace ? "trace" : "viewport", d.over, expected.size() / 4,
-                  double(d.largest));
+      io::ImageDifference d = compare(view, expected, got);
+      EXPECT_LE(d.over1, 3u) << "time " << time << (output == snell::View::Output::Trace ? " trace" : " viewport")
+                             << ": largest difference " << d.maximum << "/255";
+      std::printf("time %.1f %s: %llu of %llu pixels over 1/255, largest %d/255\n", time,
+                  output == snell::View::Output::Trace ? "trace" : "viewport", (unsigned long long)d.over1,
+                  (unsigned long long)d.pixels, d.maximum);
     }
   }
   EXPECT_EQ(device.validationMessages(), 0u);
