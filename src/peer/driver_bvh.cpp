@@ -39,6 +39,21 @@ VkDeviceSize scratchAlignment(vk::Context& context) {
   return std::max<VkDeviceSize>(properties.minAccelerationStructureScratchOffsetAlignment, 1);
 }
 
+// A build (or update) of one geometry, as sized and as recorded; the caller
+// names the structures and the scratch.
+VkAccelerationStructureBuildGeometryInfoKHR geometryInfo(VkAccelerationStructureTypeKHR type,
+                                                         VkBuildAccelerationStructureFlagsKHR flags,
+                                                         const VkAccelerationStructureGeometryKHR& geometry,
+                                                         bool update = false) {
+  VkAccelerationStructureBuildGeometryInfoKHR info{VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_BUILD_GEOMETRY_INFO_KHR};
+  info.type = type;
+  info.flags = flags;
+  info.mode = update ? VK_BUILD_ACCELERATION_STRUCTURE_MODE_UPDATE_KHR : VK_BUILD_ACCELERATION_STRUCTURE_MODE_BUILD_KHR;
+  info.geometryCount = 1;
+  info.pGeometries = &geometry;
+  return info;
+}
+
 }  // namespace
 
 DriverStructure::DriverStructure(vk::Context& context, VkAccelerationStructureTypeKHR type, VkDeviceSize bytes,
@@ -95,12 +110,8 @@ DriverBlas::DriverBlas(vk::Context& context, const vk::Buffer& positions, uint32
            (mode == DriverBuild::FastBuild ? VK_BUILD_ACCELERATION_STRUCTURE_PREFER_FAST_BUILD_BIT_KHR
                                            : VK_BUILD_ACCELERATION_STRUCTURE_PREFER_FAST_TRACE_BIT_KHR);
 
-  VkAccelerationStructureBuildGeometryInfoKHR info{VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_BUILD_GEOMETRY_INFO_KHR};
-  info.type = VK_ACCELERATION_STRUCTURE_TYPE_BOTTOM_LEVEL_KHR;
-  info.flags = flags_;
-  info.mode = VK_BUILD_ACCELERATION_STRUCTURE_MODE_BUILD_KHR;
-  info.geometryCount = 1;
-  info.pGeometries = &geometry_;
+  VkAccelerationStructureBuildGeometryInfoKHR info =
+      geometryInfo(VK_ACCELERATION_STRUCTURE_TYPE_BOTTOM_LEVEL_KHR, flags_, geometry_);
   VkAccelerationStructureBuildSizesInfoKHR sizes{VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_BUILD_SIZES_INFO_KHR};
   sizesOf(context.device(), VK_ACCELERATION_STRUCTURE_BUILD_TYPE_DEVICE_KHR, &info, &triangleCount_, &sizes);
   structureBytes_ = sizes.accelerationStructureSize;
@@ -116,14 +127,10 @@ void DriverBlas::recordBuild(vk::Commands& commands) { record(commands, false); 
 void DriverBlas::recordUpdate(vk::Commands& commands) { record(commands, true); }
 
 VkAccelerationStructureBuildGeometryInfoKHR DriverBlas::buildInfo(bool update) const {
-  VkAccelerationStructureBuildGeometryInfoKHR info{VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_BUILD_GEOMETRY_INFO_KHR};
-  info.type = VK_ACCELERATION_STRUCTURE_TYPE_BOTTOM_LEVEL_KHR;
-  info.flags = flags_;
-  info.mode = update ? VK_BUILD_ACCELERATION_STRUCTURE_MODE_UPDATE_KHR : VK_BUILD_ACCELERATION_STRUCTURE_MODE_BUILD_KHR;
+  VkAccelerationStructureBuildGeometryInfoKHR info =
+      geometryInfo(VK_ACCELERATION_STRUCTURE_TYPE_BOTTOM_LEVEL_KHR, flags_, geometry_, update);
   info.srcAccelerationStructure = update ? structure_->handle() : VK_NULL_HANDLE;
   info.dstAccelerationStructure = structure_->handle();
-  info.geometryCount = 1;
-  info.pGeometries = &geometry_;
   info.scratchData.deviceAddress = structure_->scratchAddress();
   return info;
 }
@@ -155,15 +162,9 @@ VkAccelerationStructureGeometryKHR instanceGeometry(const vk::Buffer& instances)
   return geometry;
 }
 
-// A top-level build over `geometry`, as sized and as recorded.
 VkAccelerationStructureBuildGeometryInfoKHR topLevelInfo(const VkAccelerationStructureGeometryKHR& geometry) {
-  VkAccelerationStructureBuildGeometryInfoKHR info{VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_BUILD_GEOMETRY_INFO_KHR};
-  info.type = VK_ACCELERATION_STRUCTURE_TYPE_TOP_LEVEL_KHR;
-  info.flags = VK_BUILD_ACCELERATION_STRUCTURE_PREFER_FAST_TRACE_BIT_KHR;
-  info.mode = VK_BUILD_ACCELERATION_STRUCTURE_MODE_BUILD_KHR;
-  info.geometryCount = 1;
-  info.pGeometries = &geometry;
-  return info;
+  return geometryInfo(VK_ACCELERATION_STRUCTURE_TYPE_TOP_LEVEL_KHR, VK_BUILD_ACCELERATION_STRUCTURE_PREFER_FAST_TRACE_BIT_KHR,
+                      geometry);
 }
 
 }  // namespace

@@ -259,22 +259,14 @@ std::unique_ptr<Context> Context::create(const ContextDesc& desc) {
   features.features.fillModeNonSolid = supported.features.fillModeNonSolid;
 
   std::vector<const char*> extensions;
-  {
-    uint32_t count = 0;
-    VK_CHECK(vkEnumerateDeviceExtensionProperties(physical, nullptr, &count, nullptr));
-    std::vector<VkExtensionProperties> available(count);
-    VK_CHECK(vkEnumerateDeviceExtensionProperties(physical, nullptr, &count, available.data()));
-    for (const std::string& e : desc.deviceExtensions) {
-      bool found = std::any_of(available.begin(), available.end(),
-                               [&](const VkExtensionProperties& a) { return e == a.extensionName; });
-      if (!found) throw VulkanError(chosen.name + " lacks the device extension " + e);
-      extensions.push_back(e.c_str());
-    }
-    for (const std::string& e : desc.optionalDeviceExtensions) {
-      bool found = std::any_of(available.begin(), available.end(),
-                               [&](const VkExtensionProperties& a) { return e == a.extensionName; });
-      if (found) extensions.push_back(e.c_str()), c.optionalEnabled_.push_back(e);
-    }
+  const std::set<std::string> available = deviceExtensions(physical);
+  auto has = [&](const std::string& name) { return available.count(name) > 0; };
+  for (const std::string& e : desc.deviceExtensions) {
+    if (!has(e)) throw VulkanError(chosen.name + " lacks the device extension " + e);
+    extensions.push_back(e.c_str());
+  }
+  for (const std::string& e : desc.optionalDeviceExtensions) {
+    if (has(e)) extensions.push_back(e.c_str()), c.optionalEnabled_.push_back(e);
   }
   VkPhysicalDevicePipelineExecutablePropertiesFeaturesKHR executableInfo{
       VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PIPELINE_EXECUTABLE_PROPERTIES_FEATURES_KHR};
@@ -292,14 +284,6 @@ std::unique_ptr<Context> Context::create(const ContextDesc& desc) {
       VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_RAY_TRACING_PIPELINE_FEATURES_KHR};
   bool driverAcceleration = false, driverRayTracing = false;
   if (desc.driverAccelerationStructures || desc.driverRayTracing) {
-    uint32_t count = 0;
-    VK_CHECK(vkEnumerateDeviceExtensionProperties(physical, nullptr, &count, nullptr));
-    std::vector<VkExtensionProperties> available(count);
-    VK_CHECK(vkEnumerateDeviceExtensionProperties(physical, nullptr, &count, available.data()));
-    auto has = [&](const char* name) {
-      return std::any_of(available.begin(), available.end(),
-                         [&](const VkExtensionProperties& a) { return std::string(a.extensionName) == name; });
-    };
     VkPhysicalDeviceRayTracingPipelineFeaturesKHR supportedRayTracing{
         VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_RAY_TRACING_PIPELINE_FEATURES_KHR};
     VkPhysicalDeviceAccelerationStructureFeaturesKHR supportedAcceleration{

@@ -77,6 +77,16 @@ std::string versionString(uint32_t v) {
   return text.str();
 }
 
+std::set<std::string> deviceExtensions(VkPhysicalDevice device) {
+  uint32_t count = 0;
+  VK_CHECK(vkEnumerateDeviceExtensionProperties(device, nullptr, &count, nullptr));
+  std::vector<VkExtensionProperties> properties(count);
+  VK_CHECK(vkEnumerateDeviceExtensionProperties(device, nullptr, &count, properties.data()));
+  std::set<std::string> names;
+  for (const VkExtensionProperties& p : properties) names.insert(p.extensionName);
+  return names;
+}
+
 DeviceFacts readDeviceFacts(VkPhysicalDevice device, uint32_t index) {
   DeviceFacts facts;
   facts.index = index;
@@ -111,14 +121,8 @@ DeviceFacts readDeviceFacts(VkPhysicalDevice device, uint32_t index) {
     return facts;  // the 1.2/1.3 property structs below may not be chained on it
   }
 
-  uint32_t extensionCount = 0;
-  VK_CHECK(vkEnumerateDeviceExtensionProperties(device, nullptr, &extensionCount, nullptr));
-  std::vector<VkExtensionProperties> extensions(extensionCount);
-  VK_CHECK(vkEnumerateDeviceExtensionProperties(device, nullptr, &extensionCount, extensions.data()));
-  auto hasExtension = [&](const char* name) {
-    return std::any_of(extensions.begin(), extensions.end(),
-                       [&](const VkExtensionProperties& e) { return std::strcmp(e.extensionName, name) == 0; });
-  };
+  const std::set<std::string> extensions = deviceExtensions(device);
+  auto hasExtension = [&](const char* name) { return extensions.count(name) > 0; };
 
   VkPhysicalDevicePCIBusInfoPropertiesEXT pci{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PCI_BUS_INFO_PROPERTIES_EXT};
   bool hasPci = hasExtension(VK_EXT_PCI_BUS_INFO_EXTENSION_NAME);

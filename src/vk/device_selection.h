@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <optional>
 #include <span>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -41,6 +42,9 @@ struct DeviceFacts {
 /// Vulkan 1.3, a compute queue, subgroup basic/ballot/arithmetic in compute
 /// shaders, subgroupSizeControl, computeFullSubgroups and maintenance4.
 DeviceFacts readDeviceFacts(VkPhysicalDevice device, uint32_t index);
+
+/// The names of the device extensions `device` offers.
+std::set<std::string> deviceExtensions(VkPhysicalDevice device);
 
 /// The outcome of choosing: the chosen device (if any) and one line per device
 /// saying why it was or was not chosen.
