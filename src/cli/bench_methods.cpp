@@ -664,8 +664,7 @@ void addBenchMethods(CLI::App& bench, Runner& run) {
   sub->add_flag("--optics", o->optics, "rows per optics feature (trace) instead of per method")->excludes(methods);
   sub->add_flag("--no-reference", o->noReference, "time only: no CPU reference, no errors (for scaling runs)");
   sub->add_flag("--pipeline-stats", o->pipelineStats,
-                "print the driver's statistics of each trace pipeline (registers, spills), where it offers "
-                "them; pipelines that capture them can run slower, so time without it");
+                "print the driver's statistics of each trace pipeline (registers, spills), where it offers them");
   sub->add_option("--json", o->json, "write the results as JSON")->type_name("FILE");
   sub->add_option("--svg", o->svg,
                   "write a chart of time against error (log-log, the\nPareto front drawn) that a browser opens")
