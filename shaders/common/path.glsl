@@ -159,15 +159,21 @@ bool tracePath(vec3 origin, vec3 dir, float width, float spread, int channel, ou
     GpuMaterial m;
     bool opaque = false;
     float hitWidth = width + spread * hit.t;  // the cone where it meets the face
+    // The face's base colour texel, and an opaque face's light in two parts
+    // (phongParts), each from one call site whatever the branch below uses
+    // them: every call site is compiled in full, and the first image waits
+    // for the compile.
+    vec3 texel = vec3(1.0), shine = vec3(0.0), weight = vec3(0.0);
     if (hit.instance != kNoHit) {
       s = surfaceAt(hit);
       s.lods = coneLod(s.density, hitWidth, dot(dir, s.ng));
       m = materials[s.material];
       opaque = !refractive(m);
+      texel = textured(m.base, s.uvs, s.lods, true);
+      if (opaque) shine = phongParts(s.position, s.ns, s.uvs, s.lods, m, dir, pc.lightCount, pc.forward.xyz, weight);
     }
     if (reflecting) {  // an opaque face is shaded; a miss or glass sees the environment
-      path.colour += reflectedWeight * (opaque ? phong(s.position, s.ns, s.uvs, s.lods, m, dir, pc.lightCount, pc.forward.xyz)
-                                               : environmentColour(dir));
+      path.colour += reflectedWeight * (opaque ? shine + weight * texel : environmentColour(dir));
       reflecting = false;
       origin = parkedOrigin;
       dir = parkedDir;
@@ -195,9 +201,6 @@ bool tracePath(vec3 origin, vec3 dir, float width, float spread, int channel, ou
       path.firstPrimitive = hit.primitive - firstTriangleOf(hit.instance);
     }
     if (opaque) {
-      vec3 weight;
-      vec3 shine = phongParts(s.position, s.ns, s.uvs, s.lods, m, dir, pc.lightCount, pc.forward.xyz, weight);
-      vec3 texel = textured(m.base, s.uvs, s.lods, true);
       if (path.interfaces > 0u) {
         if (m.base.texture != kNoTexture) path.landing = textureUv(m.base, s.uvs);
         path.landingMaterial = s.material;
@@ -268,7 +271,7 @@ bool tracePath(vec3 origin, vec3 dir, float width, float spread, int channel, ou
         throughput *= 1.0 - r;
       }
     }
-    if (boundary) throughput *= baseColour(m, s.uvs, s.lods);
+    if (boundary) throughput *= m.baseColorFactor.rgb * texel;  // the base colour (baseColour()) of the texel above
     origin = leave(s, dir, tMin);
     skipInstance = hit.instance;
     skipPrim = hit.primitive;
