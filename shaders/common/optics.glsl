@@ -27,10 +27,11 @@ float mediumIor(uint material, int channel) {
   return channelIor(m.ior, m.dispersion, channel);
 }
 
-// The IOR of the material at a hit, its IOR texture applied.
-float surfaceIor(GpuMaterial m, vec4 uvs, vec2 lods, int channel) {
+// The IOR of the material at a hit, its IOR texture's value there (read by
+// the caller as bytes / 255) applied.
+float surfaceIor(GpuMaterial m, float iorTexel, int channel) {
   float ior = m.ior;
-  if (m.iorMap.texture != kNoTexture) ior = max(1.0, ior + m.iorOffset + m.iorScale * textured(m.iorMap, uvs, lods, false).r);
+  if (m.iorMap.texture != kNoTexture) ior = max(1.0, ior + m.iorOffset + m.iorScale * iorTexel);
   return channelIor(ior, m.dispersion, channel);
 }
 

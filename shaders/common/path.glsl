@@ -159,18 +159,23 @@ bool tracePath(vec3 origin, vec3 dir, float width, float spread, int channel, ou
     GpuMaterial m;
     bool opaque = false;
     float hitWidth = width + spread * hit.t;  // the cone where it meets the face
-    // The face's base colour texel, and an opaque face's light in two parts
-    // (phongParts), each from one call site whatever the branch below uses
-    // them: every call site is compiled in full, and the first image waits
-    // for the compile.
-    vec3 texel = vec3(1.0), shine = vec3(0.0), weight = vec3(0.0);
+    // The face's base colour texel, its second texture's (an opaque face's
+    // emissive one, glass's IOR map) and an opaque face's light in two parts
+    // (phongParts), each from one call site whatever the branches below use:
+    // every call site is compiled in full, and the first image waits for the
+    // compile.
+    vec3 texel = vec3(1.0), second = vec3(1.0), shine = vec3(0.0), weight = vec3(0.0);
     if (hit.instance != kNoHit) {
       s = surfaceAt(hit);
       s.lods = coneLod(s.density, hitWidth, dot(dir, s.ng));
       m = materials[s.material];
       opaque = !refractive(m);
-      texel = textured(m.base, s.uvs, s.lods, true);
-      if (opaque) shine = phongParts(s.position, s.ns, s.uvs, s.lods, m, dir, pc.lightCount, pc.forward.xyz, weight);
+      [[dont_unroll]] for (uint k = 0u; k < 2u; ++k) {
+        vec3 read = textured(k == 0u ? m.base : (opaque ? m.emissive : m.iorMap), s.uvs, s.lods, k == 0u || opaque);
+        if (k == 0u) texel = read;
+        else second = read;
+      }
+      if (opaque) shine = phongLight(s.position, s.ns, m, second, dir, pc.lightCount, pc.forward.xyz, weight);
     }
     if (reflecting) {  // an opaque face is shaded; a miss or glass sees the environment
       path.colour += reflectedWeight * (opaque ? shine + weight * texel : environmentColour(dir));
@@ -219,7 +224,7 @@ bool tracePath(vec3 origin, vec3 dir, float width, float spread, int channel, ou
     }
     bool entering = dot(dir, s.ng) < 0.0;
     bool boundary;  // a true boundary: the medium changes here
-    float surface = surfaceIor(m, s.uvs, s.lods, channel);
+    float surface = surfaceIor(m, second.r, channel);
     uint other = kNoHit;  // the material of the medium on the far side; kNoHit: air
     if (entering) {
       if (inside >= 0) other = media[inside];

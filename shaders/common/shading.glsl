@@ -6,6 +6,7 @@
 
 #ifndef SNELL_SHADING_GLSL
 #define SNELL_SHADING_GLSL
+#extension GL_EXT_control_flow_attributes : require
 
 #include "../shared/trace.h"
 
@@ -55,8 +56,14 @@ vec3 bilinear(GpuTexture tex, uint level, vec2 uv, bool srgb) {
   vec2 base = floor(p);
   vec2 f = p - base;
   int x = int(base.x), y = int(base.y);
-  vec3 top = mix(texel(tex, m, x, y, srgb), texel(tex, m, x + 1, y, srgb), f.x);
-  vec3 bottom = mix(texel(tex, m, x, y + 1, srgb), texel(tex, m, x + 1, y + 1, srgb), f.x);
+  // The four corners from one call site of texel(), rolled (see sampleTexture).
+  vec3 top, bottom, left;
+  [[dont_unroll]] for (int k = 0; k < 4; ++k) {
+    vec3 c = texel(tex, m, x + (k & 1), y + (k >> 1), srgb);
+    if (k == 1) top = mix(left, c, f.x);
+    if (k == 3) bottom = mix(left, c, f.x);
+    left = c;
+  }
   return mix(top, bottom, f.y);
 }
 
@@ -161,13 +168,15 @@ bool lightAt(uint i, uint lightCount, vec3 headlight, vec3 position, out vec3 l,
 // return value, and `weight`, what that texture's colour is multiplied by
 // (ambient and diffuse light times the base colour factor). A baked
 // refraction map redraws a landing from these two (TraceAov). `position` is
-// camera-relative, `ns` the shading normal, `lods` its textures' level of
-// detail, `lightCount` lights (0: the headlight shining along `headlight`).
-vec3 phongParts(vec3 position, vec3 ns, vec4 uvs, vec2 lods, GpuMaterial m, vec3 dir, uint lightCount, vec3 headlight,
+// camera-relative, `ns` the shading normal, `emissiveTexel` the emissive
+// texture's value there (the trace reads it beside the others: phongParts
+// reads it itself), `lightCount` lights (0: the headlight shining along
+// `headlight`).
+vec3 phongLight(vec3 position, vec3 ns, GpuMaterial m, vec3 emissiveTexel, vec3 dir, uint lightCount, vec3 headlight,
                 out vec3 weight) {
   vec3 n = dot(ns, dir) > 0.0 ? -ns : ns;  // towards the viewer
   vec3 v = -dir;
-  vec3 shine = m.emissiveFactor.rgb * textured(m.emissive, uvs, lods, true);
+  vec3 shine = m.emissiveFactor.rgb * emissiveTexel;
   vec3 diffuse = vec3(kAmbient);
   uint count = max(lightCount, 1u);
   for (uint i = 0u; i < count; ++i) {
@@ -181,6 +190,12 @@ vec3 phongParts(vec3 position, vec3 ns, vec4 uvs, vec2 lods, GpuMaterial m, vec3
   }
   weight = diffuse * m.baseColorFactor.rgb;
   return shine;
+}
+
+// phongLight with the emissive texture read at `uvs` and `lods`, its textures' level of detail.
+vec3 phongParts(vec3 position, vec3 ns, vec4 uvs, vec2 lods, GpuMaterial m, vec3 dir, uint lightCount, vec3 headlight,
+                out vec3 weight) {
+  return phongLight(position, ns, m, textured(m.emissive, uvs, lods, true), dir, lightCount, headlight, weight);
 }
 
 vec3 phong(vec3 position, vec3 ns, vec4 uvs, vec2 lods, GpuMaterial m, vec3 dir, uint lightCount, vec3 headlight) {
