@@ -275,13 +275,13 @@ struct View {
     Viewport,  ///< rasterised, with only the refracting pixels traced: the talk's viewport
     Trace,     ///< every pixel traced
   } output = Output::Viewport;
-  /// How glass is drawn: a method of `snell render --method` ("auto",
-  /// "trace", "trace-1", "iris-plane", "normal-offset", "refraction-map",
-  /// "none", "driver-rt"); empty: "auto", which is "trace" unless the Device
-  /// has the driver's ray tracing (DeviceOptions::driverRayTracing) and the
-  /// first frames time "driver-rt" faster. With Output::Viewport the traced
-  /// methods trace only the refracting pixels under the raster pass; a
-  /// raster method draws the viewport whatever `output` says.
+  /// How glass is drawn: "auto" or a name methods() lists (those of `snell
+  /// render --method`: "trace", "iris-plane", ...); empty: "auto", which is
+  /// "trace" unless the Device has the driver's ray tracing
+  /// (DeviceOptions::driverRayTracing) and the first frames time "driver-rt"
+  /// faster. With Output::Viewport the traced methods trace only the
+  /// refracting pixels under the raster pass; a raster method draws the
+  /// viewport whatever `output` says.
   /// "refraction-map" bakes its map with the trace at the first frame that
   /// draws it (again when the view's size changes).
   std::string method;
