@@ -39,7 +39,7 @@ Baked bakeEye(vk::Context& context, double time = 0.0) {
   b.pose = scene::evaluate(b.scene, time);
   b.settings = {kWidth, kHeight, scene::resolveView(b.scene, b.pose, {}), glm::vec3(scene::kDefaultBackground), 8};
   render::Renderer renderer(context, b.scene, b.pose);
-  b.bake = renderer.bakeRefractionMap(b.pose, b.settings);
+  b.bake = render::bakeRefraction(renderer, b.pose, b.settings);
   return b;
 }
 

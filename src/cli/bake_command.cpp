@@ -36,7 +36,7 @@ int runBake(const Options& o) {
   std::string summary;
   {
     render::Renderer renderer(*context, scene, pose);
-    bake::RefractionBake baked = renderer.bakeRefractionMap(pose, settings);
+    bake::RefractionBake baked = render::bakeRefraction(renderer, pose, settings);  // files only: nothing kept on the GPU
     if (material) baked.behindMaterial = *material;
     summary = bake::describe(baked, scene);
     if (baked.count(bake::Coverage::Lands) == 0) {

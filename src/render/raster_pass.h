@@ -56,8 +56,8 @@ struct RasterOptions {
   bool refraction = true;
   /// With refraction: a screen-space approximation instead of the trace.
   ScreenSpace screenSpace = ScreenSpace::Off;
-  /// RefractionMap's map: unset, the one Renderer::bakeRefractionMap last
-  /// baked. A map of the caller's own stays theirs while frames that read it
+  /// RefractionMap's map: unset, the one Renderer::bakeRefractionMap keeps
+  /// for the view. A map of the caller's own stays theirs while frames that read it
   /// are in flight; new content in the same object is invisible to the
   /// renderer: call Renderer::invalidateViews() after.
   const RefractionMapBuffer* refractionMap = nullptr;

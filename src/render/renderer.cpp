@@ -130,9 +130,8 @@ void Renderer::invalidateViews() {
 
 const RefractionBake& Renderer::bakeRefractionMap(const scene::Pose& pose, const FrameSettings& settings,
                                                   size_t view) {
-  RenderedFrame frame = renderFrame(*this, pose, settings, true);
   KeptMap map;
-  map.bake = bakeFromAov(frame.width, frame.height, frame.aov, sceneModel_);
+  map.bake = bakeRefraction(*this, pose, settings);
   map.buffer = uploadRefractionMap(context_, map.bake);
   finish();  // no frame in flight reads the old map when it goes
   if (maps_.size() <= view) maps_.resize(view + 1);
@@ -742,6 +741,11 @@ CompositeFrame renderComposite(Renderer& renderer, const scene::Pose& pose, cons
   CompositeFrame frame;
   frame.trace = renderOneView(renderer, pose, view, &frame.rgba);
   return frame;
+}
+
+RefractionBake bakeRefraction(Renderer& renderer, const scene::Pose& pose, const FrameSettings& settings) {
+  RenderedFrame frame = renderFrame(renderer, pose, settings, true);
+  return bakeFromAov(frame.width, frame.height, frame.aov, renderer.scene());
 }
 
 }  // namespace snell::render

@@ -300,6 +300,11 @@ struct CompositeFrame {
 CompositeFrame renderComposite(Renderer& renderer, const scene::Pose& pose, const FrameSettings& settings,
                                const RasterOptions& options, bool withAov = false, bool masked = false);
 
+/// The refraction-map method's map of `settings` at `pose`, traced and baked
+/// on the host only (waits for the GPU), for a map file;
+/// Renderer::bakeRefractionMap also keeps it on the GPU for the raster pass.
+RefractionBake bakeRefraction(Renderer& renderer, const scene::Pose& pose, const FrameSettings& settings);
+
 /// Checks a requested image size against the device: throws
 /// std::invalid_argument saying what is wrong.
 void checkImageSize(const vk::Context& context, uint32_t width, uint32_t height);
