@@ -43,7 +43,7 @@ void Viewer::bakeRefractionMaps() {
   for (size_t i = 0; i < viewports_.size(); ++i) {
     const Viewport& vp = viewports_[i];
     if (!vp.width) continue;
-    const render::RefractionBake& map = renderer_->refractionMap(viewIndexOf(viewports_, i));
+    const render::RefractionMapBuffer& map = renderer_->refractionMap(viewIndexOf(viewports_, i));
     if (rebake_ || map.width != vp.width || map.height != vp.height) due.push_back(i);
   }
   rebake_ = false;
@@ -53,7 +53,7 @@ void Viewer::bakeRefractionMaps() {
   for (size_t i : due) {
     const Viewport& vp = viewports_[i];
     render::FrameSettings settings{vp.width, vp.height, viewOf(vp), glm::vec3(scene::kDefaultBackground), gpu::kDefaultMaxInterfaces};
-    const render::RefractionBake& baked = renderer_->bakeRefractionMap(pose_, settings, viewIndexOf(viewports_, i));
+    render::RefractionBake baked = renderer_->bakeRefractionMap(pose_, settings, viewIndexOf(viewports_, i));
     char when[32];
     std::snprintf(when, sizeof when, "%.2f s", pose_.time);
     message_ = "refraction map baked at " + std::string(when) + ": " + bake::describe(baked, *scene_);

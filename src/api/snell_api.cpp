@@ -541,7 +541,7 @@ struct Renderer::Impl {
   // The refraction-map method's map: the trace of this view at this pose,
   // baked once per view size; the renderer keeps it.
   void bakeMap(const render::FrameSettings& settings) {
-    const render::RefractionBake& map = renderer->refractionMap();
+    const render::RefractionMapBuffer& map = renderer->refractionMap();
     if (map.width == settings.width && map.height == settings.height) return;
     if (kept && !kept->pending.empty()) {  // the bake's frame has no prologue: copy the vertices first
       render::FrameRequest flush;

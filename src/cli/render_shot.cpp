@@ -217,7 +217,7 @@ class Worker {
       scene::View bakeView = o_.shot.resolveView("render", scene, bakePose);
       render::FrameSettings settings{o_.shot.width, o_.shot.height, bakeView, o_.shot.background, o_.shot.maxInterfaces};
       settings.optics = o_.optics;
-      const render::RefractionBake& baked = renderer_->bakeRefractionMap(bakePose, settings);
+      render::RefractionBake baked = renderer_->bakeRefractionMap(bakePose, settings);
       if (id_ == 0) std::printf("baked the refraction map at %g s: %s\n", t, bake::describe(baked, scene).c_str());
     }
   }

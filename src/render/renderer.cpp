@@ -128,21 +128,19 @@ void Renderer::invalidateViews() {
   for (View& v : views_) v.rendered = false;
 }
 
-const RefractionBake& Renderer::bakeRefractionMap(const scene::Pose& pose, const FrameSettings& settings,
-                                                  size_t view) {
-  KeptMap map;
-  map.bake = bakeRefraction(*this, pose, settings);
-  map.buffer = uploadRefractionMap(context_, map.bake);
+RefractionBake Renderer::bakeRefractionMap(const scene::Pose& pose, const FrameSettings& settings, size_t view) {
+  RefractionBake bake = bakeRefraction(*this, pose, settings);
+  RefractionMapBuffer map = uploadRefractionMap(context_, bake);
   finish();  // no frame in flight reads the old map when it goes
   if (maps_.size() <= view) maps_.resize(view + 1);
   maps_[view] = std::move(map);
   invalidateViews();  // a view that reads a kept map sees a new one through the same pointer
-  return maps_[view].bake;
+  return bake;
 }
 
-const RefractionBake& Renderer::refractionMap(size_t view) const {
-  static const RefractionBake none;
-  return view < maps_.size() ? maps_[view].bake : none;
+const RefractionMapBuffer& Renderer::refractionMap(size_t view) const {
+  static const RefractionMapBuffer none;
+  return view < maps_.size() ? maps_[view] : none;
 }
 
 void Renderer::markDirty(int shape) {
@@ -413,9 +411,7 @@ void Renderer::recordView(vk::Commands& commands, Slot& slot, size_t index, cons
       recordTrace(commands, request, view, false, stats);
     } else {
       RasterOptions raster = request.raster;
-      if (!raster.refractionMap && index < maps_.size() && maps_[index].buffer.width > 0) {
-        raster.refractionMap = &maps_[index].buffer;
-      }
+      if (!raster.refractionMap && refractionMap(index).width > 0) raster.refractionMap = &maps_[index];
       if (!raster.depth) {
         // Near and far planes around the items' spheres at this pose: loose
         // enough for any deformation, and reverse Z keeps the precision.

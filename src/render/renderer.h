@@ -189,12 +189,12 @@ class Renderer {
   void invalidateTrees();
   /// The refraction-map method's map for view `view` of later frames: every
   /// pixel of `settings` traced at `pose` with its AOVs, and baked (waits for
-  /// the GPU). The renderer keeps the last one baked per view, which that
-  /// view reads where its RasterOptions name no map of their own, and
-  /// redraws the views with it.
-  const RefractionBake& bakeRefractionMap(const scene::Pose& pose, const FrameSettings& settings, size_t view = 0);
-  /// The map kept for view `view` (empty, 0 x 0, before one is baked).
-  const RefractionBake& refractionMap(size_t view = 0) const;
+  /// the GPU). The renderer keeps the last one baked per view on the GPU,
+  /// which that view reads where its RasterOptions name no map of their own,
+  /// and redraws the views with it; the bake itself goes to the caller.
+  RefractionBake bakeRefractionMap(const scene::Pose& pose, const FrameSettings& settings, size_t view = 0);
+  /// The map kept for view `view` (0 x 0 before one is baked).
+  const RefractionMapBuffer& refractionMap(size_t view = 0) const;
 
   /// Forces the next frame to redraw every view, even one that nothing
   /// changed for (for tools that change GPU data behind the renderer's back).
@@ -246,11 +246,7 @@ class Renderer {
   vk::Buffer instances_, lights_;
   uint32_t lightCount_ = 0;
   bool refractive_ = false;
-  struct KeptMap {
-    RefractionBake bake;
-    RefractionMapBuffer buffer;
-  };
-  std::vector<KeptMap> maps_;  ///< per view index, baked by bakeRefractionMap
+  std::vector<RefractionMapBuffer> maps_;  ///< per view index, baked by bakeRefractionMap
 
   // What the GPU holds, to find what changed.
   struct ItemState {
