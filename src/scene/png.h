@@ -6,9 +6,9 @@
 
 namespace snell::scene {
 
-/// An RGBA8 image as a PNG file's bytes (stb's encoder: filtered and deflated).
+/// An RGBA8 image as a PNG file's bytes (filtered per row, deflated by zlib).
 std::vector<uint8_t> encodePng(uint32_t width, uint32_t height, const std::vector<uint8_t>& rgba);
-/// A 16-bit RGBA image as a PNG file's bytes (filtered per row and deflated by stb).
+/// A 16-bit RGBA image as a PNG file's bytes (filtered per row, deflated by zlib).
 std::vector<uint8_t> encodePng16(uint32_t width, uint32_t height, const std::vector<uint16_t>& rgba);
 
 }  // namespace snell::scene
