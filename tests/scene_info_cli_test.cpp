@@ -1,6 +1,7 @@
 // `snell info SCENE` as a user runs it: exit codes and what it prints.
 #include "assets.h"
 #include "command_run.h"
+#include "io/json.h"
 
 #include <gtest/gtest.h>
 
@@ -46,6 +47,16 @@ TEST(SceneInfoCommand, ReportsTextureMemoryWithMipsAndLoadTimes) {
   EXPECT_NE(run.output.find("on the GPU with mips; largest"), std::string::npos) << run.output;
   EXPECT_NE(run.output.find("load times: parse"), std::string::npos) << run.output;
   EXPECT_NE(run.output.find("image decode"), std::string::npos) << run.output;
+}
+
+TEST(SceneInfoCommand, TimingsReportTheVulkanDevicesCreationTime) {
+  std::string path = shellQuoted(model("TransmissionTest/glTF-Binary/TransmissionTest.glb"));
+  CommandRun text = snell("info " + path + " --timings");
+  ASSERT_EQ(text.exitCode, 0) << text.output;
+  EXPECT_NE(text.output.find("Vulkan instance and device "), std::string::npos) << text.output;
+  CommandRun json = snell("info " + path + " --timings --json -");
+  ASSERT_EQ(json.exitCode, 0) << json.output;
+  EXPECT_GT(io::Json::parse(json.output).at("load_times").at("device_ms").get<double>(), 0.0) << json.output;
 }
 
 TEST(SceneInfoCommand, TimingsReportTheFirstFramesPipelineCompile) {
