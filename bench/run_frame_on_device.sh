@@ -26,6 +26,8 @@
 #   bench/run_frame_on_device.sh python  # the Python module, built there for its python3 against the carried
 #                                        # install (.carry/prefix), replaying the Blender feed in .carry/feed
 #                                        # (bench/record_blender_feed.py), beside bench frame of the rig's glTF
+# SNELL_BIN picks another carried binary for the first, trace, viewport and
+# build steps (default .carry/snell), to measure two builds in one lease.
 # Results land in $OUT.
 set -uo pipefail
 for f in .gl/*.deb; do dpkg -x "$f" /; done
@@ -39,6 +41,7 @@ OUT=${OUT:-/tmp/out}
 mkdir -p "$OUT"
 nvidia-smi --query-gpu=name,driver_version,clocks.sm,clocks.mem --format=csv
 step=${1:-all}
+snell=${SNELL_BIN:-.carry/snell}
 # The tests that run the command find it where it was built.
 mkdir -p build/device && ln -sf "$PWD/.carry/snell" build/device/snell
 if [[ $step == all || $step == tests ]]; then
@@ -203,13 +206,13 @@ if [[ $step == first ]]; then
       mkdir -p /tmp/caches/xdg /tmp/caches/nv
       echo "== $run: snell render --eye --size 1920x1080"
       time XDG_CACHE_HOME=/tmp/caches/xdg __GL_SHADER_DISK_CACHE_PATH=/tmp/caches/nv \
-        .carry/snell -q render --eye --size 1920x1080 -o /tmp/first.png
+        $snell -q render --eye --size 1920x1080 -o /tmp/first.png
     done
     echo "== where a cold first frame goes (snell info --timings, empty caches)"
-    .carry/snell eye -o /tmp/eye.glb >/dev/null
+    $snell eye -o /tmp/eye.glb >/dev/null
     rm -rf /tmp/caches && mkdir -p /tmp/caches/xdg /tmp/caches/nv
-    XDG_CACHE_HOME=/tmp/caches/xdg __GL_SHADER_DISK_CACHE_PATH=/tmp/caches/nv .carry/snell info /tmp/eye.glb --timings | tail -2
-    XDG_CACHE_HOME=/tmp/caches/xdg __GL_SHADER_DISK_CACHE_PATH=/tmp/caches/nv .carry/snell info /tmp/eye.glb --timings | tail -1
+    XDG_CACHE_HOME=/tmp/caches/xdg __GL_SHADER_DISK_CACHE_PATH=/tmp/caches/nv $snell info /tmp/eye.glb --timings | tail -2
+    XDG_CACHE_HOME=/tmp/caches/xdg __GL_SHADER_DISK_CACHE_PATH=/tmp/caches/nv $snell info /tmp/eye.glb --timings | tail -1
   } 2>&1 | tee "$OUT/first.log"
 fi
 if [[ $step == trace ]]; then
@@ -221,7 +224,7 @@ if [[ $step == trace ]]; then
       name=$(basename "$scene" .gltf)
       [[ $scene == eye ]] && scene=""
       echo "== trace against driver-rt, 1920x1080, $name"
-      .carry/snell bench methods $scene --methods trace,driver-rt --no-reference --frames 8 --size 1920x1080 \
+      $snell bench methods $scene --methods trace,driver-rt --no-reference --frames 8 --size 1920x1080 \
         --json "$json/trace-$name.json" | grep -v "CPU reference"
     done
   } 2>&1 | tee "$OUT/trace.log"
@@ -230,7 +233,7 @@ fi
 if [[ $step == viewport ]]; then
   json=$(mktemp -d)
   {
-    s=.carry/snell
+    s=$snell
     $s bench frame --crowd 2 --viewport --warmup 200 --json "$json/frame-crowd2.json"
     $s bench frame --viewport --warmup 200 --json "$json/frame-eye64.json"
     $s bench frame --eye-resolution 256 --viewport --warmup 200 --json "$json/frame-eye256.json"
@@ -240,5 +243,5 @@ if [[ $step == viewport ]]; then
   tar -C "$json" -cf "$OUT/viewport-results.tar" .
 fi
 if [[ $step == build ]]; then
-  .carry/snell bench scale --crowds 0 --triangles 1000000,10000000 --json "$OUT/scale.json" 2>&1 | tee "$OUT/scale.log"
+  $snell bench scale --crowds 0 --triangles 1000000,10000000 --json "$OUT/scale.json" 2>&1 | tee "$OUT/scale.log"
 fi
