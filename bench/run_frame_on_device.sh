@@ -26,8 +26,8 @@
 #   bench/run_frame_on_device.sh python  # the Python module, built there for its python3 against the carried
 #                                        # install (.carry/prefix), replaying the Blender feed in .carry/feed
 #                                        # (bench/record_blender_feed.py), beside bench frame of the rig's glTF
-# SNELL_BIN picks another carried binary for the first, trace, viewport and
-# build steps (default .carry/snell), to measure two builds in one lease.
+# SNELL_BIN picks another carried binary for the first, trace, viewport,
+# build and shot1 steps (default .carry/snell), to measure two builds in one lease.
 # Results land in $OUT.
 set -uo pipefail
 for f in .gl/*.deb; do dpkg -x "$f" /; done
@@ -189,10 +189,10 @@ if [[ $step == shot ]]; then
 fi
 if [[ $step == shot1 ]]; then
   echo "== two workers on one GPU: bench shot --devices 0,0, crowd 100 at 3840x2160, ${SHOT_FRAMES:-24} frames as PNG"
-  SNELL_PIPELINE_CACHE=/tmp/snell-cache .carry/snell bench shot --devices 0,0 --frames "${SHOT_FRAMES:-24}" \
+  SNELL_PIPELINE_CACHE=/tmp/snell-cache $snell bench shot --devices 0,0 --frames "${SHOT_FRAMES:-24}" \
     --folder /tmp/shot --json "$OUT/shot1.json" 2> "$OUT/shot1-progress.log" | tee "$OUT/shot1.txt"
   echo "bench shot exit ${PIPESTATUS[0]}"
-  CUDA_VISIBLE_DEVICES=0 .carry/snell render --eye --size 320x240 --frames 1-8 --devices all -o /tmp/c2.#.png 2>&1 | grep -E "device|frames on"
+  CUDA_VISIBLE_DEVICES=0 $snell render --eye --size 320x240 --frames 1-8 --devices all -o /tmp/c2.#.png 2>&1 | grep -E "device|frames on"
   SNELL_VALIDATION=1 .carry/snell_tests --gtest_brief=1 --gtest_filter='MultiDevice.*:DeviceList.*:LauncherOverride.*' \
     > "$OUT/multi-tests.log" 2>&1
   echo "multi-device tests exit $?"; grep -E "FAILED|PASSED|tests ran" "$OUT/multi-tests.log" | tail -8
