@@ -15,6 +15,7 @@
 #include <exception>
 #include <stdexcept>
 #include <string>
+#include <system_error>
 #include <thread>
 
 namespace snell::scene {
@@ -100,7 +101,13 @@ void forEachBand(size_t bands, Job job) {
     }
   };
   std::vector<std::thread> pool;
-  for (size_t t = 1; t < threads; ++t) pool.emplace_back(share, t);
+  for (size_t t = 1; t < threads; ++t) {
+    try {
+      pool.emplace_back(share, t);
+    } catch (const std::system_error&) {
+      share(t);  // no thread to be had: this one does that share too
+    }
+  }
   share(0);
   for (std::thread& thread : pool) thread.join();
   for (const std::exception_ptr& failure : failures) {
