@@ -117,12 +117,12 @@ void forEachBand(size_t bands, Job job) {
 
 // One band of the stream as raw deflate: primed with the window before it,
 // ended on a byte boundary (a sync flush) unless it is the last.
-std::vector<uint8_t> deflateBand(const uint8_t* data, size_t bytes, size_t primed, bool last, int& status) {
+std::vector<uint8_t> deflateBand(const uint8_t* data, size_t bytes, size_t primed, bool last) {
   z_stream z{};
-  status = deflateInit2(&z, kDeflateLevel, Z_DEFLATED, -15, 8, Z_DEFAULT_STRATEGY);
-  if (status != Z_OK) return {};
-  if (primed) status = deflateSetDictionary(&z, data - primed, static_cast<uInt>(primed));
+  int status = deflateInit2(&z, kDeflateLevel, Z_DEFLATED, -15, 8, Z_DEFAULT_STRATEGY);
+  if (status != Z_OK) throw std::runtime_error(std::string("PNG: zlib could not start deflating (") + zError(status) + ")");
   std::vector<uint8_t> out(deflateBound(&z, static_cast<uLong>(bytes)) + 16);
+  if (primed) status = deflateSetDictionary(&z, data - primed, static_cast<uInt>(primed));
   if (status == Z_OK) {
     z.next_in = const_cast<Bytef*>(data);
     z.avail_in = static_cast<uInt>(bytes);
@@ -135,6 +135,7 @@ std::vector<uint8_t> deflateBand(const uint8_t* data, size_t bytes, size_t prime
   }
   out.resize(z.total_out);
   deflateEnd(&z);
+  if (status != Z_OK) throw std::runtime_error(std::string("PNG: zlib could not deflate the image (") + zError(status) + ")");
   return out;
 }
 
@@ -147,27 +148,21 @@ std::vector<uint8_t> imageData(const std::vector<uint8_t>& samples, size_t rowBy
   forEachBand(bands, [&](size_t b) {
     filterRows(samples, rowBytes, firstRow(b), firstRow(b + 1), pixelBytes, filtered.data() + firstRow(b) * filteredRow);
   });
+  auto bandBytes = [&](size_t band) { return size_t(firstRow(band + 1) - firstRow(band)) * filteredRow; };
   std::vector<std::vector<uint8_t>> deflated(bands);
   std::vector<uLong> adlers(bands);
-  std::vector<int> statuses(bands, Z_OK);
   forEachBand(bands, [&](size_t b) {
-    size_t start = firstRow(b) * filteredRow, bytes = (firstRow(b + 1) - firstRow(b)) * filteredRow;
-    deflated[b] = deflateBand(filtered.data() + start, bytes, std::min(start, kWindowBytes), b + 1 == bands, statuses[b]);
-    adlers[b] = adler32(adler32(0L, Z_NULL, 0), filtered.data() + start, static_cast<uInt>(bytes));
+    size_t start = firstRow(b) * filteredRow;
+    deflated[b] = deflateBand(filtered.data() + start, bandBytes(b), std::min(start, kWindowBytes), b + 1 == bands);
+    adlers[b] = adler32(adler32(0L, Z_NULL, 0), filtered.data() + start, static_cast<uInt>(bandBytes(b)));
   });
-  for (int status : statuses) {
-    if (status != Z_OK) throw std::runtime_error(std::string("PNG: zlib could not deflate the image (") + zError(status) + ")");
-  }
   // A zlib header (deflate, 32 KiB window, "fast" level: 0x785e is a multiple
   // of 31), the bands back to back, the Adler-32 of all the filtered bytes.
   std::vector<uint8_t> stream = {0x78, 0x5e};
   uLong adler = adlers[0];
   for (size_t b = 0; b < bands; ++b) {
     stream.insert(stream.end(), deflated[b].begin(), deflated[b].end());
-    if (b) {
-      size_t bytes = (firstRow(b + 1) - firstRow(b)) * filteredRow;
-      adler = adler32_combine(adler, adlers[b], static_cast<z_off_t>(bytes));
-    }
+    if (b) adler = adler32_combine(adler, adlers[b], static_cast<z_off_t>(bandBytes(b)));
   }
   putBigEndian(stream, static_cast<uint32_t>(adler));
   return stream;
