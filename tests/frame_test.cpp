@@ -216,7 +216,7 @@ TEST_F(GpuTest, AViewportOfASceneWithoutTransmissiveFacesBuildsNoTrees) {
   scene::Pose pose = scene::evaluate(s, 0.0);
   Renderer renderer(context(), s, pose);
   FrameStats stats = frame(renderer, pose, {compositeView(scene::resolveView(s, pose, {}))}).stats;
-  EXPECT_FALSE(renderer.refractive());
+  EXPECT_FALSE(renderer.seeThrough());
   EXPECT_EQ(renderer.blas(), nullptr);
   EXPECT_EQ(renderer.builder(), nullptr) << "no tree builder and no trace pipeline were made";
   EXPECT_EQ(stats.treesBuilt, 0u);

@@ -86,6 +86,30 @@ float curvatureAt(Hit hit) {
   return k < 1e30 ? k : 0.0;  // NaN and infinity: 0
 }
 
+// The shading normal at a hit bent by its material's normal map, whose texel
+// (bytes / 255) was read at the hit (trace.h: Normal maps).
+vec3 normalMappedAt(Hit hit, Surface s, GpuMaterial m, vec3 mapTexel) {
+  GpuInstance inst = instances[hit.instance];
+  uvec3 i = triangleAt(hit.primitive);
+  vec3 p0 = vertexAt(i.x);
+  vec3 t, b;
+  if (!tangentFrame(vectorToWorld(inst, vertexAt(i.y) - p0), vectorToWorld(inst, vertexAt(i.z) - p0),
+                    textureUv(m.normal, texcoords[i.x]), textureUv(m.normal, texcoords[i.y]),
+                    textureUv(m.normal, texcoords[i.z]), t, b)) {
+    return s.ns;
+  }
+  return normalMapped(s.ns, s.ng, t, b, mapTexel, m.normalScale);
+}
+
+// How much of an opaque face is there (trace.h: Alpha): 1 unless its
+// material masks or blends by alpha, the factor's times the base texture's.
+float coverageOf(GpuMaterial m, float textureAlpha) {
+  float alpha = m.baseColorFactor.a * textureAlpha;
+  if (m.alphaMode == kAlphaMask) return alpha >= m.alphaCutoff ? 1.0 : 0.0;
+  if (m.alphaMode == kAlphaBlend) return clamp(alpha, 0.0, 1.0);
+  return 1.0;
+}
+
 // Wächter & Binder (Ray Tracing Gems, ch. 6): move the point off the surface
 // by a few ulps of its own magnitude (a fixed step near the origin, where ulps
 // vanish). Their constants (256 ulps, 1/65536 below 1/32) assume metre-sized
@@ -159,22 +183,32 @@ bool tracePath(vec3 origin, vec3 dir, float width, float spread, int channel, ou
     GpuMaterial m;
     bool opaque = false;
     float hitWidth = width + spread * hit.t;  // the cone where it meets the face
-    // The face's base colour texel, its second texture's (an opaque face's
-    // emissive one, glass's IOR map) and an opaque face's light in two parts
-    // (phongParts), each from one call site whatever the branches below use:
-    // every call site is compiled in full, and the first image waits for the
-    // compile.
+    // The face's base colour texel (and its alpha), its second texture's (an
+    // opaque face's emissive one, glass's IOR map), its normal map's and an
+    // opaque face's light in two parts (phongParts), each from one call site
+    // whatever the branches below use: every call site is compiled in full,
+    // and the first image waits for the compile.
     vec3 texel = vec3(1.0), second = vec3(1.0), shine = vec3(0.0), weight = vec3(0.0);
+    float coverage = 1.0;
     if (hit.instance != kNoHit) {
       s = surfaceAt(hit);
       s.lods = coneLod(s.density, hitWidth, dot(dir, s.ng));
       m = materials[s.material];
       opaque = !refractive(m);
-      [[dont_unroll]] for (uint k = 0u; k < 2u; ++k) {
-        vec3 read = textured(k == 0u ? m.base : (opaque ? m.emissive : m.iorMap), s.uvs, s.lods, k == 0u || opaque);
-        if (k == 0u) texel = read;
-        else second = read;
+      vec3 mapTexel = vec3(0.5, 0.5, 1.0);
+      [[dont_unroll]] for (uint k = 0u; k < 3u; ++k) {
+        GpuTextureSlot slot = k == 0u ? m.base : k == 2u ? m.normal : opaque ? m.emissive : m.iorMap;
+        vec4 read = textured(slot, s.uvs, s.lods, k == 0u || (k == 1u && opaque));
+        if (k == 0u) {
+          texel = read.rgb;
+          if (opaque) coverage = coverageOf(m, read.a);
+        } else if (k == 1u) {
+          second = read.rgb;
+        } else {
+          mapTexel = read.rgb;
+        }
       }
+      if (m.normal.texture != kNoTexture) s.ns = normalMappedAt(hit, s, m, mapTexel);
       if (opaque) shine = phongLight(s.position, s.ns, m, second, dir, pc.lightCount, pc.forward.xyz, weight);
     }
     if (reflecting) {  // an opaque face is shaded; a miss or glass sees the environment
@@ -205,7 +239,7 @@ bool tracePath(vec3 origin, vec3 dir, float width, float spread, int channel, ou
       path.firstInstance = hit.instance;
       path.firstPrimitive = hit.primitive - firstTriangleOf(hit.instance);
     }
-    if (opaque) {
+    if (opaque && coverage == 1.0) {
       if (path.interfaces > 0u) {
         if (m.base.texture != kNoTexture) path.landing = textureUv(m.base, s.uvs);
         path.landingMaterial = s.material;
@@ -221,6 +255,16 @@ bool tracePath(vec3 origin, vec3 dir, float width, float spread, int channel, ou
       path.colour += throughput * pc.background.rgb;
       path.outcome = kOutcomeInterfaceLimit;
       return false;
+    }
+    if (opaque) {  // a face partly there: its light in proportion, the rest goes on straight
+      path.colour += throughput * coverage * (shine + weight * texel);
+      throughput *= 1.0 - coverage;
+      ++path.interfaces;
+      width = hitWidth;
+      origin = leave(s, dir, tMin);
+      skipInstance = hit.instance;
+      skipPrim = hit.primitive;
+      continue;
     }
     bool entering = dot(dir, s.ng) < 0.0;
     bool boundary;  // a true boundary: the medium changes here

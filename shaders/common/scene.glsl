@@ -46,6 +46,10 @@ vec3 vectorToWorld(GpuInstance inst, vec3 v) {
 
 bool refractive(GpuMaterial m) { return m.transmission > 0.0; }
 
+// A face whose pixels the viewport leaves to the masked trace: glass, and
+// opaque faces that alpha may make partly see-through (trace.h: Alpha).
+bool tracedInViewport(GpuMaterial m) { return refractive(m) || m.alphaMode != kAlphaOpaque; }
+
 uint texelWord(uint page, uint i) {
   switch (page) {
     case 0u: return texelPage0[i];

@@ -42,24 +42,26 @@ MipLevel mipLevel(GpuTexture tex, uint level) {
   return m;
 }
 
-// Colour textures are sRGB; data textures (the IOR's) are read as bytes / 255.
-vec3 texel(GpuTexture tex, MipLevel m, int x, int y, bool srgb) {
+// Colour textures are sRGB; data textures (the IOR texture, normal maps) are
+// read as bytes / 255. Alpha is always bytes / 255.
+vec4 texel(GpuTexture tex, MipLevel m, int x, int y, bool srgb) {
   x = wrapIndex(x, m.width, tex.flags & 3u);
   y = wrapIndex(y, m.height, (tex.flags >> 2) & 3u);
   uint rgba = texelWord(tex.flags >> kTexturePageShift, m.first + uint(y * m.width + x));
-  return srgb ? srgbToLinear(rgba) : vec3(rgba & 0xffu, (rgba >> 8) & 0xffu, (rgba >> 16) & 0xffu) / 255.0;
+  vec4 bytes = vec4(rgba & 0xffu, (rgba >> 8) & 0xffu, (rgba >> 16) & 0xffu, rgba >> 24) / 255.0;
+  return srgb ? vec4(srgbToLinear(rgba), bytes.a) : bytes;
 }
 
-vec3 bilinear(GpuTexture tex, uint level, vec2 uv, bool srgb) {
+vec4 bilinear(GpuTexture tex, uint level, vec2 uv, bool srgb) {
   MipLevel m = mipLevel(tex, level);
   vec2 p = uv * vec2(m.width, m.height) - 0.5;
   vec2 base = floor(p);
   vec2 f = p - base;
   int x = int(base.x), y = int(base.y);
   // The four corners from one call site of texel(), rolled (see sampleTexture).
-  vec3 top, bottom, left;
+  vec4 top, bottom, left;
   [[dont_unroll]] for (int k = 0; k < 4; ++k) {
-    vec3 c = texel(tex, m, x + (k & 1), y + (k >> 1), srgb);
+    vec4 c = texel(tex, m, x + (k & 1), y + (k >> 1), srgb);
     if (k == 1) top = mix(left, c, f.x);
     if (k == 3) bottom = mix(left, c, f.x);
     left = c;
@@ -69,7 +71,7 @@ vec3 bilinear(GpuTexture tex, uint level, vec2 uv, bool srgb) {
 
 // The texture at uv and level of detail `lod` (trace.h: Textures): trilinear
 // between the two levels around it, or the nearest texel of level 0.
-vec3 sampleTexture(uint index, vec2 uv, bool srgb, float lod) {
+vec4 sampleTexture(uint index, vec2 uv, bool srgb, float lod) {
   GpuTexture tex = textures[index];
   if ((tex.flags & kTextureFlagNearest) != 0u) {
     MipLevel m = mipLevel(tex, 0u);
@@ -83,10 +85,10 @@ vec3 sampleTexture(uint index, vec2 uv, bool srgb, float lod) {
   // Level, then (between two levels) the next one mixed in, from one call
   // site of bilinear(): the trace compiles each site in full, and its
   // compile is what a first image waits for.
-  vec3 c = vec3(0.0);
+  vec4 c = vec4(0.0);
   uint reads = f > 0.0 ? 2u : 1u;
   for (uint k = 0u; k < reads; ++k) {
-    vec3 b = bilinear(tex, level + k, uv, srgb);
+    vec4 b = bilinear(tex, level + k, uv, srgb);
     c = k == 0u ? b : mix(c, b, f);
   }
   return c;
@@ -117,14 +119,41 @@ vec2 textureUv(GpuTextureSlot slot, vec4 uvs) {
   return vec2(dot(slot.uvRow0.xyz, uv), dot(slot.uvRow1.xyz, uv));
 }
 
-vec3 textured(GpuTextureSlot slot, vec4 uvs, vec2 lods, bool srgb) {
-  if (slot.texture == kNoTexture) return vec3(1.0);
+vec4 textured(GpuTextureSlot slot, vec4 uvs, vec2 lods, bool srgb) {
+  if (slot.texture == kNoTexture) return vec4(1.0);
   float lod = (slot.texCoord == 1u ? lods.y : lods.x) + slot.lodOffset;
   return sampleTexture(slot.texture, textureUv(slot, uvs), srgb, lod);
 }
 
 vec3 baseColour(GpuMaterial m, vec4 uvs, vec2 lods) {
-  return m.baseColorFactor.rgb * textured(m.base, uvs, lods, true);
+  return m.baseColorFactor.rgb * textured(m.base, uvs, lods, true).rgb;
+}
+
+// The tangent frame a normal map is read in (trace.h: Normal maps): world
+// dp/du' and dp/dv'' of the triangle with edges e1, e2 and corner UVs uv0-2
+// (the slot's set, transformed), v'' = -v' running up the image; false where
+// the UVs are degenerate.
+bool tangentFrame(vec3 e1, vec3 e2, vec2 uv0, vec2 uv1, vec2 uv2, out vec3 t, out vec3 b) {
+  vec2 d1 = uv1 - uv0, d2 = uv2 - uv0;
+  float det = d1.x * d2.y - d2.x * d1.y;
+  t = (e1 * d2.y - e2 * d1.y) / det;
+  b = -(e2 * d1.x - e1 * d2.x) / det;
+  return det != 0.0 && !any(isinf(t)) && !any(isnan(t)) && !any(isinf(b)) && !any(isnan(b));
+}
+
+// The shading normal `ns` (unit, on ng's side) bent by a normal map's texel
+// (bytes / 255) in the frame (t, b), then turned back to ng's side.
+vec3 normalMapped(vec3 ns, vec3 ng, vec3 t, vec3 b, vec3 texel, float scale) {
+  vec3 m = (2.0 * texel - 1.0) * vec3(scale, scale, 1.0);
+  vec3 tu = t - ns * dot(ns, t);
+  if (!(dot(tu, tu) > 0.0)) return ns;
+  tu = normalize(tu);
+  vec3 bu = cross(ns, tu);
+  if (dot(bu, b) < 0.0) bu = -bu;  // a mirrored UV layout flips the bitangent
+  vec3 n = m.x * tu + m.y * bu + m.z * ns;
+  if (!(dot(n, n) > 0.0)) return ns;
+  n = normalize(n);
+  return dot(n, ng) < 0.0 ? -n : n;
 }
 
 // Light i as seen from `position` (camera-relative): the unit direction
@@ -195,13 +224,13 @@ vec3 phongLight(vec3 position, vec3 ns, GpuMaterial m, vec3 emissiveTexel, vec3 
 // phongLight with the emissive texture read at `uvs` and `lods`, its textures' level of detail.
 vec3 phongParts(vec3 position, vec3 ns, vec4 uvs, vec2 lods, GpuMaterial m, vec3 dir, uint lightCount, vec3 headlight,
                 out vec3 weight) {
-  return phongLight(position, ns, m, textured(m.emissive, uvs, lods, true), dir, lightCount, headlight, weight);
+  return phongLight(position, ns, m, textured(m.emissive, uvs, lods, true).rgb, dir, lightCount, headlight, weight);
 }
 
 vec3 phong(vec3 position, vec3 ns, vec4 uvs, vec2 lods, GpuMaterial m, vec3 dir, uint lightCount, vec3 headlight) {
   vec3 weight;
   vec3 shine = phongParts(position, ns, uvs, lods, m, dir, lightCount, headlight, weight);
-  return shine + weight * textured(m.base, uvs, lods, true);
+  return shine + weight * textured(m.base, uvs, lods, true).rgb;
 }
 
 #endif

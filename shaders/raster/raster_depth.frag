@@ -10,5 +10,7 @@ layout(location = 2) in vec4 inUvs;
 layout(location = 3) flat in vec3 inGeometricNormal;
 layout(location = 4) flat in uint inMaterial;
 layout(location = 5) flat in vec2 inDensity;
+layout(location = 6) flat in vec3 inTangent;
+layout(location = 7) flat in vec3 inBitangent;
 
 void main() {}

@@ -1,5 +1,6 @@
 // Opaque fragments: Phong, exactly the trace's shading of a primary hit.
-// Transmissive fragments: the trace image at this pixel. The compute pass wrote
+// Transmissive fragments, and those alpha may make see-through: the trace
+// image at this pixel (where nothing was traced, alpha is ignored). The compute pass wrote
 // it before a barrier; it never leaves the GPU. With a screen-space method
 // the "trace image" is the picture of what lies behind the glass, read at a
 // pixel displaced the way the method says, and tinted by the glass once.
@@ -24,6 +25,8 @@ layout(location = 2) in vec4 inUvs;
 layout(location = 3) flat in vec3 inGeometricNormal;
 layout(location = 4) flat in uint inMaterial;
 layout(location = 5) flat in vec2 inDensity;
+layout(location = 6) flat in vec3 inTangent;
+layout(location = 7) flat in vec3 inBitangent;
 
 layout(location = 0) out vec4 outColour;
 
@@ -62,7 +65,7 @@ vec3 refractionMapLookup(vec2 size) {
   vec3 texel = vec3(1.0);
   if (t.material != kNoHit) {
     uint texture = materials[t.material].base.texture;
-    if (texture != kNoTexture) texel = sampleTexture(texture, vec2(t.u, t.v), true, t.weight.w);
+    if (texture != kNoTexture) texel = sampleTexture(texture, vec2(t.u, t.v), true, t.weight.w).rgb;
   }
   return t.shine.rgb + t.weight.rgb * texel;
 }
@@ -82,6 +85,14 @@ void main() {
   float height = float(imageSize(traceImage).y);
   float width = ortho ? 2.0 / (pc.up.w * height) : atan(2.0 / (pc.up.w * height)) * length(inPosition - pc.eye.xyz);
   vec2 lods = coneLod(inDensity, width, dot(dir, ng));
+  if (dot(inTangent, inTangent) > 0.0) {
+    ns = normalMapped(ns, ng, inTangent, inBitangent, textured(m.normal, inUvs, lods, false).rgb, m.normalScale);
+  }
+  if (!refractive(m) && tracedInViewport(m) && (pc.flags & kRasterFlagTraced) != 0u) {
+    // A face alpha may make see-through: the trace drew what shows at this pixel.
+    outColour = vec4(imageLoad(traceImage, ivec2(gl_FragCoord.xy)).rgb, 1.0);
+    return;
+  }
   if (refractive(m)) {
     if ((pc.flags & kRasterFlagRefractionMap) != 0u) {
       outColour = vec4(refractionMapLookup(vec2(imageSize(traceImage))), 1.0);

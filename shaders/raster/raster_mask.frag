@@ -18,6 +18,8 @@ layout(location = 2) in vec4 inUvs;
 layout(location = 3) flat in vec3 inGeometricNormal;
 layout(location = 4) flat in uint inMaterial;
 layout(location = 5) flat in vec2 inDensity;
+layout(location = 6) flat in vec3 inTangent;
+layout(location = 7) flat in vec3 inBitangent;
 
 layout(location = 0) out uint outMask;
 
@@ -30,5 +32,5 @@ void main() {
     outMask = floatBitsToUint(max(ortho ? z - pc.forward.w + 1.0 : z, 1e-30));
     return;
   }
-  outMask = refractive(materials[inMaterial]) ? 1u : 0u;
+  outMask = tracedInViewport(materials[inMaterial]) ? 1u : 0u;
 }

@@ -14,6 +14,9 @@ layout(location = 2) out vec4 outUvs;
 layout(location = 3) flat out vec3 outGeometricNormal;
 layout(location = 4) flat out uint outMaterial;
 layout(location = 5) flat out vec2 outDensity;  // uvDensity() of the triangle, per UV set
+// The normal map's tangent frame of the triangle (tangentFrame), zero without one.
+layout(location = 6) flat out vec3 outTangent;
+layout(location = 7) flat out vec3 outBitangent;
 
 void main() {
   uint triangle = uint(gl_VertexIndex) / 3u;
@@ -33,6 +36,15 @@ void main() {
                          texcoords[i.z]);
   outMaterial = inst.material;
   outPosition = world;
+  outTangent = outBitangent = vec3(0.0);
+  GpuTextureSlot normalMap = materials[inst.material].normal;
+  vec3 t, b;
+  if (normalMap.texture != kNoTexture &&
+      tangentFrame(vectorToWorld(inst, p1 - p0), vectorToWorld(inst, p2 - p0), textureUv(normalMap, texcoords[i.x]),
+                   textureUv(normalMap, texcoords[i.y]), textureUv(normalMap, texcoords[i.z]), t, b)) {
+    outTangent = t;
+    outBitangent = b;
+  }
 
   // precise: the depth pre-pass and the shading pass (EQUAL) must agree on
   // every depth bit, so no compiler may fuse this arithmetic differently in

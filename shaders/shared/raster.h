@@ -24,6 +24,9 @@ SNELL_CONST kRasterFlagBehindDepth = 32u;
 // baked pixel at its place on the screen, shine + weight * the texture
 // behind at the baked UV (RefractionTexel), however the scene moved since.
 SNELL_CONST kRasterFlagRefractionMap = 64u;
+// The trace drew this frame's see-through pixels (the mask's), so faces that
+// alpha may make see-through read the trace image too; without it they are opaque.
+SNELL_CONST kRasterFlagTraced = 128u;
 
 // The raster pass's own binding slots, after the scene binding set (shared/scene.h).
 SNELL_CONST kRasterBindingTraceImage = kSceneBindingCount + 0;   // rgba16f storage image, read at the fragment's pixel (or displaced)

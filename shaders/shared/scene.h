@@ -44,7 +44,12 @@ struct GpuTextureSlot {
   uint pad;         // 4
 };
 
-// 224 bytes, total: 224 bytes
+// How a face's alpha (baseColorFactor.a times the base texture's alpha) covers it (trace.h: Alpha).
+SNELL_CONST kAlphaOpaque = 0u;  // alpha is ignored
+SNELL_CONST kAlphaMask = 1u;    // alpha >= alphaCutoff: opaque, else not there
+SNELL_CONST kAlphaBlend = 2u;   // alpha of the face's light, 1 - alpha of what lies behind
+
+// 288 bytes, total: 288 bytes
 struct GpuMaterial {
   vec4 baseColorFactor;       // 16: rgba, linear
   vec4 emissiveFactor;        // 16: rgb; w unused
@@ -60,6 +65,11 @@ struct GpuMaterial {
   GpuTextureSlot base;        // 48: base colour (sRGB)
   GpuTextureSlot emissive;    // 48: emissive (sRGB)
   GpuTextureSlot iorMap;      // 48: the IOR texture (data: bytes / 255)
+  GpuTextureSlot normal;      // 48: the tangent-space normal map (data: bytes / 255; trace.h: Normal maps)
+  float normalScale;          // 4: the map's x and y are scaled by this
+  float alphaCutoff;          // 4: kAlphaMask's threshold
+  uint alphaMode;             // 4: kAlpha*
+  uint pad0;                  // 4
 };
 
 // The sRGB decode table (kSceneBindingSrgbDecode): the linear value of each

@@ -22,6 +22,27 @@
 //   Ns = normalize(b0 n0 + b1 n1 + b2 n2), the shading normal (Ng where that is zero),
 //        flipped to Ng's side when dot(Ns, Ng) < 0.
 // Object-space normals go to world by the inverse transpose of the instance matrix.
+// Normal maps (glTF normalTexture, tangent space): where a material has one, Ns
+//   is bent before anything reads it, on glass and opaque faces alike. The
+//   frame comes from the triangle (no tangent attribute): with world edges
+//   e1 = v1 - v0, e2 = v2 - v0 and the corners' UVs of the map's set through
+//   its transform, d1 = uv1 - uv0, d2 = uv2 - uv0, det = d1.x d2.y - d2.x d1.y:
+//   T = (e1 d2.y - e2 d1.y) / det, B = -(e2 d1.x - e1 d2.x) / det (B runs up
+//   the image, as v runs down it); no bend where det = 0 or T, B are not finite.
+//   t = normalize(T - Ns dot(Ns, T)) (no bend where that is zero), b = cross(Ns, t),
+//   negated where dot(b, B) < 0 (mirrored UVs); m = (2 texel - 1) * (scale, scale, 1)
+//   with texel the map's RGB read as data (bytes / 255, filtered as below);
+//   Ns' = normalize(m.x t + m.y b + m.z Ns), flipped to Ng's side.
+//   (Per-triangle frames equal MikkTSpace's wherever UVs are affine across
+//   neighbouring triangles; elsewhere they differ by the vertex smoothing.)
+// Alpha (glTF alphaMode) of an opaque face: alpha = baseColorFactor.a * the base
+//   texture's alpha (bytes / 255, filtered like its colour); coverage = 1 for
+//   OPAQUE, alpha >= alphaCutoff ? 1 : 0 for MASK, clamp(alpha, 0, 1) for BLEND.
+//   Where coverage < 1 the path adds throughput * coverage * (the face's
+//   opaque shading, below), goes on straight with throughput *= 1 - coverage
+//   from the hit (leaving that face, as secondary rays do), and counts an
+//   interface (the limit below ends it as a miss). Reflected rays shade such
+//   a face whole, and glass ignores alpha.
 //
 // Refractive faces (material transmission > 0) are the boundaries of media
 // (Schmidt & Budge 2002, "Simple Nested Dielectrics in Ray Traced Images"):

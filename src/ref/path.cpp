@@ -59,10 +59,11 @@ struct Tracer {
     if (hit.found()) {
       const TriangleData& tri = prepared.triangle(hit.triangle);
       const ResolvedMaterial& m = prepared.material(tri.material);
-      if (!m.refractive) {
+      if (!m.refractive) {  // alpha is not looked at: an opaque face is shaded whole (trace.h: Alpha)
         const SurfacePoint at = pointOf(hit, tri, width, spread, d);
         glm::dvec3 q, ns;
         surfaceAt(tri, at.b0, at.b1, at.b2, q, ns);
+        ns = normalMapped(m, tri, at, ns);
         return shadeOpaque(prepared, q, ns, d, m.baseFactor * textureColor(m.base, tri, at),
                            m.emissiveFactor * textureColor(m.emissive, tri, at));
       }
@@ -109,8 +110,11 @@ struct Tracer {
       surfaceAt(tri, here.b0, here.b1, here.b2, p, ns);
 
       const ResolvedMaterial& material = prepared.material(tri.material);
-      const glm::dvec3 base = material.baseFactor * textureColor(material.base, tri, here);
-      if (!material.refractive) {
+      ns = normalMapped(material, tri, here, ns);
+      const glm::dvec4 baseTexel = textureRgba(material.base, tri, here);
+      const glm::dvec3 base = material.baseFactor * glm::dvec3(baseTexel);
+      const double coverage = material.refractive ? 1.0 : coverageOf(material, baseTexel.a);
+      if (!material.refractive && coverage == 1.0) {
         if (result.interfaces > 0 && material.base.texture) result.landing = textureUv(material.base, tri, here);
         const glm::dvec3 emissive = material.emissiveFactor * textureColor(material.emissive, tri, here);
         result.color += throughput * shadeOpaque(prepared, p, ns, d, base, emissive);
@@ -121,6 +125,16 @@ struct Tracer {
         result.color += throughput * settings.background;  // ends as a miss
         result.outcome = gpu::kOutcomeInterfaceLimit;
         return true;
+      }
+      if (!material.refractive) {  // a face partly there: its light in proportion, the rest goes on straight
+        const glm::dvec3 emissive = material.emissiveFactor * textureColor(material.emissive, tri, here);
+        result.color += throughput * coverage * shadeOpaque(prepared, p, ns, d, base, emissive);
+        throughput *= 1.0 - coverage;
+        ++result.interfaces;
+        origin = p;
+        excluded = hit.triangle;
+        tMin = tMinFrom(origin);
+        continue;
       }
 
       const bool entering = glm::dot(d, ng) < 0.0;

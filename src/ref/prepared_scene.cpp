@@ -20,7 +20,7 @@ bool finite(const glm::dvec3& v) { return std::isfinite(v.x) && std::isfinite(v.
 
 PreparedScene::PreparedScene(const scene::Scene& scene, const scene::Pose& pose, const scene::View& view) {
   textures_.reserve(scene.textures.size());
-  // Only drawn textures get their mip chains (normal maps and the like are never sampled).
+  // Only drawn textures get their mip chains (the others are never sampled).
   const std::vector<bool> colour = scene::colourTextures(scene), drawn = scene::drawnTextures(scene);
   for (size_t t = 0; t < scene.textures.size(); ++t) {
     textures_.push_back(drawn[t] ? decode(scene.textures[t], colour[t]) : LinearTexture{});
@@ -38,9 +38,16 @@ PreparedScene::PreparedScene(const scene::Scene& scene, const scene::Pose& pose,
   for (const scene::Material& m : scene.materials) {
     ResolvedMaterial r;
     r.baseFactor = glm::dvec3(glm::vec3(m.baseColorFactor));
+    r.baseAlpha = double(m.baseColorFactor.a);
+    r.alphaMode = m.alphaMode == scene::AlphaMode::Mask    ? gpu::kAlphaMask
+                  : m.alphaMode == scene::AlphaMode::Blend ? gpu::kAlphaBlend
+                                                           : gpu::kAlphaOpaque;
+    r.alphaCutoff = double(m.alphaCutoff);
     r.emissiveFactor = glm::dvec3(m.emissiveFactor);
     r.base = use(m.baseColorTexture);
     r.emissive = use(m.emissiveTexture);
+    r.normal = use(m.normalTexture);
+    r.normalScale = double(m.normalScale);
     r.refractive = m.refractive();
     r.baseIor = double(m.ior);
     r.ior = use(m.iorTexture);

@@ -31,25 +31,25 @@ int64_t wrapIndex(int64_t i, int64_t n, uint32_t mode) {
   return ((i % n) + n) % n;
 }
 
-glm::dvec3 bilinear(const LinearTexture& t, size_t level, const glm::dvec2& uv, bool srgb) {
+glm::dvec4 bilinear(const LinearTexture& t, size_t level, const glm::dvec2& uv, bool srgb) {
   const LinearLevel& l = t.levels[level];
-  const std::vector<glm::dvec3>& texels = srgb ? l.texels : l.data;
+  const std::vector<glm::dvec4>& texels = srgb ? l.texels : l.data;
   auto texel = [&](int64_t x, int64_t y) {
     return texels[size_t(wrapIndex(y, l.height, t.wrapT) * l.width + wrapIndex(x, l.width, t.wrapS))];
   };
   double x = uv.x * double(l.width) - 0.5, y = uv.y * double(l.height) - 0.5;
   int64_t x0 = floorIndex(x), y0 = floorIndex(y);
   double fx = std::clamp(x - double(x0), 0.0, 1.0), fy = std::clamp(y - double(y0), 0.0, 1.0);
-  glm::dvec3 top = glm::mix(texel(x0, y0), texel(x0 + 1, y0), fx);
-  glm::dvec3 bottom = glm::mix(texel(x0, y0 + 1), texel(x0 + 1, y0 + 1), fx);
+  glm::dvec4 top = glm::mix(texel(x0, y0), texel(x0 + 1, y0), fx);
+  glm::dvec4 bottom = glm::mix(texel(x0, y0 + 1), texel(x0 + 1, y0 + 1), fx);
   return glm::mix(top, bottom, fy);
 }
 
 /// The texture at uv and level of detail `lod` (trace.h: Textures).
-glm::dvec3 sample(const LinearTexture& t, const glm::dvec2& uv, bool srgb, double lod) {
+glm::dvec4 sample(const LinearTexture& t, const glm::dvec2& uv, bool srgb, double lod) {
   if (t.nearest) {
     const LinearLevel& l = t.levels[0];
-    const std::vector<glm::dvec3>& texels = srgb ? l.texels : l.data;
+    const std::vector<glm::dvec4>& texels = srgb ? l.texels : l.data;
     int64_t x = wrapIndex(floorIndex(uv.x * double(l.width)), l.width, t.wrapS);
     int64_t y = wrapIndex(floorIndex(uv.y * double(l.height)), l.height, t.wrapT);
     return texels[size_t(y * l.width + x)];
@@ -58,7 +58,7 @@ glm::dvec3 sample(const LinearTexture& t, const glm::dvec2& uv, bool srgb, doubl
   lod = std::min(lod, double(t.levels.size() - 1));
   const size_t level = size_t(lod);
   const double f = lod - double(level);
-  glm::dvec3 c = bilinear(t, level, uv, srgb);
+  glm::dvec4 c = bilinear(t, level, uv, srgb);
   if (f > 0.0) c = glm::mix(c, bilinear(t, level + 1, uv, srgb), f);
   return c;
 }
@@ -78,8 +78,8 @@ LinearTexture decode(const scene::Texture& t, bool colour) {
     l.data.resize(count);
     for (size_t i = 0; i < count; ++i) {
       const uint8_t* rgba = &level.rgba[i * 4];
-      l.texels[i] = {table[rgba[0]], table[rgba[1]], table[rgba[2]]};
-      l.data[i] = glm::dvec3(rgba[0], rgba[1], rgba[2]) / 255.0;
+      l.texels[i] = {table[rgba[0]], table[rgba[1]], table[rgba[2]], rgba[3] / 255.0};
+      l.data[i] = glm::dvec4(rgba[0], rgba[1], rgba[2], rgba[3]) / 255.0;
     }
     out.levels.push_back(std::move(l));
   }
@@ -108,10 +108,46 @@ glm::dvec2 textureUv(const TextureUse& use, const TriangleData& tri, const Surfa
   return glm::dvec2(use.transform * glm::dvec3(uv, 1.0));
 }
 
-glm::dvec3 textureColor(const TextureUse& use, const TriangleData& tri, const SurfacePoint& at, bool srgb) {
-  if (!use.texture) return glm::dvec3(1.0);
+glm::dvec4 textureRgba(const TextureUse& use, const TriangleData& tri, const SurfacePoint& at, bool srgb) {
+  if (!use.texture) return glm::dvec4(1.0);
   const double lod = (use.texCoord == 1 ? at.lods.y : at.lods.x) + use.lodOffset;
   return sample(*use.texture, textureUv(use, tri, at), srgb, lod);
+}
+
+glm::dvec3 textureColor(const TextureUse& use, const TriangleData& tri, const SurfacePoint& at, bool srgb) {
+  return glm::dvec3(textureRgba(use, tri, at, srgb));
+}
+
+double coverageOf(const ResolvedMaterial& m, double textureAlpha) {
+  const double alpha = m.baseAlpha * textureAlpha;
+  if (m.alphaMode == gpu::kAlphaMask) return alpha >= m.alphaCutoff ? 1.0 : 0.0;
+  if (m.alphaMode == gpu::kAlphaBlend) return std::clamp(alpha, 0.0, 1.0);
+  return 1.0;
+}
+
+glm::dvec3 normalMapped(const ResolvedMaterial& m, const TriangleData& tri, const SurfacePoint& at, const glm::dvec3& ns) {
+  if (!m.normal.texture) return ns;
+  // The frame: world dp/du' and dp/dv'' with v'' = -v' running up the image,
+  // from the corners' UVs in the map's set through its transform.
+  glm::dvec2 uv[3];
+  for (int c = 0; c < 3; ++c) {
+    SurfacePoint corner{c == 0 ? 1.0 : 0.0, c == 1 ? 1.0 : 0.0, c == 2 ? 1.0 : 0.0, at.lods};
+    uv[c] = textureUv(m.normal, tri, corner);
+  }
+  const glm::dvec3 e1 = tri.v[1] - tri.v[0], e2 = tri.v[2] - tri.v[0];
+  const glm::dvec2 d1 = uv[1] - uv[0], d2 = uv[2] - uv[0];
+  const double det = d1.x * d2.y - d2.x * d1.y;
+  if (det == 0.0) return ns;
+  const glm::dvec3 t = (e1 * d2.y - e2 * d1.y) / det, b = -(e2 * d1.x - e1 * d2.x) / det;
+  glm::dvec3 tu = unitOrZero(t - ns * glm::dot(ns, t));
+  if (tu == glm::dvec3(0.0) || !std::isfinite(glm::dot(b, b))) return ns;
+  glm::dvec3 bu = glm::cross(ns, tu);
+  if (glm::dot(bu, b) < 0.0) bu = -bu;  // a mirrored UV layout flips the bitangent
+  const glm::dvec3 texel = textureColor(m.normal, tri, at, false);
+  const glm::dvec3 v = (2.0 * texel - 1.0) * glm::dvec3(m.normalScale, m.normalScale, 1.0);
+  glm::dvec3 n = unitOrZero(v.x * tu + v.y * bu + v.z * ns);
+  if (n == glm::dvec3(0.0)) return ns;
+  return glm::dot(n, tri.ng) < 0.0 ? -n : n;
 }
 
 bool lightAt(const ResolvedLight& light, const glm::dvec3& p, glm::dvec3& l, glm::dvec3& e) {

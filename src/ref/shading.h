@@ -27,8 +27,8 @@ class PreparedScene;
 /// One mip level decoded once (sRGB decode per texel, before filtering).
 struct LinearLevel {
   int64_t width = 0, height = 0;
-  std::vector<glm::dvec3> texels;  // linear RGB; row 0 is the image's first row
-  std::vector<glm::dvec3> data;    // the same texels as bytes / 255 (data textures: the IOR's)
+  std::vector<glm::dvec4> texels;  // linear RGB and alpha (bytes / 255); row 0 is the image's first row
+  std::vector<glm::dvec4> data;    // the same texels as bytes / 255 (data textures: the IOR's, normal maps)
 };
 
 /// A texture's mip chain (scene::mipChain, the GPU's rule) decoded.
@@ -56,8 +56,12 @@ struct TextureUse {
 
 struct ResolvedMaterial {
   glm::dvec3 baseFactor{1.0};
+  double baseAlpha = 1.0;  // baseColorFactor.a
+  uint32_t alphaMode = gpu::kAlphaOpaque;
+  double alphaCutoff = 0.5;
   glm::dvec3 emissiveFactor{0.0};
-  TextureUse base, emissive, ior;
+  TextureUse base, emissive, ior, normal;
+  double normalScale = 1.0;
   bool refractive = false;
   double baseIor = 1.5;
   double iorScale = 1.0, iorOffset = 0.0;
@@ -93,7 +97,16 @@ glm::dvec2 coneLods(const TriangleData& tri, double width, const glm::dvec3& d);
 /// The UV `use` reads at `at`: its set's UV through its KHR_texture_transform.
 glm::dvec2 textureUv(const TextureUse& use, const TriangleData& tri, const SurfacePoint& at);
 
+/// The texture `use` reads at `at`: colour (sRGB decoded, or data as bytes / 255) and alpha; white without one.
+glm::dvec4 textureRgba(const TextureUse& use, const TriangleData& tri, const SurfacePoint& at, bool srgb = true);
 glm::dvec3 textureColor(const TextureUse& use, const TriangleData& tri, const SurfacePoint& at, bool srgb = true);
+
+/// How much of an opaque face of `m` is there (trace.h: Alpha) where its base texture's alpha is `textureAlpha`.
+double coverageOf(const ResolvedMaterial& m, double textureAlpha);
+
+/// The shading normal `ns` (unit, on Ng's side) bent by `m`'s normal map at
+/// `at` (trace.h: Normal maps); `ns` itself without a map or with degenerate UVs.
+glm::dvec3 normalMapped(const ResolvedMaterial& m, const TriangleData& tri, const SurfacePoint& at, const glm::dvec3& ns);
 
 /// Light `light` as seen from p: the unit direction towards it and its
 /// irradiance; false where it has no direction (a light on the point).

@@ -45,9 +45,11 @@ static_assert(sizeof(GpuInstance) == 112 && offsetof(GpuInstance, worldToObject)
 
 static_assert(sizeof(GpuTextureSlot) == 48 && offsetof(GpuTextureSlot, texture) == 32 &&
               offsetof(GpuTextureSlot, lodOffset) == 40);
-static_assert(sizeof(GpuMaterial) == 224 && offsetof(GpuMaterial, transmission) == 48 &&
+static_assert(sizeof(GpuMaterial) == 288 && offsetof(GpuMaterial, transmission) == 48 &&
               offsetof(GpuMaterial, attenuationDistance) == 76 && offsetof(GpuMaterial, base) == 80 &&
-              offsetof(GpuMaterial, emissive) == 128 && offsetof(GpuMaterial, iorMap) == 176);
+              offsetof(GpuMaterial, emissive) == 128 && offsetof(GpuMaterial, iorMap) == 176 &&
+              offsetof(GpuMaterial, normal) == 224 && offsetof(GpuMaterial, normalScale) == 272 &&
+              offsetof(GpuMaterial, alphaMode) == 280);
 static_assert(sizeof(GpuTexture) == 16 && offsetof(GpuTexture, flags) == 12);
 static_assert(sizeof(TextureMipPush) == 32 && offsetof(TextureMipPush, srgb) == 24);
 static_assert(sizeof(GpuLight) == 64 && offsetof(GpuLight, cone) == 48);

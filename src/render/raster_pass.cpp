@@ -145,13 +145,15 @@ void RasterPass::recordDepthPass(vk::Commands& commands, const RasterScene& scen
 
 void RasterPass::recordShading(vk::Commands& commands, const RasterScene& scene, const FrameSettings& settings,
                                const RasterOptions& options, const vk::Image& traceImage, const vk::Image& target,
-                               const vk::Image& depth, const vk::Image& behindDepth) const {
-  recordShadingPass(commands, scene, settings, options, traceImage, target, depth, behindDepth, pass::kRasterShading);
+                               const vk::Image& depth, const vk::Image& behindDepth, bool traced) const {
+  recordShadingPass(commands, scene, settings, options, traceImage, target, depth, behindDepth,
+                    traced ? gpu::kRasterFlagTraced : 0u, pass::kRasterShading);
 }
 
 void RasterPass::recordShadingPass(vk::Commands& commands, const RasterScene& scene, const FrameSettings& settings,
                                    const RasterOptions& options, const vk::Image& traceImage, const vk::Image& target,
-                                   const vk::Image& depth, const vk::Image& behindDepth, const char* passName) const {
+                                   const vk::Image& depth, const vk::Image& behindDepth, uint32_t extraFlags,
+                                   const char* passName) const {
   for (const vk::Image* image : {&traceImage, &target, &depth, &behindDepth}) {
     if (image->width() != settings.width || image->height() != settings.height) {
       throw vk::VulkanError("raster pass: image '" + image->name() + "' is not the frame's size");
@@ -178,6 +180,7 @@ void RasterPass::recordShadingPass(vk::Commands& commands, const RasterScene& sc
                                                 {gpu::kRasterBindingRefractionMap, &map, nullptr}};
     scene.scene->appendBindings(resources, *scene.instances, *scene.lights);
     gpu::RasterPush p = push(scene, settings, options);
+    p.flags |= extraFlags;
     drawItems(commands, *fill_, scene, options, p, resources, area);
     if (options.wireframe) {
       p.flags |= gpu::kRasterFlagWireframe;
@@ -195,7 +198,7 @@ void RasterPass::recordBehind(vk::Commands& commands, const RasterScene& scene, 
   opaque.wireframe = false;
   recordDepthPass(commands, scene, settings, opaque, depth, &behindDepth, behind, gpu::kRasterFlagBehindDepth,
                   "behind depth");
-  recordShadingPass(commands, scene, settings, opaque, behind, behind, depth, behindDepth, "behind shading");
+  recordShadingPass(commands, scene, settings, opaque, behind, behind, depth, behindDepth, 0u, "behind shading");
   // The picture and its depth become what the shading pass's fragments read;
   // the depth attachment is cleared again by the next pre-pass.
   commands.barrier(VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT | VK_PIPELINE_STAGE_LATE_FRAGMENT_TESTS_BIT,

@@ -103,9 +103,12 @@ class RasterPass {
   /// `traceImage`'s texel (rgba16f, GENERAL, written before a compute-to-graphics
   /// barrier), or with a screen-space method a displaced texel of the picture
   /// recordBehind() drew there; `behindDepth` is that picture's depth.
+  /// `traced`: the trace drew this frame's see-through pixels into
+  /// `traceImage`, so faces alpha may make see-through take it too (else
+  /// they are shaded opaque).
   void recordShading(vk::Commands& commands, const RasterScene& scene, const FrameSettings& settings,
                      const RasterOptions& options, const vk::Image& traceImage, const vk::Image& target,
-                     const vk::Image& depth, const vk::Image& behindDepth) const;
+                     const vk::Image& depth, const vk::Image& behindDepth, bool traced) const;
   /// For the screen-space methods: the picture behind the glass (every
   /// opaque face, glass left out) into `behind` (rgba16f, colour attachment
   /// and storage) and its view depth into `behindDepth` (kMaskFormat), using
@@ -121,7 +124,8 @@ class RasterPass {
                        const vk::Image& colorTarget, uint32_t extraFlags, const char* passName) const;
   void recordShadingPass(vk::Commands& commands, const RasterScene& scene, const FrameSettings& settings,
                          const RasterOptions& options, const vk::Image& traceImage, const vk::Image& target,
-                         const vk::Image& depth, const vk::Image& behindDepth, const char* passName) const;
+                         const vk::Image& depth, const vk::Image& behindDepth, uint32_t extraFlags,
+                         const char* passName) const;
   void drawItems(vk::Commands& commands, const vk::GraphicsProgram& program, const RasterScene& scene,
                  const RasterOptions& options, const gpu::RasterPush& push, std::span<const vk::BufferBinding> resources,
                  VkRect2D area) const;

@@ -103,7 +103,7 @@ Renderer::Renderer(vk::Context& context, const scene::Scene& scene, const scene:
                                     name + " instances"});
   lights_ = vk::Buffer(context, {std::max<size_t>(lightNodes, 1) * sizeof(gpu::GpuLight), kStorage,
                                  vk::MemoryDomain::Device, name + " lights"});
-  for (char r : scene_.itemRefractive) refractive_ = refractive_ || r;
+  for (char r : scene_.itemSeeThrough) seeThrough_ = seeThrough_ || r;
 
   items_.resize(pose.items.size());
   itemDeformOutput_.assign(pose.items.size(), ~0u);
@@ -196,12 +196,12 @@ double Renderer::treeBytesPerTriangle() const {
 
 bool Renderer::viewNeedsTrees(const ViewRequest& request) const {
   if (request.output == ViewOutput::Trace) return !request.driverTrace;
-  return request.raster.refraction && request.raster.screenSpace == ScreenSpace::Off && refractive_ &&
+  return request.raster.refraction && request.raster.screenSpace == ScreenSpace::Off && seeThrough_ &&
          transmissiveInView(request.settings);
 }
 
 bool Renderer::transmissiveInView(const FrameSettings& settings) const {
-  return bounds_.anyInView(settings, scene_.itemRefractive);
+  return bounds_.anyInView(settings, scene_.itemSeeThrough);
 }
 
 Renderer::Update Renderer::planUpdate(const scene::Pose& pose, const std::vector<ViewRequest>& views,
@@ -419,7 +419,7 @@ void Renderer::recordView(vk::Commands& commands, Slot& slot, size_t index, cons
         bounds_.box(lo, hi);
         raster.depth = fitDepthRange(settings.view, lo, hi);
       }
-      bool glass = raster.refraction && refractive_ && transmissiveInView(settings);
+      bool glass = raster.refraction && seeThrough_ && transmissiveInView(settings);
       bool traces = glass && raster.screenSpace == ScreenSpace::Off;
       bool masked = traces && request.masked;
       // A screen-space method draws what lies behind the glass first, into the trace image.
@@ -433,7 +433,7 @@ void Renderer::recordView(vk::Commands& commands, Slot& slot, size_t index, cons
         if (masked) slot.maskedViews.push_back(index);
       }
       raster_->recordShading(commands, scene, settings, raster, view.images.trace, view.images.composite,
-                             view.images.depth, view.images.mask);
+                             view.images.depth, view.images.mask, traces);
     }
     view.rendered = true;
     view.version = sceneVersion_;
@@ -492,7 +492,7 @@ uint64_t Renderer::submit(const FrameRequest& request) {
   for (const ViewRequest& v : request.views) {
     trace_->prepare(v.settings);
     bool traces = v.output == ViewOutput::Trace ? !v.driverTrace
-                                                : v.raster.refraction && v.raster.screenSpace == ScreenSpace::Off && refractive_;
+                                                : v.raster.refraction && v.raster.screenSpace == ScreenSpace::Off && seeThrough_;
     if (traces) trace_->prefetch(v.settings, v.aov, v.output == ViewOutput::Composite && v.masked);
   }
   uint64_t frame = ++submitted_;

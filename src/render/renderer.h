@@ -203,8 +203,9 @@ class Renderer {
   const SceneGpu& sceneGpu() const { return scene_; }
   const scene::Scene& scene() const { return sceneModel_; }
   const glm::dvec3& origin() const { return origin_.origin(); }
-  /// Whether any face of the scene refracts (else a composite never traces).
-  bool refractive() const { return refractive_; }
+  /// Whether any face of the scene refracts or may be see-through by alpha
+  /// (else a composite never traces).
+  bool seeThrough() const { return seeThrough_; }
   /// The trees, built by the first frame that traces (null before).
   const Bvh* blas() const { return blas_.get(); }
   const Bvh* tlas() const { return tlas_.get(); }
@@ -245,7 +246,7 @@ class Renderer {
   std::unique_ptr<Bvh> blas_, tlas_;
   vk::Buffer instances_, lights_;
   uint32_t lightCount_ = 0;
-  bool refractive_ = false;
+  bool seeThrough_ = false;
   std::vector<RefractionMapBuffer> maps_;  ///< per view index, baked by bakeRefractionMap
 
   // What the GPU holds, to find what changed.

@@ -183,6 +183,12 @@ gpu::GpuMaterial packMaterial(const scene::Material& m, const scene::Scene& scen
   g.base = slot(m.baseColorTexture);
   g.emissive = slot(m.emissiveTexture);
   g.iorMap = slot(m.iorTexture);
+  g.normal = slot(m.normalTexture);
+  g.normalScale = m.normalScale;
+  g.alphaMode = m.alphaMode == scene::AlphaMode::Mask    ? gpu::kAlphaMask
+                : m.alphaMode == scene::AlphaMode::Blend ? gpu::kAlphaBlend
+                                                         : gpu::kAlphaOpaque;
+  g.alphaCutoff = m.alphaCutoff;
   return g;
 }
 
@@ -248,7 +254,9 @@ SceneGpu uploadScene(vk::Context& context, const scene::Scene& scene, const scen
     bool hasMaterial = shape.material >= 0 && size_t(shape.material) < scene.materials.size();
     gpu.itemMaterial.push_back(hasMaterial ? static_cast<uint32_t>(shape.material)
                                            : static_cast<uint32_t>(scene.materials.size()));
-    gpu.itemRefractive.push_back(hasMaterial && scene.materials[size_t(shape.material)].refractive() ? 1 : 0);
+    const scene::Material* material = hasMaterial ? &scene.materials[size_t(shape.material)] : nullptr;
+    gpu.itemRefractive.push_back(material && material->refractive() ? 1 : 0);
+    gpu.itemSeeThrough.push_back(material && (material->refractive() || material->alphaMode != scene::AlphaMode::Opaque));
   }
   if (host) vertices = host->vertexCapacity;  // the host's numbering, gaps and all
   gpu.vertexCount = static_cast<uint32_t>(vertices);

@@ -31,6 +31,9 @@ struct SceneGpu {
   std::vector<uint32_t> itemGeometry;  ///< per pose item
   std::vector<uint32_t> itemMaterial;  ///< per pose item: index into the material table
   std::vector<char> itemRefractive;    ///< per pose item: its faces refract (material transmission > 0)
+  /// Per pose item: a viewport leaves its pixels to the trace (its faces
+  /// refract, or alpha may make them see-through).
+  std::vector<char> itemSeeThrough;
   uint32_t vertexCount = 0, triangleCount = 0;
   vk::Buffer positions, normals;  ///< float[3 * vertexCount]; rest pose, deformed slices rewritten per frame
   vk::Buffer texcoords;           ///< vec4 per vertex: uv0, uv1

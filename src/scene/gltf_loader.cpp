@@ -70,13 +70,7 @@ glm::mat3 textureTransform(const tinygltf::ExtensionMap& extensions) {
   if (t.Has("scale") && t.Get("scale").ArrayLen() == 2) {
     scale = {t.Get("scale").Get(0).GetNumberAsDouble(), t.Get("scale").Get(1).GetNumberAsDouble()};
   }
-  float rotation = static_cast<float>(number(t, "rotation", 0.0));
-  float c = std::cos(rotation), s = std::sin(rotation);
-  // The extension's order: translate * rotate * scale (column-major here).
-  glm::mat3 translate(1, 0, 0, 0, 1, 0, offset.x, offset.y, 1);
-  glm::mat3 rotate(c, -s, 0, s, c, 0, 0, 0, 1);
-  glm::mat3 scaling(scale.x, 0, 0, 0, scale.y, 0, 0, 0, 1);
-  return translate * rotate * scaling;
+  return uvTransform(offset, static_cast<float>(number(t, "rotation", 0.0)), scale);
 }
 
 TextureRef textureRef(const Reader& r, int index, int texCoord, const tinygltf::ExtensionMap& extensions,
@@ -174,9 +168,14 @@ void loadMaterials(const Reader& r) {
     }
     material.emissiveTexture = textureRef(r, source.emissiveTexture.index, source.emissiveTexture.texCoord,
                                           source.emissiveTexture.extensions, what + " emissiveTexture");
+    material.normalTexture = textureRef(r, source.normalTexture.index, source.normalTexture.texCoord,
+                                        source.normalTexture.extensions, what + " normalTexture");
+    material.normalScale = static_cast<float>(source.normalTexture.scale);
+    if (!std::isfinite(material.normalScale)) r.fail(what + ": normalTexture.scale is not finite");
     material.doubleSided = source.doubleSided;
     material.alphaMode = source.alphaMode == "MASK" ? AlphaMode::Mask : source.alphaMode == "BLEND" ? AlphaMode::Blend : AlphaMode::Opaque;
     material.alphaCutoff = static_cast<float>(source.alphaCutoff);
+    if (!(material.alphaCutoff >= 0.0f)) r.fail(what + ": alphaCutoff " + std::to_string(material.alphaCutoff) + " is negative");
     material.roughness = static_cast<float>(std::clamp(pbr.roughnessFactor, 0.0, 1.0));
 
     auto extension = [&](const char* name) -> const tinygltf::Value* {
@@ -246,8 +245,8 @@ void loadMaterials(const Reader& r) {
   }
   // A texture that could not be decoded is dropped from every material that uses it.
   for (Material& material : r.scene.materials) {
-    for (TextureRef* ref : {&material.baseColorTexture, &material.emissiveTexture, &material.transmissionTexture,
-                            &material.thicknessTexture, &material.iorTexture}) {
+    for (TextureRef* ref : {&material.baseColorTexture, &material.emissiveTexture, &material.normalTexture,
+                            &material.transmissionTexture, &material.thicknessTexture, &material.iorTexture}) {
       if (ref->present() && r.scene.textures[size_t(ref->texture)].rgba.empty()) *ref = TextureRef{};
     }
   }

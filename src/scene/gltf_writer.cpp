@@ -124,8 +124,18 @@ void saveGltf(const Scene& scene, const std::string& path) {
       out.pbrMetallicRoughness.baseColorTexture.texCoord = m.baseColorTexture.texCoord;
     }
     out.emissiveFactor = {m.emissiveFactor.r, m.emissiveFactor.g, m.emissiveFactor.b};
+    if (m.emissiveTexture.present()) {
+      out.emissiveTexture.index = m.emissiveTexture.texture;
+      out.emissiveTexture.texCoord = m.emissiveTexture.texCoord;
+    }
+    if (m.normalTexture.present()) {
+      out.normalTexture.index = m.normalTexture.texture;
+      out.normalTexture.texCoord = m.normalTexture.texCoord;
+      out.normalTexture.scale = m.normalScale;
+    }
     out.doubleSided = m.doubleSided;
     out.alphaMode = m.alphaMode == AlphaMode::Mask ? "MASK" : m.alphaMode == AlphaMode::Blend ? "BLEND" : "OPAQUE";
+    if (m.alphaMode == AlphaMode::Mask) out.alphaCutoff = m.alphaCutoff;
     if (m.refractive()) {
       tinygltf::Value::Object transmission{{"transmissionFactor", tinygltf::Value(double(m.transmission))}};
       if (m.transmissionTexture.present()) transmission["transmissionTexture"] = textureInfo(m.transmissionTexture);

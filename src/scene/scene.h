@@ -63,6 +63,16 @@ struct TextureRef {
   bool present() const { return texture >= 0; }
 };
 
+/// KHR_texture_transform's UV matrix: translate(offset) * rotate(rotation) * scale(scale).
+inline glm::mat3 uvTransform(glm::vec2 offset, float rotation, glm::vec2 scale) {
+  float c = std::cos(rotation), s = std::sin(rotation);
+  // Column-major, as glm stores them.
+  glm::mat3 translate(1, 0, 0, 0, 1, 0, offset.x, offset.y, 1);
+  glm::mat3 rotate(c, -s, 0, s, c, 0, 0, 0, 1);
+  glm::mat3 scaling(scale.x, 0, 0, 0, scale.y, 0, 0, 0, 1);
+  return translate * rotate * scaling;
+}
+
 enum class AlphaMode { Opaque, Mask, Blend };
 
 struct Material {
@@ -71,6 +81,9 @@ struct Material {
   TextureRef baseColorTexture;
   glm::vec3 emissiveFactor{0.0f};
   TextureRef emissiveTexture;
+  /// A tangent-space normal map (glTF normalTexture); x and y are scaled by normalScale.
+  TextureRef normalTexture;
+  float normalScale = 1.0f;
   bool doubleSided = false;
   AlphaMode alphaMode = AlphaMode::Opaque;
   float alphaCutoff = 0.5f;

@@ -23,7 +23,7 @@ uint64_t mipChainTexels(uint32_t width, uint32_t height) {
 std::vector<bool> drawnTextures(const Scene& scene) {
   std::vector<bool> drawn(scene.textures.size(), false);
   for (const Material& m : scene.materials) {
-    for (const TextureRef* ref : {&m.baseColorTexture, &m.emissiveTexture, &m.iorTexture}) {
+    for (const TextureRef* ref : {&m.baseColorTexture, &m.emissiveTexture, &m.normalTexture, &m.iorTexture}) {
       if (ref->present() && size_t(ref->texture) < drawn.size()) drawn[size_t(ref->texture)] = true;
     }
   }
@@ -39,6 +39,7 @@ std::vector<bool> colourTextures(const Scene& scene) {
     mark(m.baseColorTexture, colour);
     mark(m.emissiveTexture, colour);
     mark(m.iorTexture, data);
+    mark(m.normalTexture, data);
   }
   for (size_t t = 0; t < colour.size(); ++t) colour[t] = colour[t] || !data[t];
   return colour;

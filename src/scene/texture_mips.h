@@ -18,7 +18,8 @@ uint32_t mipLevels(uint32_t width, uint32_t height);
 uint64_t mipChainTexels(uint32_t width, uint32_t height);
 
 /// Per texture: true where it holds colour (sRGB, averaged in linear light),
-/// false where only an IOR texture reads it (data, averaged as bytes).
+/// false where only data slots (the IOR texture, the normal map) read it
+/// (averaged as bytes).
 std::vector<bool> colourTextures(const Scene& scene);
 
 /// 0.5 log2(W H |det|): how many texels of level 0 one unit of UV area
