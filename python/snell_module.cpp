@@ -9,11 +9,13 @@
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <memory>
 #include <optional>
 #include <string>
+#include <type_traits>
 #include <unistd.h>
 #include <vector>
 
@@ -160,7 +162,39 @@ struct PyInstance {
 struct PyTexture {
   py::object rgba;
   std::string name;
+  snell::Texture::Wrap wrapS = snell::Texture::Wrap::Repeat, wrapT = snell::Texture::Wrap::Repeat;
+  bool nearest = false;
 };
+
+snell::Texture::Wrap wrapMode(const std::string& name) {
+  if (name == "repeat") return snell::Texture::Wrap::Repeat;
+  if (name == "clamp") return snell::Texture::Wrap::Clamp;
+  if (name == "mirror") return snell::Texture::Wrap::Mirror;
+  throw snell::Error("texture wrap '" + name + "' is not repeat, clamp or mirror");
+}
+
+const char* wrapName(snell::Texture::Wrap wrap) {
+  switch (wrap) {
+    case snell::Texture::Wrap::Clamp: return "clamp";
+    case snell::Texture::Wrap::Mirror: return "mirror";
+    default: return "repeat";
+  }
+}
+
+snell::Material::Alpha alphaMode(const std::string& name) {
+  if (name == "opaque") return snell::Material::Alpha::Opaque;
+  if (name == "mask") return snell::Material::Alpha::Mask;
+  if (name == "blend") return snell::Material::Alpha::Blend;
+  throw snell::Error("alpha_mode '" + name + "' is not opaque, mask or blend");
+}
+
+const char* alphaName(snell::Material::Alpha alpha) {
+  switch (alpha) {
+    case snell::Material::Alpha::Mask: return "mask";
+    case snell::Material::Alpha::Blend: return "blend";
+    default: return "opaque";
+  }
+}
 
 snell::Light::Type lightType(const std::string& name) {
   if (name == "point") return snell::Light::Type::Point;
@@ -195,8 +229,12 @@ snell::Scene sceneFromArrays(const std::vector<PyMesh>& meshes, const std::vecto
       throw snell::Error(what + " must have shape (height, width, 4)");
     }
     auto pixels = py::array_t<uint8_t, py::array::c_style>::ensure(a);
-    host.textures.push_back(snell::Texture{textures[i].name, uint32_t(a.shape(1)), uint32_t(a.shape(0)),
-                                           std::vector<uint8_t>(pixels.data(), pixels.data() + pixels.size())});
+    snell::Texture& texture =
+        host.textures.emplace_back(snell::Texture{textures[i].name, uint32_t(a.shape(1)), uint32_t(a.shape(0)),
+                                                  std::vector<uint8_t>(pixels.data(), pixels.data() + pixels.size())});
+    texture.wrapS = textures[i].wrapS;
+    texture.wrapT = textures[i].wrapT;
+    texture.nearest = textures[i].nearest;
   }
   for (size_t i = 0; i < meshes.size(); ++i) {
     const PyMesh& m = meshes[i];
@@ -326,11 +364,31 @@ PYBIND11_MODULE(_snell, m) {
         return d.device ? "<snell.Device '" + d.device->name() + "'>" : std::string("<snell.Device (closed)>");
       });
 
+  py::class_<snell::TextureTransform>(m, "TextureTransform",
+                                      "How a material's texture reads its UVs (glTF's KHR_texture_transform).")
+      .def(py::init([](const std::vector<float>& offset, float rotation, const std::vector<float>& scale) {
+             if (offset.size() != 2 || scale.size() != 2) throw snell::Error("offset and scale need 2 numbers each");
+             return snell::TextureTransform{{offset[0], offset[1]}, rotation, {scale[0], scale[1]}};
+           }),
+           "offset"_a = std::vector<float>{0, 0}, "rotation"_a = 0.0f, "scale"_a = std::vector<float>{1, 1},
+           "uv' = translate(offset) * rotate(rotation, radians) * scale(scale) * uv.")
+      .def_readwrite("offset", &snell::TextureTransform::offset)
+      .def_readwrite("rotation", &snell::TextureTransform::rotation)
+      .def_readwrite("scale", &snell::TextureTransform::scale)
+      .def("__repr__", [](const snell::TextureTransform& t) {
+        return "snell.TextureTransform(offset=(" + std::to_string(t.offset[0]) + ", " + std::to_string(t.offset[1]) +
+               "), rotation=" + std::to_string(t.rotation) + ", scale=(" + std::to_string(t.scale[0]) + ", " +
+               std::to_string(t.scale[1]) + "))";
+      });
+
   py::class_<snell::Material>(m, "Material", "A glTF metallic-roughness material with transmission, IOR and volume.")
       .def(py::init([](const std::string& name, const std::vector<float>& baseColor, int baseColorTexture,
                        float transmission, float ior, float roughness, float thickness,
                        const std::vector<float>& attenuationColor, float attenuationDistance, bool doubleSided,
-                       const std::vector<float>& emissive, float dispersion) {
+                       const std::vector<float>& emissive, float dispersion, int emissiveTexture, int normalTexture,
+                       float normalScale, const std::string& alpha, float alphaCutoff,
+                       const snell::TextureTransform& baseColorTransform, const snell::TextureTransform& emissiveTransform,
+                       const snell::TextureTransform& normalTransform) {
              snell::Material mat;
              mat.name = name;
              if (baseColor.size() != 3 && baseColor.size() != 4) throw snell::Error("base_color needs 3 or 4 numbers");
@@ -345,15 +403,27 @@ PYBIND11_MODULE(_snell, m) {
              mat.doubleSided = doubleSided;
              mat.emissive = toVec3(emissive, "emissive");
              mat.dispersion = dispersion;
+             mat.emissiveTexture = emissiveTexture;
+             mat.normalTexture = normalTexture;
+             mat.normalScale = normalScale;
+             mat.alphaMode = alphaMode(alpha);
+             mat.alphaCutoff = alphaCutoff;
+             mat.baseColorTransform = baseColorTransform;
+             mat.emissiveTransform = emissiveTransform;
+             mat.normalTransform = normalTransform;
              return mat;
            }),
            "name"_a = "", "base_color"_a = std::vector<float>{1, 1, 1, 1}, "base_color_texture"_a = -1,
            "transmission"_a = 0.0f, "ior"_a = 1.5f, "roughness"_a = 1.0f, "thickness"_a = 0.0f,
            "attenuation_color"_a = std::vector<float>{1, 1, 1}, "attenuation_distance"_a = INFINITY,
            "double_sided"_a = false, "emissive"_a = std::vector<float>{0, 0, 0}, "dispersion"_a = 0.0f,
+           "emissive_texture"_a = -1, "normal_texture"_a = -1, "normal_scale"_a = 1.0f, "alpha_mode"_a = "opaque",
+           "alpha_cutoff"_a = 0.5f, "base_color_transform"_a = snell::TextureTransform{},
+           "emissive_transform"_a = snell::TextureTransform{}, "normal_transform"_a = snell::TextureTransform{},
            "Colours are linear RGB(A). transmission > 0 makes the faces refract; thickness > 0 with\n"
-           "a finite attenuation_distance gives the glass a volume; base_color_texture indexes\n"
-           "Scene.from_arrays' textures.")
+           "a finite attenuation_distance gives the glass a volume; the *_texture arguments index\n"
+           "Scene.from_arrays' textures (a normal map is glTF's: tangent space, +Y up the image).\n"
+           "alpha_mode 'mask' or 'blend' lets base_color's alpha (times the texture's) show what is behind.")
       .def_readwrite("name", &snell::Material::name)
       .def_readwrite("base_color", &snell::Material::baseColor)
       .def_readwrite("base_color_texture", &snell::Material::baseColorTexture)
@@ -365,7 +435,17 @@ PYBIND11_MODULE(_snell, m) {
       .def_readwrite("attenuation_distance", &snell::Material::attenuationDistance)
       .def_readwrite("double_sided", &snell::Material::doubleSided)
       .def_readwrite("emissive", &snell::Material::emissive)
-      .def_readwrite("dispersion", &snell::Material::dispersion);
+      .def_readwrite("dispersion", &snell::Material::dispersion)
+      .def_readwrite("emissive_texture", &snell::Material::emissiveTexture)
+      .def_readwrite("normal_texture", &snell::Material::normalTexture)
+      .def_readwrite("normal_scale", &snell::Material::normalScale)
+      .def_property(
+          "alpha_mode", [](const snell::Material& mat) { return std::string(alphaName(mat.alphaMode)); },
+          [](snell::Material& mat, const std::string& alpha) { mat.alphaMode = alphaMode(alpha); })
+      .def_readwrite("alpha_cutoff", &snell::Material::alphaCutoff)
+      .def_readwrite("base_color_transform", &snell::Material::baseColorTransform)
+      .def_readwrite("emissive_transform", &snell::Material::emissiveTransform)
+      .def_readwrite("normal_transform", &snell::Material::normalTransform);
 
   py::class_<snell::Light>(m, "Light", "A punctual light: candela for point and spot lights, lux for directional.")
       .def(py::init([](const std::string& type, const std::vector<float>& color, float intensity,
@@ -436,11 +516,24 @@ PYBIND11_MODULE(_snell, m) {
       .def_readwrite("mesh", &PyInstance::mesh)
       .def_readonly("transform", &PyInstance::transform);
 
-  py::class_<PyTexture>(m, "Texture", "An 8-bit sRGB RGBA texture, row 0 at the top, repeating.")
-      .def(py::init([](py::object rgba, const std::string& name) { return PyTexture{std::move(rgba), name}; }),
-           "rgba"_a, "name"_a = "", "rgba: (height, width, 4) uint8.")
+  py::class_<PyTexture>(m, "Texture",
+                        "An 8-bit RGBA texture, row 0 at the top: sRGB colour, or data for a normal map.")
+      .def(py::init([](py::object rgba, const std::string& name, const std::string& wrapS, const std::string& wrapT,
+                       bool nearest) {
+             return PyTexture{std::move(rgba), name, wrapMode(wrapS), wrapMode(wrapT), nearest};
+           }),
+           "rgba"_a, "name"_a = "", "wrap_s"_a = "repeat", "wrap_t"_a = "repeat", "nearest"_a = false,
+           "rgba: (height, width, 4) uint8. wrap_s, wrap_t: repeat, clamp or mirror across u and v;\n"
+           "nearest: read the nearest texel, unfiltered.")
       .def_readonly("rgba", &PyTexture::rgba)
-      .def_readwrite("name", &PyTexture::name);
+      .def_readwrite("name", &PyTexture::name)
+      .def_property(
+          "wrap_s", [](const PyTexture& t) { return std::string(wrapName(t.wrapS)); },
+          [](PyTexture& t, const std::string& wrap) { t.wrapS = wrapMode(wrap); })
+      .def_property(
+          "wrap_t", [](const PyTexture& t) { return std::string(wrapName(t.wrapT)); },
+          [](PyTexture& t, const std::string& wrap) { t.wrapT = wrapMode(wrap); })
+      .def_readwrite("nearest", &PyTexture::nearest);
 
   py::class_<PyScene>(m, "Scene", "What is drawn: a glTF file, or meshes from numpy arrays.")
       .def_static(
@@ -662,6 +755,38 @@ PYBIND11_MODULE(_snell, m) {
           },
           "view"_a, "image"_a,
           "Renders `view` into a SharedImage and waits for the GPU: the pixels never visit the host.")
+      .def(
+          "render_aovs",
+          [](PyRenderer& r, const snell::View& view) {
+            RendererState& state = r.get();
+            snell::Aovs aovs;
+            {
+              py::gil_scoped_release release;
+              aovs = state.renderer.readAovs(view);
+            }
+            const py::ssize_t h = aovs.height, w = aovs.width;
+            auto planes = [&](auto& values, std::vector<py::ssize_t> shape) {
+              using T = typename std::decay_t<decltype(values)>::value_type;
+              py::array_t<T> a(shape);
+              std::copy(values.begin(), values.end(), a.mutable_data());
+              return a;
+            };
+            py::dict out;
+            out["rgba"] = planes(aovs.rgba, {h, w, 4});
+            out["depth"] = planes(aovs.depth, {h, w});
+            out["normal"] = planes(aovs.normal, {h, w, 3});
+            out["instance"] = planes(aovs.instance, {h, w});
+            out["primitive"] = planes(aovs.primitive, {h, w});
+            out["interfaces"] = planes(aovs.interfaces, {h, w});
+            out["cost"] = planes(aovs.cost, {h, w});
+            return out;
+          },
+          "view"_a,
+          "Traces every pixel of `view` and returns what each pixel's ray found, as numpy arrays:\n"
+          "rgba (h, w, 4) float32 with alpha = coverage; depth (h, w) float32, camera-space, inf where\n"
+          "nothing was hit; normal (h, w, 3) float32, world-space face normals; instance, primitive\n"
+          "(h, w) uint32, 0xffffffff where nothing was hit; interfaces, cost (h, w) uint32. The method\n"
+          "must trace (auto, trace or trace-1).")
       .def("last_frame", [](const PyRenderer& r) { return frameDict(r.get().renderer.lastFrame()); },
            "What the last frame did: counters and per-pass GPU milliseconds (pass_ms, gpu_ms).")
       .def("close", [](PyRenderer& r) { r.state.reset(); },

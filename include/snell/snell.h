@@ -123,11 +123,25 @@ class Device {
   std::unique_ptr<Impl> impl_;
 };
 
+/// How a material's texture reads its UVs: glTF's KHR_texture_transform,
+/// uv' = translate(offset) * rotate(rotation) * scale(scale) * uv.
+struct TextureTransform {
+  std::array<float, 2> offset{0, 0};
+  float rotation = 0;  ///< radians, as the extension's rotation
+  std::array<float, 2> scale{1, 1};
+};
+
 /// A glTF metallic-roughness material with the transmission, IOR and volume extensions.
 struct Material {
   std::string name;
-  std::array<float, 4> baseColor{1, 1, 1, 1};  ///< linear RGBA
+  std::array<float, 4> baseColor{1, 1, 1, 1};  ///< linear RGBA; alpha counts as alphaMode says
   int baseColorTexture = -1;                   ///< index into HostScene::textures; -1: none
+  TextureTransform baseColorTransform;
+  /// How alpha (baseColor[3] times the base texture's alpha) covers an
+  /// opaque face: ignored; Mask: there where alpha >= alphaCutoff, else not;
+  /// Blend: the face's light times alpha over what lies behind. Glass ignores it.
+  enum class Alpha { Opaque, Mask, Blend } alphaMode = Alpha::Opaque;
+  float alphaCutoff = 0.5f;
   float transmission = 0;                      ///< > 0: the faces refract
   float ior = 1.5f;
   float roughness = 1;    ///< the width of a glass face's highlights
@@ -136,14 +150,25 @@ struct Material {
   float attenuationDistance = INFINITY;
   bool doubleSided = false;
   Vec3 emissive{0, 0, 0};  ///< linear RGB the faces give off
+  int emissiveTexture = -1;  ///< sRGB, multiplies `emissive`; -1: none
+  TextureTransform emissiveTransform;
+  /// A tangent-space normal map as glTF's normalTexture (+Y up the image,
+  /// read as data, not sRGB); its frame comes from each triangle's UVs. -1: none.
+  int normalTexture = -1;
+  float normalScale = 1;  ///< scales the map's X and Y
+  TextureTransform normalTransform;
   float dispersion = 0;    ///< KHR_materials_dispersion: 20 / Abbe number; 0: none
 };
 
-/// An 8-bit sRGB RGBA texture, row 0 at the top, repeating.
+/// An 8-bit RGBA texture, row 0 at the top: sRGB colour for a base colour or
+/// emissive texture, data for a normal map.
 struct Texture {
   std::string name;
   uint32_t width = 0, height = 0;
   std::vector<uint8_t> rgba;  ///< width * height * 4 bytes
+  enum class Wrap { Repeat, Clamp, Mirror };
+  Wrap wrapS = Wrap::Repeat, wrapT = Wrap::Repeat;  ///< across u and v
+  bool nearest = false;  ///< the nearest texel of the full size, not filtered
 };
 
 /// A triangle mesh whose vertices live in the host's buffers (HostScene::positions and normals).
@@ -351,6 +376,23 @@ struct FrameInfo {
   std::vector<PassTime> passes;  ///< GPU time per pass, in order
 };
 
+/// What the trace found at each pixel of a view (Renderer::readAovs), row 0
+/// at the top, as `snell render --aov` writes them into an EXR.
+struct Aovs {
+  uint32_t width = 0, height = 0;
+  /// The traced picture, linear RGBA; alpha is coverage: 1 where the pixel's ray met a surface.
+  std::vector<float> rgba;
+  /// Camera-space depth of the first surface along the view's axis; +infinity where none.
+  std::vector<float> depth;
+  /// 3 per pixel: the first surface's unit world-space face normal; 0 where
+  /// none, and everywhere for a scene whose vertices are in the host's buffers.
+  std::vector<float> normal;
+  /// The first surface's draw item (Renderer::instanceCount) and its triangle; UINT32_MAX where none.
+  std::vector<uint32_t> instance, primitive;
+  std::vector<uint32_t> interfaces;  ///< glass (and see-through) faces the pixel's path crossed
+  std::vector<uint32_t> cost;        ///< tree nodes the pixel's paths visited
+};
+
 /// Where the host rewrites a kept mesh's vertices (Renderer::vertices).
 struct Vertices {
   float* positions = nullptr;  ///< count * 3 floats
@@ -396,6 +438,10 @@ class Renderer {
   std::vector<float> read(const View& view);
   /// The same into the host's memory: view.width * view.height * 4 floats.
   void read(const View& view, float* rgba);
+  /// Traces every pixel of `view` (whatever its output says) and reads the
+  /// picture back with what each pixel's ray found. The method must trace:
+  /// "auto" (empty), "trace" or "trace-1".
+  Aovs readAovs(const View& view);
   /// What the last frame did.
   FrameInfo lastFrame() const;
 

@@ -42,6 +42,19 @@ class Device:
         traceback: Optional[TracebackType],
     ) -> None: ...
 
+class TextureTransform:
+    """How a material's texture reads its UVs (glTF's KHR_texture_transform)."""
+
+    offset: Sequence[float]
+    rotation: float
+    scale: Sequence[float]
+    def __init__(
+        self,
+        offset: Sequence[float] = (0, 0),
+        rotation: float = 0.0,
+        scale: Sequence[float] = (1, 1),
+    ) -> None: ...
+
 class Material:
     """A glTF metallic-roughness material with transmission, IOR and volume (colours linear)."""
 
@@ -57,6 +70,14 @@ class Material:
     double_sided: bool
     emissive: Sequence[float]
     dispersion: float
+    emissive_texture: int
+    normal_texture: int
+    normal_scale: float
+    alpha_mode: str
+    alpha_cutoff: float
+    base_color_transform: TextureTransform
+    emissive_transform: TextureTransform
+    normal_transform: TextureTransform
     def __init__(
         self,
         name: str = "",
@@ -71,6 +92,14 @@ class Material:
         double_sided: bool = False,
         emissive: Sequence[float] = (0, 0, 0),
         dispersion: float = 0.0,
+        emissive_texture: int = -1,
+        normal_texture: int = -1,
+        normal_scale: float = 1.0,
+        alpha_mode: str = "opaque",
+        alpha_cutoff: float = 0.5,
+        base_color_transform: TextureTransform = ...,
+        emissive_transform: TextureTransform = ...,
+        normal_transform: TextureTransform = ...,
     ) -> None: ...
 
 class Light:
@@ -144,10 +173,20 @@ class Instance:
     def transform(self) -> Optional[Matrix]: ...
 
 class Texture:
-    """An 8-bit sRGB RGBA texture, (height, width, 4) uint8, row 0 at the top."""
+    """An 8-bit RGBA texture, (height, width, 4) uint8, row 0 at the top: sRGB colour, or a normal map's data."""
 
     name: str
-    def __init__(self, rgba: npt.NDArray[np.uint8], name: str = "") -> None: ...
+    wrap_s: str
+    wrap_t: str
+    nearest: bool
+    def __init__(
+        self,
+        rgba: npt.NDArray[np.uint8],
+        name: str = "",
+        wrap_s: str = "repeat",
+        wrap_t: str = "repeat",
+        nearest: bool = False,
+    ) -> None: ...
     @property
     def rgba(self) -> npt.NDArray[np.uint8]: ...
 
@@ -246,6 +285,7 @@ class Renderer:
     def render(self, view: View) -> npt.NDArray[np.float32]: ...
     def render_into(self, view: View, out: npt.NDArray[np.float32]) -> None: ...
     def render_to(self, view: View, image: SharedImage) -> None: ...
+    def render_aovs(self, view: View) -> dict[str, npt.NDArray[Any]]: ...
     def last_frame(self) -> dict[str, Any]: ...
     def close(self) -> None: ...
     def __enter__(self) -> "Renderer": ...

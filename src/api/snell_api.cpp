@@ -6,6 +6,7 @@
 
 #include "bake/refraction_bake.h"
 #include "render/method.h"
+#include "render/pixel_aovs.h"
 #include "render/raster_pass.h"
 #include "render/renderer.h"
 #include "scene/evaluate.h"
@@ -169,21 +170,40 @@ Scene Scene::load(const std::string& path) {
 
 namespace {
 
-scene::Material toMaterial(const Material& m, size_t textures, const std::string& where) {
-  if (m.baseColorTexture >= int(textures)) {
-    throw Error(where + ": baseColorTexture " + std::to_string(m.baseColorTexture) + " of " + std::to_string(textures) +
-                " textures");
+// One of a material's texture slots: its index checked against the scene's textures.
+scene::TextureRef toTextureRef(int texture, const TextureTransform& t, size_t textures, const std::string& where) {
+  if (texture < -1 || texture >= int(textures)) {
+    throw Error(where + " " + std::to_string(texture) + " of " + std::to_string(textures) + " textures");
   }
+  for (float f : {t.offset[0], t.offset[1], t.rotation, t.scale[0], t.scale[1]}) {
+    if (!std::isfinite(f)) throw Error(where + "'s transform is not finite");
+  }
+  scene::TextureRef ref;
+  ref.texture = texture;
+  ref.transform = scene::uvTransform({t.offset[0], t.offset[1]}, t.rotation, {t.scale[0], t.scale[1]});
+  return ref;
+}
+
+scene::Material toMaterial(const Material& m, size_t textures, const std::string& where) {
   if (!(m.ior >= 1.0f) || !(m.transmission >= 0.0f && m.transmission <= 1.0f)) {
     throw Error(where + ": ior must be at least 1 and transmission within [0, 1]");
   }
   if (!(m.dispersion >= 0.0f) || !std::isfinite(m.dispersion)) throw Error(where + ": dispersion must be 0 or more");
+  if (!(m.alphaCutoff >= 0.0f) || !std::isfinite(m.alphaCutoff)) throw Error(where + ": alphaCutoff must be 0 or more");
+  if (!std::isfinite(m.normalScale)) throw Error(where + ": normalScale is not finite");
   scene::Material out;
   out.name = m.name;
   out.emissiveFactor = toVec(m.emissive);
   out.dispersion = m.dispersion;
   out.baseColorFactor = glm::make_vec4(m.baseColor.data());
-  out.baseColorTexture.texture = m.baseColorTexture;
+  out.baseColorTexture = toTextureRef(m.baseColorTexture, m.baseColorTransform, textures, where + ": baseColorTexture");
+  out.emissiveTexture = toTextureRef(m.emissiveTexture, m.emissiveTransform, textures, where + ": emissiveTexture");
+  out.normalTexture = toTextureRef(m.normalTexture, m.normalTransform, textures, where + ": normalTexture");
+  out.normalScale = m.normalScale;
+  out.alphaMode = m.alphaMode == Material::Alpha::Mask    ? scene::AlphaMode::Mask
+                  : m.alphaMode == Material::Alpha::Blend ? scene::AlphaMode::Blend
+                                                          : scene::AlphaMode::Opaque;
+  out.alphaCutoff = m.alphaCutoff;
   out.transmission = m.transmission;
   out.ior = m.ior;
   out.roughness = m.roughness;
@@ -284,7 +304,12 @@ Scene Scene::fromHost(const HostScene& host) {
                     std::to_string(t.rgba.size()) + " bytes for " + std::to_string(t.width) + "x" +
                     std::to_string(t.height) + " RGBA8 pixels");
       }
-      s.textures.push_back(scene::Texture{t.name, t.width, t.height, t.rgba});
+      scene::Texture& texture = s.textures.emplace_back(scene::Texture{t.name, t.width, t.height, t.rgba});
+      texture.repeatS = t.wrapS != Texture::Wrap::Clamp;
+      texture.repeatT = t.wrapT != Texture::Wrap::Clamp;
+      texture.mirrorS = t.wrapS == Texture::Wrap::Mirror;
+      texture.mirrorT = t.wrapT == Texture::Wrap::Mirror;
+      texture.linearFilter = !t.nearest;
     }
     for (size_t i = 0; i < host.materials.size(); ++i) {
       s.materials.push_back(toMaterial(host.materials[i], s.textures.size(),
@@ -720,6 +745,65 @@ void Renderer::read(const View& view, float* rgba) {
     const std::vector<uint16_t>& halves = composite ? pixels.compositeHalf : pixels.traceHalf;
     const std::array<float, 65536>& toFloat = halfTable();
     for (size_t i = 0; i < halves.size(); ++i) rgba[i] = toFloat[halves[i]];
+  });
+}
+
+Aovs Renderer::readAovs(const View& view) {
+  return guarded([&] {
+    std::lock_guard lock(impl_->mutex);
+    const std::string name = view.method.empty() ? "auto" : view.method;
+    if (name != "auto" && name != "trace" && name != "trace-1") {
+      throw Error("readAovs: the AOVs come from snell's trace; give the method auto, trace or trace-1, not '" + name + "'");
+    }
+    View traced = view;
+    traced.output = View::Output::Trace;
+    traced.method = name == "auto" ? "trace" : name;
+    render::FrameRequest frame;
+    frame.pose = &impl_->pose;
+    frame.views.push_back(impl_->request(traced));
+    render::ViewRequest& request = frame.views.back();
+    request.aov = true;
+    request.readback.enabled = true;
+    frame.prologue = uploadsOf(*impl_);
+    const render::FrameResult& result = impl_->renderer->wait(impl_->renderer->submit(frame));
+    impl_->note(result);
+    const render::ViewPixels& pixels = result.views.at(0);
+
+    const size_t count = size_t(view.width) * view.height;
+    Aovs out;
+    out.width = view.width;
+    out.height = view.height;
+    out.rgba.resize(count * 4);
+    out.depth.resize(count);
+    out.normal.resize(count * 3);
+    out.instance.resize(count);
+    out.primitive.resize(count);
+    out.interfaces.resize(count);
+    out.cost.resize(count);
+    const scene::Scene& model = impl_->scene.scene;
+    auto kept = [&](int shape) -> const float* {
+      if (!impl_->kept) return nullptr;
+      const auto* xyz = reinterpret_cast<const float*>(impl_->kept->staging.mapped().data());
+      return xyz + size_t(model.shapes[size_t(shape)].host->first) * 3;
+    };
+    render::FaceNormals normals(model, impl_->pose, kept);
+    const std::vector<render::PixelHit> hits = render::pixelHits(pixels.aov);
+    for (size_t p = 0; p < count; ++p) {
+      const render::PixelHit& hit = hits[p];
+      const bool covered = hit.distance >= 0.0;
+      const glm::vec4& c = pixels.trace[p];
+      std::copy_n(&c.x, 3, &out.rgba[4 * p]);
+      out.rgba[4 * p + 3] = covered ? 1.0f : 0.0f;
+      out.depth[p] = covered ? float(render::cameraDepth(request.settings.view, view.width, view.height, p, hit.distance))
+                             : INFINITY;
+      const glm::vec3 n = covered ? normals.of(hit.instance, hit.primitive) : glm::vec3(0.0f);
+      std::copy_n(&n.x, 3, &out.normal[3 * p]);
+      out.instance[p] = hit.instance;
+      out.primitive[p] = hit.primitive;
+      out.interfaces[p] = hit.interfaces;
+      out.cost[p] = hit.cost;
+    }
+    return out;
   });
 }
 

@@ -3,67 +3,17 @@
 
 #include "io/json.h"
 #include "io/version.h"
+#include "render/pixel_aovs.h"
 #include "scene/evaluate.h"
 
 #include <glm/gtc/packing.hpp>
 
 #include <cmath>
 #include <limits>
-#include <map>
 
 namespace snell::cli {
 
 const std::vector<std::string> kAovNames = {"depth", "normal", "instance", "primitive", "interfaces", "cost"};
-
-namespace {
-
-// Camera-space depth along the view axis from the trace's distance along
-// each pixel's unit ray (the reference tracer's ray, in double).
-double depthOf(const scene::View& view, uint32_t width, uint32_t height, size_t pixel, double distance) {
-  if (view.orthographic) return distance;
-  double w = width, h = height;
-  double x = double(pixel % width), y = double(pixel / width);
-  double sx = (2.0 * (x + 0.5) / w - 1.0) * view.halfHeight * w / h + view.shift.x;
-  double sy = (1.0 - 2.0 * (y + 0.5) / h) * view.halfHeight + view.shift.y;
-  return distance / std::sqrt(1.0 + sx * sx + sy * sy);
-}
-
-// The world-space face normal of each (item, triangle) the pixels hit, from
-// the item's deformed positions at this pose (deformed once per item).
-class FaceNormals {
- public:
-  FaceNormals(const scene::Scene& scene, const scene::Pose& pose) : scene_(scene), pose_(pose) {}
-  glm::vec3 of(uint32_t item, uint32_t triangle) {
-    if (item >= pose_.items.size()) return glm::vec3(0.0f);
-    const scene::DrawItem& drawn = pose_.items[item];
-    auto [at, fresh] = items_.try_emplace(item);
-    Deformed& d = at->second;
-    if (fresh) {
-      std::vector<glm::dvec3> normals;
-      scene::deformOnCpu(drawn, d.positions, normals);
-      d.normalToWorld = glm::transpose(glm::inverse(glm::dmat3(drawn.world)));
-    }
-    const std::vector<uint32_t>& indices = scene_.shapes[size_t(drawn.shape)].indices;
-    if (3 * size_t(triangle) + 2 >= indices.size()) return glm::vec3(0.0f);
-    const std::vector<glm::dvec3>& p = d.positions;
-    glm::dvec3 a = p[indices[3 * triangle]], b = p[indices[3 * triangle + 1]], c = p[indices[3 * triangle + 2]];
-    glm::dvec3 n = d.normalToWorld * glm::cross(b - a, c - a);
-    double length = glm::length(n);
-    return length > 0.0 ? glm::vec3(n / length) : glm::vec3(0.0f);
-  }
-
- private:
-  struct Deformed {
-    std::vector<glm::dvec3> positions;
-    glm::dmat3 normalToWorld{1.0};
-  };
-  const scene::Scene& scene_;
-  const scene::Pose& pose_;
-  std::map<uint32_t, Deformed> items_;
-};
-
-
-}  // namespace
 
 // Alpha = coverage written into the image, and the layers --aov asked for.
 std::vector<io::AovLayer> aovLayers(const RenderOptions& o, const scene::Scene& scene, const scene::Pose& pose,
@@ -84,11 +34,11 @@ std::vector<io::AovLayer> aovLayers(const RenderOptions& o, const scene::Scene& 
       l.channels = {"Z"};
       l.values.resize(pixels);
       for (size_t i = 0; i < pixels; ++i) {
-        l.values[i] = hits[i].distance >= 0.0 ? float(depthOf(view, image.width, image.height, i, hits[i].distance))
+        l.values[i] = hits[i].distance >= 0.0 ? float(render::cameraDepth(view, image.width, image.height, i, hits[i].distance))
                                               : std::numeric_limits<float>::infinity();
       }
     } else if (name == "normal") {
-      FaceNormals normals(scene, pose);
+      render::FaceNormals normals(scene, pose);
       l.channels = {"X", "Y", "Z"};
       l.values.resize(3 * pixels);
       for (size_t i = 0; i < pixels; ++i) {

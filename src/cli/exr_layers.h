@@ -5,6 +5,7 @@
 
 #include "cli/render_shot.h"
 #include "io/image_file.h"
+#include "render/pixel_aovs.h"
 #include "scene/scene.h"
 #include "scene/view.h"
 
@@ -14,11 +15,7 @@
 
 namespace snell::cli {
 
-/// What one pixel's trace found, from the GPU's AOV or the reference.
-struct PixelHit {
-  double distance;  ///< < 0: missed
-  uint32_t instance, primitive, interfaces, cost;
-};
+using render::PixelHit;
 
 /// Writes alpha = coverage into `image` and returns the layers --aov asked for.
 std::vector<io::AovLayer> aovLayers(const RenderOptions& o, const scene::Scene& scene, const scene::Pose& pose,

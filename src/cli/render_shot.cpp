@@ -274,14 +274,7 @@ class Worker {
       if (o_.autoMethod) chooser_->note(method, result.passes);
       const render::ViewPixels& pixels = result.views.at(0);
       image.rgbaHalf = render::drawsComposite(*o_.method) ? pixels.compositeHalf : pixels.traceHalf;
-      if (wantAov) {
-        hits.resize(image.pixels());
-        for (size_t p = 0; p < hits.size(); ++p) {
-          const gpu::TraceAov& a = pixels.aov[p];
-          hits[p] = {a.instance == gpu::kNoHit ? -1.0 : double(a.distance), a.instance, a.primitive, a.interfaces,
-                     a.nodeVisits};
-        }
-      }
+      if (wantAov) hits = render::pixelHits(pixels.aov);
       if (o_.stats) {
         std::lock_guard lock(shot_.output);
         printStats(number, result.stats, result.passes);

@@ -102,6 +102,23 @@ def quad(size: float, z: float):
     return positions, normals, indices, uvs
 
 
+def ripples(size: int = 64, slope: float = 0.6) -> np.ndarray:
+    """A tangent-space normal map of ripples across u (and a gentler swell along v), (size, size, 4) uint8."""
+    y, x = (np.mgrid[0:size, 0:size] + 0.5) / size
+    n = np.stack([-slope * np.cos(6 * np.pi * x), 0.4 * slope * np.sin(4 * np.pi * y), np.ones_like(x)], -1)
+    n /= np.linalg.norm(n, axis=-1, keepdims=True)
+    rgb = np.rint((n * 0.5 + 0.5) * 255).astype(np.uint8)
+    return np.concatenate([rgb, np.full((size, size, 1), 255, np.uint8)], -1)
+
+
+def holes(size: int = 4) -> np.ndarray:
+    """A light grey texture whose alpha is 0 on every other square: (size, size, 4) uint8."""
+    y, x = np.mgrid[0:size, 0:size]
+    rgba = np.full((size, size, 4), 200, np.uint8)
+    rgba[..., 3] = np.where((x + y) % 2 == 0, 0, 255)
+    return rgba
+
+
 def checker(size: int = 64, squares: int = 8) -> np.ndarray:
     """An RGBA checkerboard texture, (size, size, 4) uint8, so refraction shows."""
     y, x = np.mgrid[0:size, 0:size] * squares // size
@@ -136,18 +153,57 @@ class GltfWriter:
         self.doc["accessors"].append(accessor)
         return len(self.doc["accessors"]) - 1
 
-    def material(self, base_color=(1, 1, 1, 1), transmission=0.0, ior=1.5, texture: np.ndarray | None = None) -> int:
+    def texture(self, rgba: np.ndarray, wrap: str = "repeat", nearest: bool = False) -> int:
+        """An embedded PNG texture with its sampler; returns the texture's index."""
+        png = _png_bytes(rgba)
+        self.doc.setdefault("images", []).append({"uri": "data:image/png;base64," + base64.b64encode(png).decode()})
+        codes = {"repeat": 10497, "clamp": 33071, "mirror": 33648}
+        sampler = {"wrapS": codes[wrap], "wrapT": codes[wrap]}
+        if nearest:
+            sampler["magFilter"] = sampler["minFilter"] = 9728
+        self.doc.setdefault("samplers", []).append(sampler)
+        self.doc.setdefault("textures", []).append({"source": len(self.doc["images"]) - 1,
+                                                    "sampler": len(self.doc["samplers"]) - 1})
+        return len(self.doc["textures"]) - 1
+
+    def _uses(self, extension: str) -> None:
+        used = self.doc.setdefault("extensionsUsed", [])
+        if extension not in used:
+            used.append(extension)
+
+    def texture_info(self, index: int, transform: dict | None = None, **fields) -> dict:
+        """A material's reference to texture `index`, with a KHR_texture_transform."""
+        info = {"index": index, **fields}
+        if transform:
+            info["extensions"] = {"KHR_texture_transform": transform}
+            self._uses("KHR_texture_transform")
+        return info
+
+    def material(self, base_color=(1, 1, 1, 1), transmission=0.0, ior=1.5, texture: np.ndarray | None = None,
+                 base_info: dict | None = None, emissive=(0.0, 0.0, 0.0), emissive_info: dict | None = None,
+                 normal_info: dict | None = None, alpha_mode: str | None = None,
+                 alpha_cutoff: float | None = None) -> int:
+        """A material; *_info are texture_info() references (texture: the base colour's, repeating)."""
         m: dict = {"pbrMetallicRoughness": {"baseColorFactor": list(base_color), "metallicFactor": 0.0}}
         if transmission > 0:
             m["extensions"] = {"KHR_materials_transmission": {"transmissionFactor": transmission},
                                "KHR_materials_ior": {"ior": ior}}
-            self.doc.setdefault("extensionsUsed", []).extend(["KHR_materials_transmission", "KHR_materials_ior"])
+            self._uses("KHR_materials_transmission")
+            self._uses("KHR_materials_ior")
         if texture is not None:
-            png = _png_bytes(texture)
-            self.doc.setdefault("images", []).append(
-                {"uri": "data:image/png;base64," + base64.b64encode(png).decode()})
-            self.doc.setdefault("textures", []).append({"source": len(self.doc["images"]) - 1})
-            m["pbrMetallicRoughness"]["baseColorTexture"] = {"index": len(self.doc["textures"]) - 1}
+            base_info = {"index": self.texture(texture)}
+        if base_info is not None:
+            m["pbrMetallicRoughness"]["baseColorTexture"] = base_info
+        if any(emissive):
+            m["emissiveFactor"] = list(emissive)
+        if emissive_info is not None:
+            m["emissiveTexture"] = emissive_info
+        if normal_info is not None:
+            m["normalTexture"] = normal_info
+        if alpha_mode is not None:
+            m["alphaMode"] = alpha_mode
+        if alpha_cutoff is not None:
+            m["alphaCutoff"] = alpha_cutoff
         self.doc["materials"].append(m)
         return len(self.doc["materials"]) - 1
 
