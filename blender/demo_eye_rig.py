@@ -24,6 +24,9 @@ import bpy
 import numpy as np
 
 HERE = Path(__file__).resolve().parent
+if str(HERE) not in sys.path:
+    sys.path.insert(0, str(HERE))
+from snell_blender import compat  # noqa: E402  (the add-on's version gates, from this checkout)
 EYE_SEPARATION = 1.6  # centre to centre is twice this
 LIMBUS = math.radians(35.0)  # the angle from the eye's axis where the cornea meets the sclera
 CORNEA_RADIUS = 0.75
@@ -55,7 +58,7 @@ def glass(name: str, ior: float) -> bpy.types.Material:
     material.use_nodes = True
     bsdf = material.node_tree.nodes["Principled BSDF"]
     bsdf.inputs["Base Color"].default_value = (1.0, 1.0, 1.0, 1.0)
-    bsdf.inputs["Transmission"].default_value = 1.0
+    compat.principled_input(bsdf, "transmission").default_value = 1.0
     bsdf.inputs["IOR"].default_value = ior
     bsdf.inputs["Roughness"].default_value = 0.05
     return material
@@ -119,8 +122,7 @@ def eyeball_mesh(name: str) -> bpy.types.Mesh:
     mesh.polygons.foreach_set("material_index", materials)
     mesh.polygons.foreach_set("use_smooth", [True] * len(faces))
     # The limbus is a crease: the cornea's normals and the sclera's do not blend across it.
-    mesh.use_auto_smooth = True
-    mesh.auto_smooth_angle = math.radians(180.0)
+    compat.keep_sharp_edges(mesh)
     limbus = set(range(ring_start(limbus_ring), ring_start(limbus_ring) + SEGMENTS))
     for edge in mesh.edges:
         edge.use_edge_sharp = edge.vertices[0] in limbus and edge.vertices[1] in limbus
@@ -129,17 +131,25 @@ def eyeball_mesh(name: str) -> bpy.types.Mesh:
 
 
 def iris_mesh(name: str) -> bpy.types.Mesh:
-    """A disc facing -Y just behind the limbus, UV-mapped to the iris texture (the pupil its centre)."""
-    outer = math.sin(LIMBUS) * 0.99
-    rings = 12
+    """A disc facing -Y just behind the limbus, UV-mapped to the iris texture (the pupil its centre).
+
+    It reaches the eyeball's wall, as a production eye's iris does: a disc
+    that stopped at the limbus left a ring of the eyeball's dark inside to
+    show through the cornea as the eye turned (a dark crescent at the iris's
+    edge, in Cycles as in snell).
+    """
+    limbus = math.sin(LIMBUS) * 0.99  # the texture's edge: the iris as seen through the cornea
+    outer = math.sqrt(1.0 - IRIS_DEPTH**2) * 0.995  # the wall, hidden behind the sclera: the rim's colour
+    radii = [limbus * ring / 12 for ring in range(1, 13)] + [limbus + (outer - limbus) * k / 2 for k in (1, 2)]
+    rings = len(radii)
     vertices, uvs = [(0.0, -IRIS_DEPTH, 0.0)], [(0.5, 0.5)]
-    for ring in range(1, rings + 1):
-        r = outer * ring / rings
+    for r in radii:
+        t = min(r / limbus, 1.0)
         for s in range(SEGMENTS):
             phi = 2 * math.pi * s / SEGMENTS
             # A shallow cone: the iris bows towards the cornea at the pupil.
-            vertices.append((r * math.cos(phi), -IRIS_DEPTH - 0.04 * (1 - r / outer), r * math.sin(phi)))
-            uvs.append((0.5 + 0.5 * ring / rings * math.cos(phi), 0.5 + 0.5 * ring / rings * math.sin(phi)))
+            vertices.append((r * math.cos(phi), -IRIS_DEPTH - 0.04 * (1 - t), r * math.sin(phi)))
+            uvs.append((0.5 + 0.5 * t * math.cos(phi), 0.5 + 0.5 * t * math.sin(phi)))
     faces = [(0, 1 + (s + 1) % SEGMENTS, 1 + s) for s in range(SEGMENTS)]
     for ring in range(1, rings):
         base = 1 + (ring - 1) * SEGMENTS
@@ -154,11 +164,11 @@ def iris_mesh(name: str) -> bpy.types.Mesh:
             layer.data[loop].uv = uvs[mesh.loops[loop].vertex_index]
     mesh.polygons.foreach_set("use_smooth", [True] * len(faces))
     mesh.update()
-    return mesh, outer
+    return mesh, limbus
 
 
 def add_dilation(obj, outer: float) -> None:
-    """A "Dilate" shape key: the pupil (the texture's centre) opens to 1.7 times its width."""
+    """A "Dilate" shape key: the pupil (the texture's centre) opens to 1.7 times its width; from `outer` out nothing moves."""
     obj.shape_key_add(name="Basis")
     key = obj.shape_key_add(name="Dilate")
     for i, vertex in enumerate(obj.data.vertices):
@@ -194,7 +204,7 @@ def build(scene=None) -> dict:
         ball = bpy.data.objects.new(f"Eyeball.{side}", eyeball_mesh(f"Eyeball.{side}"))
         ball.data.materials.append(sclera)
         ball.data.materials.append(cornea)
-        iris_data, outer = iris_mesh(f"Iris.{side}")
+        iris_data, limbus = iris_mesh(f"Iris.{side}")
         disc = bpy.data.objects.new(f"Iris.{side}", iris_data)
         disc.data.materials.append(iris)
         for obj in (ball, disc):
@@ -205,7 +215,7 @@ def build(scene=None) -> dict:
             group.add(list(range(len(obj.data.vertices))), 1.0, "REPLACE")
             modifier = obj.modifiers.new("Armature", "ARMATURE")
             modifier.object = rig
-        add_dilation(disc, outer)
+        add_dilation(disc, limbus)
         objects[side] = (ball, disc)
 
     # The animation: the eyes look around, the pupils open and close.

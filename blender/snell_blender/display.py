@@ -15,7 +15,7 @@ import blf
 import gpu
 from gpu_extras.batch import batch_for_shader
 
-from . import gl_interop
+from . import compat, gl_interop
 
 PATH_INTEROP = "interop (GL_EXT_memory_object_fd, no copy)"
 PATH_UPLOAD = "upload (pixels through the host)"
@@ -62,10 +62,11 @@ class Display:
         flipped = ((0, 1), (1, 1), (1, 0), (0, 0))
         batch = batch_for_shader(shader, "TRI_FAN", {"pos": corners, "texCoord": flipped})
         if self.path == PATH_INTEROP and self.shared is not None:
-            import bgl  # Blender's own draw_texture_2d binds a raw OpenGL texture this way
-
-            bgl.glActiveTexture(bgl.GL_TEXTURE0)
-            bgl.glBindTexture(bgl.GL_TEXTURE_2D, self.shared.texture.value)
+            # A raw OpenGL texture is bound through the interop's own entry
+            # points: bgl, which Blender's draw_texture_2d used, is gone in 5.0.
+            gl = self.shared.gl
+            gl.active_texture(gl_interop.GL_TEXTURE0)
+            gl.bind_texture(gl_interop.GL_TEXTURE_2D, self.shared.texture.value)
             shader.uniform_int("image", 0)
         elif self.texture is not None:
             shader.uniform_sampler("image", self.texture)
@@ -93,7 +94,7 @@ def end_colour_managed(_previous) -> None:
 def draw_text(text: str, error: bool = False) -> None:
     """One line at the viewport's bottom left (the overlay, or why nothing is drawn)."""
     font = 0
-    blf.size(font, 12, 72)
+    compat.blf_size(font, 12)
     blf.color(font, *((1.0, 0.45, 0.4, 1.0) if error else (0.9, 0.9, 0.9, 0.9)))
     blf.position(font, 12, 12, 0)
     blf.enable(font, blf.SHADOW)

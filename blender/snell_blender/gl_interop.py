@@ -16,6 +16,7 @@ import ctypes.util
 from typing import Optional
 
 GL_TEXTURE_2D = 0x0DE1
+GL_TEXTURE0 = 0x84C0
 GL_RGBA16F = 0x881A
 GL_TEXTURE_MIN_FILTER = 0x2801
 GL_TEXTURE_MAG_FILTER = 0x2800
@@ -73,6 +74,7 @@ class GlInterop:
         self.gen_textures = entry("glGenTextures", None, ctypes.c_int, uint_p)
         self.delete_textures = entry("glDeleteTextures", None, ctypes.c_int, uint_p)
         self.bind_texture = entry("glBindTexture", None, ctypes.c_uint, ctypes.c_uint)
+        self.active_texture = entry("glActiveTexture", None, ctypes.c_uint)
         self.tex_parameteri = entry("glTexParameteri", None, ctypes.c_uint, ctypes.c_uint, ctypes.c_int)
         self.get_error = entry("glGetError", ctypes.c_uint)
 

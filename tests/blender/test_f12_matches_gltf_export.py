@@ -12,16 +12,14 @@ from pathlib import Path
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).parent))  # Blender runs the script without its folder on the path
-from blender_support import SCRATCH, check, demo_scene, pixels, render_f12, snell, srgb  # noqa: E402
+from blender_support import SCRATCH, check, demo_scene, export_gltf, pixels, render_f12, snell, srgb  # noqa: E402
 
 WIDTH, HEIGHT = 320, 134
 SCRATCH.mkdir(parents=True, exist_ok=True)
 scene, rig = demo_scene(WIDTH, HEIGHT)
 import bpy  # noqa: E402
 
-exported = SCRATCH / "rig.glb"
-bpy.ops.export_scene.gltf(filepath=str(exported), export_format="GLB", convert_lighting_mode="COMPAT",
-                          export_cameras=True, export_lights=True, export_animations=True)
+exported = export_gltf(SCRATCH / "rig.glb")
 background = ",".join(f"{c:.6f}" for c in bpy.context.scene.world.node_tree.nodes["Background"].inputs["Color"]
                       .default_value[:3])
 

@@ -10,6 +10,7 @@ import bpy
 
 sys.path.insert(0, str(Path(__file__).parent))  # Blender runs the script without its folder on the path
 from blender_support import SCRATCH, SNELL, check, enable_addon  # noqa: E402
+from snell_blender import compat  # noqa: E402  (blender_support puts the add-on on the path)
 
 TRANSMISSION, IOR, ROUGHNESS = 1.0, 1.45, 0.1
 ATTENUATION, DENSITY, THICKNESS = (0.8, 0.5, 0.3), 2.0, 0.25
@@ -25,7 +26,7 @@ glass = bpy.data.materials.new("Glass")
 glass.use_nodes = True
 nodes, links = glass.node_tree.nodes, glass.node_tree.links
 bsdf = nodes["Principled BSDF"]
-bsdf.inputs["Transmission"].default_value = TRANSMISSION
+compat.principled_input(bsdf, "transmission").default_value = TRANSMISSION
 bsdf.inputs["IOR"].default_value = IOR
 bsdf.inputs["Roughness"].default_value = ROUGHNESS
 absorption = nodes.new("ShaderNodeVolumeAbsorption")
@@ -34,7 +35,10 @@ absorption.inputs["Density"].default_value = DENSITY
 links.new(absorption.outputs["Volume"], nodes["Material Output"].inputs["Volume"])
 # The exporter reads the thickness from its "glTF Material Output" group, as its own UI makes it.
 group = bpy.data.node_groups.new("glTF Material Output", "ShaderNodeTree")
-group.inputs.new("NodeSocketFloat", "Thickness")
+if hasattr(group, "interface"):  # 4.0 moved a group's sockets into its interface
+    group.interface.new_socket("Thickness", in_out="INPUT", socket_type="NodeSocketFloat")
+else:
+    group.inputs.new("NodeSocketFloat", "Thickness")
 settings = nodes.new("ShaderNodeGroup")
 settings.node_tree = group
 settings.inputs["Thickness"].default_value = THICKNESS
@@ -67,7 +71,7 @@ check(close(loaded["attenuation_distance"], 1.0 / DENSITY), "snell loads the att
 from snell_blender import convert, runtime  # noqa: E402
 
 check(runtime.device() is not None, f"the add-on found snell ({runtime.status()})")
-mapped = convert.material_of(glass, {}, [])
+mapped = convert.material_of(glass, convert.Textures(), "", [])
 check(close(mapped.transmission, loaded["transmission"]) and close(mapped.ior, loaded["ior"])
       and close(mapped.thickness, loaded["thickness"])
       and close(mapped.attenuation_distance, loaded["attenuation_distance"])
