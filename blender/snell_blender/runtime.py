@@ -17,6 +17,8 @@ AREA_LIGHT_NOTE = "area lights shine as point lights of the same power"
 _device = None
 _problem: Optional[str] = None
 _tried = False
+# What the last scene snell built holds that it cannot draw (materials' nodes), for the panel.
+_scene_problems: list = []
 
 
 def _preferences():
@@ -75,6 +77,17 @@ def device():
     if _problem:
         print(f"snell: {_problem}", file=sys.stderr)
     return _device
+
+
+def note_scene_problems(problems: list) -> None:
+    """Keeps what the last scene built could not map, for the panel (the console has it already)."""
+    global _scene_problems
+    _scene_problems = list(problems)
+
+
+def scene_problems() -> list:
+    """What the last scene snell built holds that it cannot draw, one sentence each."""
+    return list(_scene_problems)
 
 
 def problem() -> Optional[str]:

@@ -22,7 +22,7 @@ from typing import Optional
 
 import numpy as np
 
-from . import convert
+from . import compat, convert, runtime
 
 
 @dataclass
@@ -46,6 +46,7 @@ class ObjectGeometry:
     parts: list = field(default_factory=list)
     co: Optional[np.ndarray] = None           # (vertices, 3) scratch for foreach_get
     loop_normals: Optional[np.ndarray] = None  # (loops, 3) scratch
+    sent: Optional[tuple] = None               # the (co, loop normals) last sent
 
 
 class TopologyChanged(Exception):
@@ -71,13 +72,21 @@ def _matrix(m) -> np.ndarray:
 
 
 def _read_mesh(obj):
-    """The evaluated object's mesh with loop triangles and split normals computed (to_mesh_clear after)."""
+    """The evaluated object's mesh with loop triangles and corner normals ready (to_mesh_clear after)."""
     mesh = obj.to_mesh()
     if mesh is None:
         return None
     mesh.calc_loop_triangles()
-    mesh.calc_normals_split()
+    compat.prepare_corner_normals(mesh)
     return mesh
+
+
+def _render_uv_layer(mesh):
+    """The UV map Cycles and the glTF exporter read where a texture names none: the one marked for render."""
+    for layer in mesh.uv_layers:
+        if layer.active_render:
+            return layer
+    return mesh.uv_layers.active
 
 
 class SceneSync:
@@ -91,9 +100,10 @@ class SceneSync:
         self.geometry: dict[str, ObjectGeometry] = {}
         self.instances: dict[tuple, tuple] = {}  # key -> (object name, [snell instance per part], matrix)
         self.notes: set[str] = set()
-        meshes, materials, textures, lights = [], [], [], []
+        self.problems: list[str] = []  # what the materials hold that snell cannot draw, named
+        meshes, materials, lights = [], [], []
+        textures = convert.Textures()
         material_index: dict[str, int] = {}
-        image_cache: dict[str, int] = {}
         placed = []  # (mesh, transform)
 
         for instance in depsgraph.object_instances:
@@ -110,7 +120,7 @@ class SceneSync:
             name = obj.original.name
             geometry = self.geometry.get(name)
             if geometry is None:
-                geometry = self._topology(obj, meshes, materials, material_index, image_cache, textures)
+                geometry = self._topology(obj, meshes, materials, material_index, textures)
                 if geometry is None:
                     continue
                 self.geometry[name] = geometry
@@ -121,17 +131,22 @@ class SceneSync:
             self.instances[key] = (name, list(range(first, len(placed))), matrix)
 
         scene = depsgraph.scene
+        self.light_state = self._lights_of(depsgraph)
         self.background = convert.background_of(scene.world)
         self.empty = not meshes
         if self.empty:  # snell needs a mesh: a degenerate one draws nothing
             zero = np.zeros((3, 3), np.float32)
             meshes.append(snell.Mesh(zero, np.tile(np.float32([0, 0, 1]), (3, 1)), np.uint32([[0, 1, 2]])))
             placed.append((0, np.eye(4)))
+        for problem in self.problems:
+            print(f"snell: {problem}")
+        self.notes.update(self.problems)
+        runtime.note_scene_problems(self.problems)
         instances = [snell.Instance(mesh, matrix) for mesh, matrix in placed]
         # What went to snell, for tools that replay the feed elsewhere (bench/record_blender_feed.py).
-        self.arrays = {"meshes": meshes, "materials": materials, "textures": textures, "lights": lights,
+        self.arrays = {"meshes": meshes, "materials": materials, "textures": textures.textures, "lights": lights,
                        "instances": instances}
-        self.scene = snell.Scene.from_arrays(meshes, materials=materials, textures=textures, lights=lights,
+        self.scene = snell.Scene.from_arrays(meshes, materials=materials, textures=textures.textures, lights=lights,
                                              instances=instances, name=scene.name)
         self.renderer = snell.Renderer(device, self.scene)
         for geometry in self.geometry.values():
@@ -140,7 +155,7 @@ class SceneSync:
                 part.normals = self.renderer.normals(part.mesh)
         self.build_seconds = time.perf_counter() - started
 
-    def _topology(self, obj, meshes, materials, material_index, image_cache, textures) -> Optional[ObjectGeometry]:
+    def _topology(self, obj, meshes, materials, material_index, textures) -> Optional[ObjectGeometry]:
         """Adds an object's meshes (one per material slot it uses) with their current vertices."""
         import snell
 
@@ -159,19 +174,22 @@ class SceneSync:
             loop_vertex = np.empty(len(mesh.loops), np.int32)
             mesh.loops.foreach_get("vertex_index", loop_vertex)
             uvs = None
-            if mesh.uv_layers.active is not None:
+            uv_layer = _render_uv_layer(mesh)
+            if uv_layer is not None:
                 uvs = np.empty(len(mesh.loops) * 2, np.float32)
-                mesh.uv_layers.active.data.foreach_get("uv", uvs)
+                uv_layer.data.foreach_get("uv", uvs)
                 uvs = uvs.reshape(-1, 2)
                 uvs[:, 1] = 1.0 - uvs[:, 1]  # glTF's v runs down the image
             geometry = ObjectGeometry(obj.original.name, len(mesh.vertices), len(mesh.loops))
             co, loop_normals = self._read_vertices(mesh, geometry)
+            geometry.sent = (co.copy(), loop_normals.copy())
             for slot in np.unique(tri_material):
                 loops, remapped = np.unique(tri_loops[tri_material == slot], return_inverse=True)
                 blender_material = obj.material_slots[slot].material if slot < len(obj.material_slots) else None
                 key = blender_material.name if blender_material is not None else ""
                 if key not in material_index:
-                    materials.append(convert.material_of(blender_material, image_cache, textures))
+                    materials.append(convert.material_of(blender_material, textures,
+                                                         uv_layer.name if uv_layer is not None else "", self.problems))
                     material_index[key] = len(materials) - 1
                 part = MeshPart(len(meshes), loops.astype(np.int32), loop_vertex[loops])
                 meshes.append(snell.Mesh(
@@ -191,11 +209,16 @@ class SceneSync:
             geometry.co = np.empty((geometry.vertex_count, 3), np.float32)
             geometry.loop_normals = np.empty((geometry.loop_count, 3), np.float32)
         mesh.vertices.foreach_get("co", geometry.co.reshape(-1))
-        mesh.loops.foreach_get("normal", geometry.loop_normals.reshape(-1))
+        compat.read_corner_normals(mesh, geometry.loop_normals.reshape(-1))
         return geometry.co, geometry.loop_normals
 
-    def send_vertices(self, obj) -> None:
-        """Writes an evaluated object's new vertices into snell's memory and marks its meshes dirty."""
+    def send_vertices(self, obj, only_if_changed: bool = False) -> bool:
+        """Writes an evaluated object's vertices into snell's memory and marks its meshes dirty.
+
+        With only_if_changed, vertices equal to those sent last are not sent
+        (a render's frame change has no update list to say what moved).
+        Returns whether they were sent.
+        """
         geometry = self.geometry[obj.original.name]
         mesh = _read_mesh(obj)
         try:
@@ -204,13 +227,42 @@ class SceneSync:
             co, loop_normals = self._read_vertices(mesh, geometry)
         finally:
             obj.to_mesh_clear()
+        if only_if_changed and geometry.sent is not None:
+            if np.array_equal(geometry.sent[0], co) and np.array_equal(geometry.sent[1], loop_normals):
+                return False
+        geometry.sent = (co.copy(), loop_normals.copy())
         for part in geometry.parts:
             np.take(co, part.vertex_of_loop, axis=0, out=part.positions)
             np.take(loop_normals, part.loops, axis=0, out=part.normals)
             self.renderer.mark_dirty(part.mesh)
+        return True
+
+    def send_changed(self, depsgraph, stop=lambda: False, progress=lambda done, total: None) -> Optional[dict]:
+        """Brings the renderer to another frame of a render: every object's evaluated vertices are read
+        and only those that changed are sent, then the transforms that moved.
+
+        `stop()` is asked between objects; when it says so, None is returned and
+        the renderer holds a frame part way. `progress(done, total)` follows the objects.
+        Raises TopologyChanged when only a rebuild can say what changed.
+        """
+        started = time.perf_counter()
+        if self._lights_of(depsgraph) != self.light_state:
+            raise TopologyChanged("a light changed")
+        objects = [i.object for i in depsgraph.object_instances
+                   if not i.is_instance and i.object.original.name in self.geometry]
+        sent = []
+        for done, obj in enumerate(objects):
+            if stop():
+                return None
+            if self.send_vertices(obj, only_if_changed=True):
+                sent.append(obj.original.name)
+            progress(done + 1, len(objects))
+        moved = self._update_transforms(depsgraph)
+        return {"meshes_sent": sent, "meshes_read": len(objects), "instances_moved": moved,
+                "feed_ms": (time.perf_counter() - started) * 1000}
 
     def send_every_mesh(self, depsgraph) -> list:
-        """Sends every object's evaluated vertices, whatever changed (a frame of a render; no update list)."""
+        """Sends every object's evaluated vertices, whatever changed (bench/record_blender_feed.py's feed)."""
         sent = []
         for instance in depsgraph.object_instances:
             name = instance.object.original.name
@@ -219,6 +271,18 @@ class SceneSync:
                 sent.append(name)
         self._update_transforms(depsgraph)
         return sent
+
+    @staticmethod
+    def _lights_of(depsgraph) -> list:
+        """What snell's lights are made of, to see when one changed: names, matrices, colours and power."""
+        state = []
+        for instance in depsgraph.object_instances:
+            obj = instance.object
+            if obj.type == "LIGHT":
+                data = obj.data
+                state.append((obj.original.name, tuple(map(tuple, instance.matrix_world)), data.type,
+                              tuple(data.color), compat.light_power(data)))
+        return state
 
     def update(self, depsgraph) -> dict:
         """Brings the renderer up to the depsgraph's state; returns what was sent.
@@ -230,7 +294,8 @@ class SceneSync:
         for update in depsgraph.updates:
             data = update.id
             kind = type(data).__name__
-            if kind in ("Material", "Light", "World", "Image", "NodeTree"):
+            # A material's own tree is a ShaderNodeTree; a node group's may be any NodeTree.
+            if kind in ("Material", "Light", "World", "Image", "NodeTree", "ShaderNodeTree"):
                 raise TopologyChanged(f"{kind} {data.name} changed")
             if kind == "Object" and data.type == "LIGHT" and (update.is_updated_geometry or update.is_updated_transform):
                 raise TopologyChanged(f"light {data.name} changed")  # lights are part of snell's scene

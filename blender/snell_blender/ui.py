@@ -6,7 +6,10 @@ from __future__ import annotations
 import bpy
 
 from . import runtime
+from .properties import PASSES
 from .runtime import AREA_LIGHT_NOTE
+
+MAX_PROBLEM_LINES = 8
 
 
 class SNELL_PT_render(bpy.types.Panel):
@@ -38,8 +41,38 @@ class SNELL_PT_render(bpy.types.Panel):
         layout.prop(options, "overlay")
         if any(o.type == "LIGHT" and o.data.type == "AREA" for o in context.scene.objects):
             layout.label(text=AREA_LIGHT_NOTE.capitalize(), icon="LIGHT_AREA")
+        problems = runtime.scene_problems()
+        if problems:
+            box = layout.box()
+            box.label(text="Not drawn as in Cycles (the console has each in full):", icon="ERROR")
+            for line in problems[:MAX_PROBLEM_LINES]:
+                box.label(text=line)
+            if len(problems) > MAX_PROBLEM_LINES:
+                box.label(text=f"... and {len(problems) - MAX_PROBLEM_LINES} more")
         if problem:
             layout.operator("snell.retry", icon="FILE_REFRESH")
+
+
+class SNELL_PT_passes(bpy.types.Panel):
+    """View Layer Properties > snell Passes: the AOVs this view layer writes as render passes."""
+
+    bl_label = "snell Passes"
+    bl_space_type = "PROPERTIES"
+    bl_region_type = "WINDOW"
+    bl_context = "view_layer"
+    COMPAT_ENGINES = {"SNELL"}
+
+    @classmethod
+    def poll(cls, context) -> bool:
+        return context.engine in cls.COMPAT_ENGINES
+
+    def draw(self, context) -> None:
+        layout = self.layout
+        layout.use_property_split = True
+        column = layout.column(heading="Passes")
+        for key, *_ in PASSES:
+            column.prop(context.view_layer.snell, key)
+        layout.label(text="From the trace: methods trace, trace-1 and auto", icon="INFO")
 
 
 class SNELL_OT_retry(bpy.types.Operator):
@@ -57,7 +90,7 @@ class SNELL_OT_retry(bpy.types.Operator):
         return {"FINISHED"}
 
 
-classes = (SNELL_PT_render, SNELL_OT_retry)
+classes = (SNELL_PT_render, SNELL_PT_passes, SNELL_OT_retry)
 
 
 def register() -> None:
