@@ -17,26 +17,12 @@ from typing import Optional
 
 import bpy
 
-from . import runtime
-from .properties import settings
+from . import compat, runtime
+from . import job as jobs
+from .properties import enabled_passes, settings
 
 # What the last viewport update and draw did, for the overlay, benchmarks and tests.
 STATS: dict = {"updates": 0, "rebuilds": 0, "meshes_sent": [], "draw_path": None}
-
-
-def _view(scene, width: int, height: int, view_matrix, projection, viewport: bool, background):
-    """A snell.View of the scene's settings through Blender's view and projection matrices."""
-    import numpy as np
-    import snell
-
-    from .sync import Y_UP
-
-    options = settings(scene)
-    to_camera = np.array([list(row) for row in view_matrix], np.float64) @ np.linalg.inv(Y_UP)
-    return snell.View(width, height, view_matrix=to_camera, projection=np.array([list(r) for r in projection]),
-                      viewport=viewport, method=options.method, max_interfaces=options.max_interfaces,
-                      fresnel=options.fresnel, dispersion=options.dispersion, volume=options.volume,
-                      background=background)
 
 
 class SnellRenderEngine(bpy.types.RenderEngine):
@@ -47,7 +33,9 @@ class SnellRenderEngine(bpy.types.RenderEngine):
     bl_use_preview = False
     bl_use_shading_nodes_custom = False  # materials are Blender's own node trees
 
-    def __init__(self) -> None:
+    def __init__(self, *args, **kwargs) -> None:
+        # 4.4 hands a RenderEngine subclass's __init__ arguments it must pass on.
+        super().__init__(*args, **kwargs)
         self.sync = None
         self.display = None
         self.problem: Optional[str] = None
@@ -69,41 +57,63 @@ class SnellRenderEngine(bpy.types.RenderEngine):
 
     # ------------------------------------------------------------ F12 and animation
 
+    def update_render_passes(self, scene=None, renderlayer=None) -> None:
+        """The passes a view layer's snell settings ask for, so the compositor and EXR files see them."""
+        self.register_pass(scene, renderlayer, "Combined", 4, "RGBA", "COLOR")
+        for _, name, channels, kind, _ in enabled_passes(renderlayer):
+            self.register_pass(scene, renderlayer, name, len(channels), channels, kind)
+
     def render(self, depsgraph) -> None:
+        """One frame of an F12 or animation render, in the render job's scene sync (job.py)."""
         scene = depsgraph.scene
-        device = runtime.device()
-        if device is None:
+        if runtime.device() is None:
             self.report({"ERROR"}, f"snell: {runtime.problem()}")
             return
-        camera = scene.camera
-        if camera is None:
+        if scene.camera is None:
             self.report({"ERROR"}, "snell: the scene has no camera to render from")
             return
         scale = scene.render.resolution_percentage / 100.0
         width = max(1, int(scene.render.resolution_x * scale))
         height = max(1, int(scene.render.resolution_y * scale))
+        view_layer = depsgraph.view_layer
+        passes = enabled_passes(view_layer)
+        if passes and settings(scene).method not in TRACED_METHODS:
+            self.report({"WARNING"}, f"snell: the passes come from the trace; method {settings(scene).method} "
+                                     "writes the combined image alone")
+            passes = []
+        frame, (index, total) = scene.frame_current, _frame_index(scene, self.is_animation)
+        status = f"Frame {frame}" + (f" ({index} of {total})" if total > 1 else "")
+
+        def progress(fraction: float, step: str) -> None:
+            self.update_progress(fraction)
+            self.update_stats("", f"snell | {status} | {step}")
+
+        job = jobs.current()
         try:
-            import numpy as np
-
-            from .sync import SceneSync
-
-            sync = SceneSync(device, depsgraph)
-            camera = camera.evaluated_get(depsgraph)
-            projection = camera.calc_matrix_camera(depsgraph, x=width, y=height,
-                                                   scale_x=scene.render.pixel_aspect_x,
-                                                   scale_y=scene.render.pixel_aspect_y)
-            view = _view(scene, width, height, camera.matrix_world.inverted(), projection, False, sync.background)
-            rgba = sync.renderer.render(view)
-            sync.close()
-        except Exception as error:  # snell.Error, or Blender data snell cannot take
+            picture = job.render_frame(depsgraph, scene.camera, width, height,
+                                       (scene.render.pixel_aspect_x, scene.render.pixel_aspect_y), passes,
+                                       self.test_break, progress)
+        except Exception as error:  # snell.Error, or Blender data snell cannot take: nothing is kept
+            jobs.end()
             self.report({"ERROR"}, f"snell: {error}")
             return
-        result = self.begin_result(0, 0, width, height)
+        if picture is None:  # Esc: the frame under way is dropped and nothing of it is written
+            job.stats.dropped += 1
+            self.update_stats("", f"snell | {status} | stopped")
+            return
+        for _, name, channels, _, _ in passes:
+            self.add_pass(name, len(channels), channels, layer=view_layer.name)
+        result = self.begin_result(0, 0, width, height, layer=view_layer.name)
         try:
-            # Blender's rows run bottom to top; foreach_set takes the (pixels, 4) float32 block at once.
-            result.layers[0].passes["Combined"].rect.foreach_set(np.ascontiguousarray(rgba[::-1]).reshape(-1, 4))
+            layer = result.layers[0]
+            # Blender's rows run bottom to top; each pass is written at once.
+            compat.write_pass(layer.passes["Combined"], _rows_up(picture.planes["rgba"]))
+            for key, name, _, _, _ in passes:
+                compat.write_pass(layer.passes[name], _rows_up(_pass_values(key, picture.planes[key])))
         finally:
             self.end_result(result)
+        if not self.is_animation:
+            jobs.end()  # a still: nothing to keep for a next frame
 
     # ------------------------------------------------------------ the viewport
 
@@ -143,8 +153,10 @@ class SnellRenderEngine(bpy.types.RenderEngine):
             display.draw_text(self.problem or runtime.problem() or "snell: nothing to draw", error=True)
             return
         started = time.perf_counter()
-        view = _view(scene, region.width, region.height, rv3d.view_matrix, rv3d.window_matrix, True,
-                     self.sync.background)
+        from .convert import view_of
+
+        view = view_of(scene, region.width, region.height, rv3d.view_matrix, rv3d.window_matrix, True,
+                               self.sync.background)
         if self.display is None:
             self.display = display.Display(runtime.device())
         try:
@@ -172,6 +184,40 @@ class SnellRenderEngine(bpy.types.RenderEngine):
                 + (f"  ({notes})" if notes else ""))
 
 
+# The methods whose F12 image is the trace's, and so has AOVs to give as passes.
+TRACED_METHODS = ("trace", "trace-1", "auto")
+
+
+def _frame_index(scene, animation: bool) -> tuple:
+    """This frame's place in the render: (1-based index, frames in all); (1, 1) for a still."""
+    if not animation:
+        return 1, 1
+    step = max(1, scene.frame_step)
+    return (scene.frame_current - scene.frame_start) // step + 1, (scene.frame_end - scene.frame_start) // step + 1
+
+
+def _rows_up(plane):
+    """A (height, width[, channels]) plane as a (pixels, channels) float32 block, bottom row first, as passes hold it."""
+    import numpy as np
+
+    return np.ascontiguousarray(plane[::-1], np.float32).reshape(plane.shape[0] * plane.shape[1], -1)
+
+
+def _pass_values(key: str, plane):
+    """A snell AOV in the form Blender's pass of it holds."""
+    import numpy as np
+
+    from .sync import Y_UP
+
+    if key == "depth":
+        return np.where(np.isfinite(plane), plane, np.float32(1e10))  # Blender's depth where nothing is hit
+    if key == "normal":
+        return plane @ Y_UP[:3, :3].astype(np.float32)  # snell's Y-up world back to Blender's Z-up one
+    if key in ("instance", "primitive"):
+        return np.where(plane == 0xFFFFFFFF, -1.0, plane.astype(np.float64)).astype(np.float32)
+    return plane.astype(np.float32)
+
+
 def compatible_panels() -> list:
     """Blender's own panels (materials, lights, world, output) that should show for snell."""
     wanted = {"MATERIAL_PT_", "EEVEE_MATERIAL_PT_", "DATA_PT_light", "DATA_PT_EEVEE_light", "DATA_PT_spot",
@@ -181,12 +227,13 @@ def compatible_panels() -> list:
     for name in dir(bpy.types):
         panel = getattr(bpy.types, name)
         engines = getattr(panel, "COMPAT_ENGINES", None)
-        if engines is not None and "BLENDER_EEVEE" in engines and any(name.startswith(w) for w in wanted):
+        if engines is not None and engines & set(compat.EEVEE_IDS) and any(name.startswith(w) for w in wanted):
             panels.append(panel)
     return panels
 
 
 def register() -> None:
+    jobs.register()
     bpy.utils.register_class(SnellRenderEngine)
     for panel in compatible_panels():
         panel.COMPAT_ENGINES.add("SNELL")
@@ -196,3 +243,4 @@ def unregister() -> None:
     for panel in compatible_panels():
         panel.COMPAT_ENGINES.discard("SNELL")
     bpy.utils.unregister_class(SnellRenderEngine)
+    jobs.unregister()

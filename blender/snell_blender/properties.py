@@ -1,5 +1,5 @@
 # SPDX-License-Identifier: GPL-3.0-or-later
-"""The add-on's settings: per scene (how glass is drawn) and per user (where snell is)."""
+"""The add-on's settings: per scene (how glass is drawn), per view layer (which passes) and per user (where snell is)."""
 
 from __future__ import annotations
 
@@ -37,6 +37,34 @@ class SnellSceneSettings(bpy.types.PropertyGroup):
                                     description="A line in the viewport says how the image was drawn and what it cost")
 
 
+# snell's AOVs as render passes: (property, pass name, channel ids, type, description). Depth and
+# Normal take Blender's own names, so the compositor's nodes for them take snell's.
+PASSES = (
+    ("depth", "Depth", "Z", "VALUE", "Camera-space depth of the first surface (1e10 where there is none)"),
+    ("normal", "Normal", "XYZ", "VECTOR", "World-space face normal of the first surface"),
+    ("instance", "snell Instance", "X", "VALUE", "snell's draw item of the first surface (-1 where there is none)"),
+    ("primitive", "snell Primitive", "X", "VALUE", "Triangle of the first surface within its mesh (-1: none)"),
+    ("interfaces", "snell Interfaces", "X", "VALUE", "Glass faces the pixel's ray crossed"),
+    ("cost", "snell Cost", "X", "VALUE", "Tree nodes the pixel's rays visited"),
+)
+
+
+def _pass_property(name: str, label: str, description: str):
+    return bpy.props.BoolProperty(name=label, default=False, description=description)
+
+
+class SnellViewLayerSettings(bpy.types.PropertyGroup):
+    """Which of snell's AOVs a view layer writes as render passes (View Layer Properties > snell Passes)."""
+
+    __annotations__ = {key: _pass_property(key, name, description) for key, name, _, _, description in PASSES}
+
+
+def enabled_passes(view_layer) -> list:
+    """The PASSES entries the view layer asks for."""
+    options = getattr(view_layer, "snell", None)
+    return [entry for entry in PASSES if options is not None and getattr(options, entry[0])]
+
+
 class SnellPreferences(bpy.types.AddonPreferences):
     """Where the `snell` Python module is, when it is not installed for Blender's Python."""
 
@@ -65,11 +93,15 @@ def settings(scene) -> SnellSceneSettings:
 
 def register() -> None:
     bpy.utils.register_class(SnellSceneSettings)
+    bpy.utils.register_class(SnellViewLayerSettings)
     bpy.utils.register_class(SnellPreferences)
     bpy.types.Scene.snell = bpy.props.PointerProperty(type=SnellSceneSettings)
+    bpy.types.ViewLayer.snell = bpy.props.PointerProperty(type=SnellViewLayerSettings)
 
 
 def unregister() -> None:
+    del bpy.types.ViewLayer.snell
     del bpy.types.Scene.snell
     bpy.utils.unregister_class(SnellPreferences)
+    bpy.utils.unregister_class(SnellViewLayerSettings)
     bpy.utils.unregister_class(SnellSceneSettings)
