@@ -76,7 +76,8 @@ class SnellRenderEngine(bpy.types.RenderEngine):
         width = max(1, int(scene.render.resolution_x * scale))
         height = max(1, int(scene.render.resolution_y * scale))
         view_layer = depsgraph.view_layer
-        passes = enabled_passes(view_layer)
+        # The layer's own settings: 5.0's evaluated copy of a view layer does not carry an add-on's properties.
+        passes = enabled_passes(scene.original.view_layers.get(view_layer.name, view_layer))
         if passes and settings(scene).method not in TRACED_METHODS:
             self.report({"WARNING"}, f"snell: the passes come from the trace; method {settings(scene).method} "
                                      "writes the combined image alone")
@@ -84,23 +85,23 @@ class SnellRenderEngine(bpy.types.RenderEngine):
         frame, (index, total) = scene.frame_current, _frame_index(scene, self.is_animation)
         status = f"Frame {frame}" + (f" ({index} of {total})" if total > 1 else "")
 
-        def progress(fraction: float, step: str) -> None:
-            self.update_progress(fraction)
-            self.update_stats("", f"snell | {status} | {step}")
-
         job = jobs.current()
         try:
             picture = job.render_frame(depsgraph, scene.camera, width, height,
                                        (scene.render.pixel_aspect_x, scene.render.pixel_aspect_y), passes,
-                                       self.test_break, progress)
+                                       lambda: escape_pressed(self),
+                                       lambda fraction, step: report_progress(self, fraction, f"{status} | {step}"))
         except Exception as error:  # snell.Error, or Blender data snell cannot take: nothing is kept
             jobs.end()
             self.report({"ERROR"}, f"snell: {error}")
             return
         if picture is None:  # Esc: the frame under way is dropped and nothing of it is written
             job.stats.dropped += 1
-            self.update_stats("", f"snell | {status} | stopped")
+            report_progress(self, None, f"{status} | stopped")
             return
+        if "normal" in picture.planes:
+            picture.planes["normal"] = _turned_to_camera(picture.planes["normal"], depsgraph, scene.camera, width,
+                                                         height)
         for _, name, channels, _, _ in passes:
             self.add_pass(name, len(channels), channels, layer=view_layer.name)
         result = self.begin_result(0, 0, width, height, layer=view_layer.name)
@@ -184,6 +185,18 @@ class SnellRenderEngine(bpy.types.RenderEngine):
                 + (f"  ({notes})" if notes else ""))
 
 
+def escape_pressed(engine) -> bool:
+    """Whether the user asked the render to stop (Esc): asked between a frame's steps."""
+    return engine.test_break()
+
+
+def report_progress(engine, fraction: Optional[float], status: str) -> None:
+    """The render window's progress bar (the frame's fraction done, if given) and status line."""
+    if fraction is not None:
+        engine.update_progress(fraction)
+    engine.update_stats("", f"snell | {status}")
+
+
 # The methods whose F12 image is the trace's, and so has AOVs to give as passes.
 TRACED_METHODS = ("trace", "trace-1", "auto")
 
@@ -201,6 +214,26 @@ def _rows_up(plane):
     import numpy as np
 
     return np.ascontiguousarray(plane[::-1], np.float32).reshape(plane.shape[0] * plane.shape[1], -1)
+
+
+def _turned_to_camera(normals, depsgraph, camera, width: int, height: int):
+    """snell's face normals (its Y-up world, as winding makes them) turned towards the camera along each
+    pixel's ray, as Blender's Normal pass has them: a mesh wound inwards still shows normals that face out."""
+    import numpy as np
+
+    from .sync import Y_UP
+
+    camera = camera.evaluated_get(depsgraph)
+    p = np.array([list(row) for row in camera.calc_matrix_camera(depsgraph, x=width, y=height)], np.float64)
+    rows, columns = np.mgrid[0:height, 0:width] + 0.5
+    ndc_x, ndc_y = 2.0 * columns / width - 1.0, 1.0 - 2.0 * rows / height
+    if p[3, 3] == 0.0:  # perspective: camera-space direction (x / -z, y / -z, -1) from the off-centre frustum
+        rays = np.stack([(ndc_x + p[0, 2]) / p[0, 0], (ndc_y + p[1, 2]) / p[1, 1], -np.ones_like(ndc_x)], -1)
+    else:
+        rays = np.broadcast_to(np.array([0.0, 0.0, -1.0]), (height, width, 3))
+    to_world = Y_UP[:3, :3] @ np.array([list(row)[:3] for row in camera.matrix_world.to_3x3()], np.float64)
+    along = np.einsum("hwc,hwc->hw", normals, rays @ to_world.T)
+    return np.where((along > 0.0)[..., None], -normals, normals).astype(np.float32)
 
 
 def _pass_values(key: str, plane):

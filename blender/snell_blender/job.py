@@ -41,8 +41,9 @@ class Stats:
     frames: int = 0
     rebuilds: int = 0
     dropped: int = 0
-    meshes_sent: list = field(default_factory=list)
-    seconds: list = field(default_factory=list)  # per rendered frame: (sync, render)
+    meshes_sent: list = field(default_factory=list)  # the last frame's
+    sent: dict = field(default_factory=dict)  # per rendered frame number: the meshes it sent
+    seconds: dict = field(default_factory=dict)  # per rendered frame number: (sync, render) seconds
 
 
 class RenderJob:
@@ -115,7 +116,8 @@ class RenderJob:
         if stop():
             return None
         self.stats.frames += 1
-        self.stats.seconds.append((synced - started, time.perf_counter() - synced))
+        self.stats.sent[scene.frame_current] = list(self.stats.meshes_sent)
+        self.stats.seconds[scene.frame_current] = (synced - started, time.perf_counter() - synced)
         progress(1.0, "done")
         return picture
 

@@ -53,3 +53,27 @@ check("no Vulkan device" in f12_error(), "F12 reports the missing device")
 bpy.context.preferences.addons["snell_blender"].preferences.device = ""
 runtime.retry()
 check(runtime.problem() is None and f12_error() == "", f"with every piece there, F12 renders ({runtime.status()})")
+
+# A node snell does not read is named, with its material, in the console and in the panel's list; F12 still renders.
+import contextlib  # noqa: E402
+import io  # noqa: E402
+
+sclera = bpy.data.materials["Sclera"]
+nodes, links = sclera.node_tree.nodes, sclera.node_tree.links
+veins = nodes.new("ShaderNodeTexNoise")
+veins.name = "Veins"
+bsdf = next(n for n in nodes if n.bl_idname == "ShaderNodeBsdfPrincipled")
+links.new(veins.outputs["Color"], bsdf.inputs["Base Color"])
+skin = bpy.data.materials["Skin"]
+wax = skin.node_tree.nodes.new("ShaderNodeSubsurfaceScattering")
+wax.name = "Wax"
+output = next(n for n in skin.node_tree.nodes if n.bl_idname == "ShaderNodeOutputMaterial")
+skin.node_tree.links.new(wax.outputs[0], output.inputs["Surface"])
+console = io.StringIO()
+with contextlib.redirect_stdout(console):
+    error = f12_error()
+check(error == "", f"F12 renders what it can ({error})")
+for name, node, kind in (("Sclera", "Veins", "ShaderNodeTexNoise"), ("Skin", "Wax", "ShaderNodeSubsurfaceScattering")):
+    named = f"material '{name}': node '{node}' ({kind})"
+    check(named in console.getvalue(), f"the console names {named}")
+    check(any(named in line for line in runtime.scene_problems()), f"the panel's list names {named}")

@@ -6,7 +6,8 @@ The window's part: the 3D viewport in Rendered shading, looking through the
 camera; a screenshot at frame 1, then at frame 20. It checks that the
 screenshot's camera frame shows the F12 image (the same view transform:
 Standard), that the refracted iris is in it, and that the frame change sent
-snell only the meshes that deform (the eyes, not the face plate).
+snell only the meshes that deform (the eyes, not the face plate), and that
+an edit in a material's node tree reaches snell.
 """
 
 import json
@@ -53,6 +54,9 @@ def background_part() -> None:
           f"after the frame change snell got the deformed meshes only: {found['sent_after_frame_change']}")
     check(found["rebuilds"] == 1, f"the frame change rebuilt nothing ({found['rebuilds']} builds in all)")
     check(found["moved"] > 0.01, f"the viewport changed with the frame ({found['moved']:.1%} of the frame's pixels)")
+    check(found["rebuilds_after_edit"] == 1 and found["green_pixels"] > 2000,
+          f"an edit in a material's nodes reached snell: {found['rebuilds_after_edit']} rebuild "
+          f"({found['rebuild_reason']}), {found['green_pixels']} green pixels")
 
 
 # ------------------------------------------------------------------ the window part
@@ -155,10 +159,29 @@ def window_part() -> None:
             found["iris_pixels"] = int(iris.sum())
             before = state["frame_1"][np.ix_(rows, columns)]
             found["moved"] = float((np.abs(seen - before).max(axis=2) > 16 / 255).mean())
+            # An edit in a material's node tree: the face plate turns green.
+            state["rebuilds"] = engine.STATS["rebuilds"]
+            skin = bpy.data.materials["Skin"]
+            bsdf = next(n for n in skin.node_tree.nodes if n.bl_idname == "ShaderNodeBsdfPrincipled")
+            bsdf.inputs["Base Color"].default_value = (0.05, 0.8, 0.05, 1.0)
+            viewport()[1].tag_redraw()
+            bpy.app.timers.register(after_material_edit, first_interval=4.0)
         except Exception as error:
             import traceback
 
             traceback.print_exc()
+            found["error"] = repr(error)
+            finish()
+
+    def after_material_edit():
+        try:
+            from snell_blender import engine
+
+            shot = screenshot("viewport_green")
+            found["rebuilds_after_edit"] = engine.STATS["rebuilds"] - state["rebuilds"]
+            found["rebuild_reason"] = engine.STATS.get("rebuild_reason", "")
+            found["green_pixels"] = int(((shot[..., 1] > 2 * shot[..., 0]) & (shot[..., 1] > 2 * shot[..., 2])).sum())
+        except Exception as error:
             found["error"] = repr(error)
         finish()
 
