@@ -1,0 +1,83 @@
+"""snell.usd: USD stages drawn by snell, read with Pixar's usd-core (`pxr`).
+
+    import snell.usd
+
+    with snell.usd.open("eyes.usda") as stage:          # preview-purpose materials
+        for frame in range(1001, 1049):
+            stage.set_time(frame)                       # only what moves is re-read and sent
+            rgba = stage.render(1920, 1080)             # the stage's first camera
+
+What is read: UsdGeomMesh (n-gons fanned, normals of every interpolation,
+st, materialBind GeomSubsets, instance proxies, visibility and purpose),
+UsdSkel skinning and blend shapes evaluated by USD itself, UsdPreviewSurface
+materials bound for a purpose (preview first, then all-purpose) with
+UsdUVTexture diffuse textures, UsdLux lights, UsdGeomCamera; metersPerUnit
+and upAxis map the stage onto snell's metres and +Y up. What snell cannot
+draw is a warning naming the prim (Stage.warnings). docs/usd.md has the
+rules; `snell-usd` (python -m snell.usd) is the command line.
+"""
+
+from __future__ import annotations
+
+import os
+from typing import Optional, Union
+
+try:
+    import pxr  # noqa: F401  (usd-core)
+except ImportError as e:  # pragma: no cover - depends on the environment
+    raise ImportError("snell.usd needs Pixar's USD Python modules: pip install usd-core") from e
+
+from .. import Device
+from ._cameras import CONFORM_POLICIES, CameraState
+from ._lights import LightRecord
+from ._problems import StageError, StageWarning
+from ._reader import GEOMETRY_PURPOSES, ReadOptions, StageContents
+from ._stage import FeedStats, Stage
+
+PathLike = Union[str, os.PathLike]
+
+
+def read(path: PathLike, *, time: Optional[float] = None, purpose: str = "preview",
+         geometry_purpose: str = "render", meters_per_unit: Optional[float] = None, strict: bool = False,
+         load_textures: bool = True) -> StageContents:
+    """Reads a stage for snell without a GPU: its meshes, materials, lights, cameras and warnings.
+
+    time: the time code (default: the stage's start); purpose: the material
+    purpose bound first ('preview', 'full', or 'all' for the all-purpose
+    binding alone); geometry_purpose: 'render' or 'proxy', drawn beside
+    'default' ('guide' never is); meters_per_unit overrides the stage's;
+    strict: a broken stage (a missing texture, a mesh with faces but no
+    points) raises StageError instead of warning.
+    """
+    options = ReadOptions(purpose=purpose, geometry_purpose=geometry_purpose, meters_per_unit=meters_per_unit,
+                          load_textures=load_textures, strict=strict)
+    return StageContents(path, time, options)
+
+
+def open(path: PathLike, *, time: Optional[float] = None, purpose: str = "preview",  # noqa: A001 (as io.open)
+         geometry_purpose: str = "render", device: Optional[Device] = None, meters_per_unit: Optional[float] = None,
+         strict: bool = False, frames_in_flight: int = 2) -> Stage:
+    """Opens a stage for drawing: a snell.Scene of its meshes and a Renderer on `device`.
+
+    Without a device the stage makes its own and closes it with itself. The
+    other arguments are read()'s. Raises StageError (a snell.Error) naming
+    the file or prim when the stage cannot be drawn.
+    """
+    contents = read(path, time=time, purpose=purpose, geometry_purpose=geometry_purpose,
+                    meters_per_unit=meters_per_unit, strict=strict)
+    return Stage(contents, device=device, frames_in_flight=frames_in_flight)
+
+
+__all__ = [
+    "CONFORM_POLICIES",
+    "CameraState",
+    "FeedStats",
+    "GEOMETRY_PURPOSES",
+    "LightRecord",
+    "Stage",
+    "StageContents",
+    "StageError",
+    "StageWarning",
+    "open",
+    "read",
+]

@@ -1,0 +1,62 @@
+"""What goes wrong while reading a stage: warnings that name the prim, and errors.
+
+A warning says what snell leaves out or approximates (an unsupported shader,
+a wrap mode snell cannot draw). An error says the stage is broken where snell
+needs it (a texture file that is missing, a mesh whose faces have no
+points): strict readers raise it at once, others keep it as a warning marked
+as an error, which `snell-usd render` refuses.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from .. import Error
+
+
+class StageError(Error):
+    """A stage snell cannot read or draw as asked; the message names the file, the prim and the problem."""
+
+
+@dataclass(frozen=True)
+class StageWarning:
+    """One thing snell could not read as the stage says."""
+
+    prim: str  #: the prim's path, '' for the stage as a whole
+    message: str
+    error: bool = False  #: the stage is broken here (strict readers raise StageError instead)
+
+    def __str__(self) -> str:
+        text = f"{self.prim}: {self.message}" if self.prim else self.message
+        return f"error: {text}" if self.error else text
+
+
+class Problems:
+    """The warnings of one stage, each said once, in the order found."""
+
+    def __init__(self, stage_path: str, strict: bool) -> None:
+        self.stage_path = stage_path
+        self.strict = strict
+        self.items: list[StageWarning] = []
+        self._seen: set[tuple[str, str]] = set()
+
+    def warn(self, prim: object, message: str) -> None:
+        self._add(StageWarning(str(prim) if prim else "", message))
+
+    def fail(self, prim: object, message: str) -> None:
+        """A broken stage: raised when strict, else kept as an error-marked warning."""
+        item = StageWarning(str(prim) if prim else "", message, error=True)
+        if self.strict:
+            where = f"{item.prim}: " if item.prim else ""
+            raise StageError(f"{self.stage_path}: {where}{message}")
+        self._add(item)
+
+    def _add(self, item: StageWarning) -> None:
+        key = (item.prim, item.message)
+        if key not in self._seen:
+            self._seen.add(key)
+            self.items.append(item)
+
+    @property
+    def errors(self) -> list[StageWarning]:
+        return [w for w in self.items if w.error]

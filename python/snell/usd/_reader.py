@@ -1,0 +1,360 @@
+"""A USD stage read for snell at a time code: its meshes, materials, lights and cameras, and what moves.
+
+Nothing here needs a GPU: `snell-usd info` stops here, and snell.usd.Stage
+builds a scene and a renderer from it. The stage's world is mapped to
+snell's (glTF's: +Y up, metres) by one matrix, to_snell: metersPerUnit as a
+scale, and a Z-up stage turned so its +Z is snell's +Y ((x, y, z) ->
+(x, z, -y)). Instance transforms carry it, so points stay in their own units
+and a static prim is never touched again.
+"""
+
+from __future__ import annotations
+
+import os
+import time as clock
+from dataclasses import dataclass
+from typing import Optional, Union
+
+import numpy as np
+from pxr import Sdf, Tf, Usd, UsdGeom, UsdLux, UsdSkel
+
+from .. import Instance, Light, Material, Mesh
+from ._cameras import CameraState, camera_state
+from ._lights import LightRecord, read_light, unsupported_light
+from ._materials import MaterialTable
+from ._meshes import MeshSource, Pose, Topology, material_subsets, read_normals, read_primvar, read_topology
+from ._problems import Problems, StageError
+from ._skinning import SkelFrame, Skin
+
+GEOMETRY_PURPOSES = ("render", "proxy")
+_Z_UP_TO_Y_UP = np.array([[1.0, 0, 0, 0], [0, 0, 1, 0], [0, -1, 0, 0], [0, 0, 0, 1]])
+
+
+@dataclass
+class ReadOptions:
+    """How a stage is read."""
+
+    purpose: str = "preview"  #: material purpose: preview, full or all (the all-purpose binding only)
+    geometry_purpose: str = "render"  #: the purpose drawn beside default: render or proxy (guide never)
+    meters_per_unit: Optional[float] = None  #: overrides the stage's metersPerUnit
+    load_textures: bool = True
+    strict: bool = False  #: a broken stage (missing texture, mesh without points) raises StageError
+
+
+@dataclass
+class Placement:
+    """One placed copy of a mesh source: its snell instances (a part each) and where they are."""
+
+    prim: Usd.Prim  #: the prim whose local-to-world places it (the skeleton, for a skinned mesh)
+    source: MeshSource
+    instances: list[int]
+    varying: bool
+    matrix: np.ndarray  #: current mesh-to-snell-world, 4x4, column vectors
+    rigid_skin: Optional[Skin] = None
+
+
+@dataclass
+class Frame:
+    """The moving part of the stage at one time code, evaluated, not yet sent to snell."""
+
+    time: float
+    poses: list[tuple[MeshSource, Pose]]
+    transforms: list[tuple[Placement, np.ndarray]]
+    seconds: float = 0.0  #: the USD evaluation's wall time
+
+
+def transform_might_vary(prim: Usd.Prim) -> bool:
+    """Whether the prim's local-to-world may change over time (any xformable ancestor up to a reset)."""
+    while prim and not prim.IsPseudoRoot():
+        xformable = UsdGeom.Xformable(prim)
+        if xformable:
+            if xformable.TransformMightBeTimeVarying():
+                return True
+            if xformable.GetResetXformStack():
+                return False
+        prim = prim.GetParent()
+    return False
+
+
+class StageContents:
+    """A stage as snell sees it at a time code (see the module's docstring)."""
+
+    def __init__(self, path: Union[str, os.PathLike], time: Optional[float] = None,
+                 options: Optional[ReadOptions] = None) -> None:
+        started = clock.perf_counter()
+        self.options = options or ReadOptions()
+        if self.options.geometry_purpose not in GEOMETRY_PURPOSES:
+            raise ValueError(f"geometry purpose must be render or proxy, got '{self.options.geometry_purpose}'")
+        self.path = os.fspath(path)
+        self.problems = Problems(self.path, self.options.strict)
+        self.stage = _open_stage(self.path)
+        stage = self.stage
+        for error in getattr(stage, "GetCompositionErrors", lambda: [])():
+            self.problems.warn("", f"composition: {error}")
+        self.has_range = stage.HasAuthoredTimeCodeRange()
+        self.start, self.end = stage.GetStartTimeCode(), stage.GetEndTimeCode()
+        self.time_codes_per_second = stage.GetTimeCodesPerSecond()
+        self.time = float(self.start if time is None else time)
+        if not self.in_range(self.time):
+            self.problems.warn("", f"time code {self.time:g} is outside the stage's range {self.start:g}-{self.end:g}: "
+                                   "USD holds the nearest samples")
+        self.meters_per_unit_authored = UsdGeom.StageHasAuthoredMetersPerUnit(stage)
+        self.meters_per_unit = float(self.options.meters_per_unit or UsdGeom.GetStageMetersPerUnit(stage))
+        if not self.meters_per_unit_authored and self.options.meters_per_unit is None:
+            self.problems.warn("", "metersPerUnit is not authored: USD's fallback, 0.01 (centimetres), applies")
+        self.up_axis = str(UsdGeom.GetStageUpAxis(stage))
+        rotate = _Z_UP_TO_Y_UP if self.up_axis == "Z" else np.eye(4)
+        self.to_snell = np.diag([self.meters_per_unit] * 3 + [1.0]) @ rotate
+
+        self.materials = MaterialTable(Usd.TimeCode(self.time), self.options.purpose, self.problems,
+                                       self.options.load_textures)
+        self.sources: list[MeshSource] = []
+        self.placements: list[Placement] = []
+        self.lights: list[LightRecord] = []
+        self.cameras: list[Usd.Prim] = []
+        self.skipped: dict[str, list[str]] = {}
+        self._skel_cache = UsdSkel.Cache()
+        self._xform_cache = UsdGeom.XformCache(Usd.TimeCode(self.time))
+        self._topologies: dict[Sdf.Path, Optional[Topology]] = {}
+        self._shared: dict[tuple, MeshSource] = {}
+        self._initial: dict[int, Pose] = {}
+        self._instance_count = 0
+        self._traverse()
+        self.dynamic_sources = [s for s in self.sources if s.deforms]
+        self.dynamic_placements = [p for p in self.placements if p.varying]
+        self.load_seconds = clock.perf_counter() - started
+
+    # ------------------------------------------------------------------ traversal
+
+    def _skip(self, what: str, prim: Usd.Prim) -> None:
+        self.skipped.setdefault(what, []).append(str(prim.GetPath()))
+
+    def _traverse(self) -> None:
+        time = Usd.TimeCode(self.time)
+        predicate = Usd.TraverseInstanceProxies(Usd.PrimDefaultPredicate)
+        walk = iter(Usd.PrimRange(self.stage.GetPseudoRoot(), predicate))
+        excluded = {"guide", "render", "proxy"} - {self.options.geometry_purpose}
+        for prim in walk:
+            if prim.IsPseudoRoot():
+                continue
+            imageable = UsdGeom.Imageable(prim)
+            if imageable:
+                visibility = imageable.GetVisibilityAttr()
+                if visibility.ValueMightBeTimeVarying():
+                    self.problems.warn(prim.GetPath(), "its visibility is animated; snell reads it once, at time "
+                                                       f"code {self.time:g}")
+                if visibility.Get(time) == UsdGeom.Tokens.invisible:
+                    self._skip("invisible", prim)
+                    walk.PruneChildren()
+                    continue
+            if prim.IsA(UsdSkel.Root):
+                self._skel_cache.Populate(UsdSkel.Root(prim), predicate)
+            if prim.IsA(UsdGeom.Camera):
+                self.cameras.append(prim)
+            elif prim.IsA(UsdGeom.PointInstancer):
+                self.problems.warn(prim.GetPath(), "a PointInstancer: snell does not read point instancing yet: "
+                                                   "skipped, with its prototypes")
+                walk.PruneChildren()
+            elif prim.IsA(UsdGeom.Mesh):
+                purpose = imageable.ComputePurpose()
+                if purpose in excluded:
+                    self._skip(f"purpose {purpose}", prim)
+                    continue
+                if prim.HasAPI(UsdLux.MeshLightAPI):
+                    self.problems.warn(prim.GetPath(), "a mesh light: snell draws the mesh but not its light")
+                self._add_mesh(prim, time)
+            elif prim.HasAPI(UsdLux.LightAPI) or prim.IsA(UsdLux.BoundableLightBase) or \
+                    prim.IsA(UsdLux.NonboundableLightBase):
+                if prim.IsA(UsdLux.DomeLight) or prim.IsA(UsdLux.DomeLight_1) or prim.IsA(UsdLux.PortalLight) or \
+                        prim.IsA(UsdLux.GeometryLight):
+                    self.lights.append(unsupported_light(prim, self.problems))
+                else:
+                    self.lights.append(read_light(prim, time, self.to_snell, self._xform_cache, self.problems))
+            elif prim.IsA(UsdGeom.Gprim):
+                self._skip(prim.GetTypeName(), prim)
+        for kind, paths in self.skipped.items():
+            if kind in ("invisible",) or kind.startswith("purpose"):
+                continue
+            first = ", ".join(paths[:3]) + (", ..." if len(paths) > 3 else "")
+            self.problems.warn("", f"{len(paths)} {kind} prim(s) skipped: snell reads UsdGeomMesh ({first})")
+
+    def _skin_of(self, prim: Usd.Prim) -> Optional[Skin]:
+        query = self._skel_cache.GetSkinningQuery(prim)
+        if not query or not (query.HasJointInfluences() or query.HasBlendShapes()):
+            return None
+        skeleton = UsdSkel.BindingAPI(prim).GetInheritedSkeleton()
+        skel_query = self._skel_cache.GetSkelQuery(skeleton) if skeleton else None
+        if not skel_query:
+            self.problems.warn(prim.GetPath(), "has joint influences but no skeleton is bound: drawn unskinned")
+            return None
+        return Skin(prim, query, skel_query, self.problems)
+
+    def _add_mesh(self, prim: Usd.Prim, time: Usd.TimeCode) -> None:
+        mesh = UsdGeom.Mesh(prim)
+        skin = self._skin_of(prim)
+        prototype = prim.GetPrimInPrototype() if prim.IsInstanceProxy() else prim
+        key = prototype.GetPath()
+        if skin is None and key in self._topologies:
+            topology = self._topologies[key]
+        else:
+            topology = read_topology(mesh, time, self.problems)
+            if skin is None:
+                self._topologies[key] = topology
+        if topology is None:
+            return
+        double_sided = bool(mesh.GetDoubleSidedAttr().Get(time))
+        parts = [(bind, triangles, self.materials.index_for(bind, prim, double_sided))
+                 for bind, triangles in material_subsets(prim, topology, time, self.problems)]
+        rigid = skin if skin is not None and skin.skinned and skin.rigid else None
+        placed_by = skin.skeleton_prim if skin is not None and skin.skinned else prim
+        frame = SkelFrame(time)
+        matrix = self._matrix(placed_by, rigid, frame)
+        flip = np.linalg.det(matrix[:3, :3]) < 0.0
+        share = (key, tuple(m for _, _, m in parts), flip) if skin is None else None
+        source = self._shared.get(share) if share is not None else None
+        if source is None:
+            source = self._make_source(mesh, topology, skin, parts, flip, time)
+            if source is None:
+                return
+            if share is not None:
+                self._shared[share] = source
+        varying = transform_might_vary(placed_by) or bool(rigid is not None and rigid.animated)
+        instances = list(range(self._instance_count, self._instance_count + len(source.parts)))
+        self._instance_count += len(source.parts)
+        self.placements.append(Placement(placed_by, source, instances, varying, matrix, rigid))
+
+    def _make_source(self, mesh: UsdGeom.Mesh, topology: Topology, skin: Optional[Skin], parts: list,
+                     flip: bool, time: Usd.TimeCode) -> Optional[MeshSource]:
+        prim = mesh.GetPrim()
+        normals = read_normals(mesh, topology, time, self.problems)
+        source = MeshSource(mesh, topology, normals, skin, self.problems)
+        pose = source.pose(time, SkelFrame(time))
+        if pose is None:
+            return None
+        for bind, triangles, material in parts:
+            record = self.materials.records[material]
+            st, st_values = None, None
+            if record.texture is not None:
+                st, st_values = self._st(prim, record.st_primvar, topology, time, record.path)
+            name = str(prim.GetPath()) if bind == prim else f"{prim.GetPath()} ({bind.GetName()})"
+            part = source.add_part(name, triangles, material, st, st_values, record.st_transform)
+            if flip:
+                part.indices = np.ascontiguousarray(part.indices[:, [0, 2, 1]])
+            if part.uvs is not None and any(w != "repeat" for w in record.wraps):
+                outside = (part.uvs < -1e-6) | (part.uvs > 1 + 1e-6)
+                if outside.any():
+                    axes = [w for w, o in zip(record.wraps, outside.any(axis=0)) if w != "repeat" and o]
+                    if axes:
+                        self.problems.warn(record.texture_prim, f"wrap '{axes[0]}' where {prim.GetPath()}'s st "
+                                                                "leaves [0, 1]: snell repeats textures")
+        self.sources.append(source)
+        self._initial[id(source)] = pose
+        return source
+
+    def _st(self, prim: Usd.Prim, name: str, topology: Topology, time: Usd.TimeCode, material: str):
+        primvar = UsdGeom.PrimvarsAPI(prim).GetPrimvar(name)
+        if not primvar or not primvar.HasAuthoredValue():
+            self.problems.warn(prim.GetPath(), f"has no primvars:{name} for the texture of {material}: the texture "
+                                               "is read at st (0, 0)")
+            return None, None
+        indices = np.asarray(primvar.GetIndices(time), np.int64) if primvar.IsIndexed() else None
+        st = read_primvar(prim, primvar.GetAttr(), primvar.GetInterpolation(), indices, topology, time,
+                          self.problems, f"primvars:{name}")
+        if st is None:
+            return None, None
+        if st.varying:
+            self.problems.warn(prim.GetPath(), f"primvars:{name} is animated; snell reads it once, at time code "
+                                               f"{self.time:g}")
+        values = np.asarray(primvar.GetAttr().Get(time), np.float64).reshape(-1, 2)
+        return st, values
+
+    def _matrix(self, prim: Usd.Prim, rigid: Optional[Skin], frame: SkelFrame) -> np.ndarray:
+        matrix = self.to_snell @ np.array(self._xform_cache.GetLocalToWorldTransform(prim)).T
+        if rigid is not None:
+            skinned = rigid.rigid_transform(frame)
+            if skinned is not None:
+                matrix = matrix @ skinned
+        return matrix
+
+    # ------------------------------------------------------------------ what snell takes
+
+    def in_range(self, time_code: float) -> bool:
+        """Whether a time code lies in the stage's authored range (any does, without one)."""
+        return not self.has_range or self.start <= time_code <= self.end
+
+    def snell_meshes(self) -> list[Mesh]:
+        """Every part of every source as a snell.Mesh, numbering the parts (part.mesh) on the way."""
+        meshes = []
+        for source in self.sources:
+            pose = self._initial[id(source)]
+            for part in source.parts:
+                positions = np.empty((len(part.vertex_point), 3), np.float32)
+                normals = np.empty_like(positions)
+                source.write(part, pose, positions, normals)
+                part.mesh = len(meshes)
+                meshes.append(Mesh(positions, normals, part.indices, part.uvs, material=part.material,
+                                   name=part.name))
+        return meshes
+
+    def snell_instances(self) -> list[Instance]:
+        """Every placement's instances, in order (snell_meshes first: it numbers the parts)."""
+        return [Instance(part.mesh, placement.matrix)
+                for placement in self.placements for part in placement.source.parts]
+
+    def snell_materials(self) -> list[Material]:
+        return [record.snell_material() for record in self.materials.records]
+
+    def snell_lights(self) -> list[Light]:
+        return [record.light for record in self.lights if record.light is not None]
+
+    def camera(self, which: Union[None, int, str], time_code: float) -> Optional[CameraState]:
+        """A camera by prim path or index (None: the first, or None if the stage has none)."""
+        if which is None:
+            if not self.cameras:
+                return None
+            prim = self.cameras[0]
+        elif isinstance(which, int):
+            if not 0 <= which < len(self.cameras):
+                raise StageError(f"{self.path}: no camera {which}; the stage has {len(self.cameras)}")
+            prim = self.cameras[which]
+        else:
+            prim = self.stage.GetPrimAtPath(which) if Sdf.Path.IsValidPathString(which) else Usd.Prim()
+            if not prim or not prim.IsA(UsdGeom.Camera):
+                known = ", ".join(str(c.GetPath()) for c in self.cameras) or "none"
+                raise StageError(f"{self.path}: {which} is not a camera of the stage (its cameras: {known})")
+        t = Usd.TimeCode(time_code)
+        state = camera_state(prim, t, self.to_snell, self.meters_per_unit, UsdGeom.XformCache(t))
+        if not (state.horizontal_aperture > 0 and state.vertical_aperture > 0 and
+                (state.orthographic or state.focal_length > 0)):
+            raise StageError(f"{self.path}: {state.path}: focal length {state.focal_length:g} and aperture "
+                             f"{state.horizontal_aperture:g} x {state.vertical_aperture:g} make no picture")
+        return state
+
+    def evaluate(self, time_code: float) -> Frame:
+        """Posed points and normals of the deforming sources and transforms of the moving placements."""
+        started = clock.perf_counter()
+        t = Usd.TimeCode(time_code)
+        frame = SkelFrame(t)
+        poses = []
+        for source in self.dynamic_sources:
+            pose = source.pose(t, frame)
+            if pose is not None:
+                poses.append((source, pose))
+        self._xform_cache.SetTime(t)
+        transforms = [(p, self._matrix(p.prim, p.rigid_skin, frame)) for p in self.dynamic_placements]
+        return Frame(time_code, poses, transforms, clock.perf_counter() - started)
+
+
+def _open_stage(path: str) -> Usd.Stage:
+    if not os.path.exists(path):
+        raise StageError(f"{path}: no such file")
+    try:
+        stage = Usd.Stage.Open(path, Usd.Stage.LoadAll)
+    except Tf.ErrorException as e:
+        reason = str(e).strip().splitlines()[-1] if str(e).strip() else "USD cannot open it"
+        raise StageError(f"{path}: not a stage USD opens ({reason.strip()})") from None
+    if stage is None:
+        raise StageError(f"{path}: not a stage USD opens")
+    return stage
+
+

@@ -1,0 +1,155 @@
+"""A small glTF 2.0 writer for test scenes: one .gltf (JSON) and one binary buffer (.bin) beside it.
+
+It writes what the USD tests compare against: meshes of several primitives
+with skins and morph targets, node animations, metallic-roughness materials
+with KHR_materials_transmission and KHR_materials_ior, an image texture by
+URI, a perspective camera and KHR_lights_punctual lights.
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+
+_COMPONENT = {np.dtype(np.float32): 5126, np.dtype(np.uint32): 5125, np.dtype(np.uint16): 5123}
+_TYPE = {1: "SCALAR", 2: "VEC2", 3: "VEC3", 4: "VEC4", 16: "MAT4"}
+
+
+class GltfWriter:
+    """Builds a glTF document; write() saves it with its buffer."""
+
+    def __init__(self) -> None:
+        self.doc: dict = {"asset": {"version": "2.0", "generator": "snell tests/usd"}, "scene": 0,
+                          "scenes": [{"nodes": []}], "nodes": [], "meshes": [], "accessors": [],
+                          "bufferViews": [], "materials": []}
+        self.blob = bytearray()
+
+    def _extension(self, name: str) -> None:
+        used = self.doc.setdefault("extensionsUsed", [])
+        if name not in used:
+            used.append(name)
+
+    def accessor(self, array: np.ndarray, minmax: bool = False, target: int | None = None) -> int:
+        """Appends an array to the buffer: rows are elements ((n,) scalars, (n, k) vectors, (n, 4, 4) matrices)."""
+        array = np.ascontiguousarray(array)
+        width = 1 if array.ndim == 1 else int(np.prod(array.shape[1:]))
+        while len(self.blob) % 4:
+            self.blob.append(0)
+        view = {"buffer": 0, "byteOffset": len(self.blob), "byteLength": array.nbytes}
+        if target is not None:
+            view["target"] = target
+        self.blob += array.tobytes()
+        self.doc["bufferViews"].append(view)
+        accessor = {"bufferView": len(self.doc["bufferViews"]) - 1, "componentType": _COMPONENT[array.dtype],
+                    "count": int(array.shape[0]), "type": _TYPE[width]}
+        if minmax:
+            flat = array.reshape(len(array), width)
+            accessor["min"] = flat.min(axis=0).tolist()
+            accessor["max"] = flat.max(axis=0).tolist()
+        self.doc["accessors"].append(accessor)
+        return len(self.doc["accessors"]) - 1
+
+    def material(self, base_color=(1, 1, 1, 1), roughness: float = 1.0, transmission: float = 0.0, ior: float = 1.5,
+                 texture_uri: str | None = None, emissive=(0, 0, 0)) -> int:
+        pbr: dict = {"baseColorFactor": list(base_color), "metallicFactor": 0.0, "roughnessFactor": roughness}
+        m: dict = {"pbrMetallicRoughness": pbr}
+        if any(emissive):
+            m["emissiveFactor"] = list(emissive)
+        if transmission > 0:
+            m["extensions"] = {"KHR_materials_transmission": {"transmissionFactor": transmission},
+                               "KHR_materials_ior": {"ior": ior}}
+            self._extension("KHR_materials_transmission")
+            self._extension("KHR_materials_ior")
+        if texture_uri is not None:
+            self.doc.setdefault("images", []).append({"uri": texture_uri})
+            self.doc.setdefault("samplers", [{"magFilter": 9729, "minFilter": 9987, "wrapS": 10497, "wrapT": 10497}])
+            self.doc.setdefault("textures", []).append({"source": len(self.doc["images"]) - 1, "sampler": 0})
+            pbr["baseColorTexture"] = {"index": len(self.doc["textures"]) - 1}
+        self.doc["materials"].append(m)
+        return len(self.doc["materials"]) - 1
+
+    def mesh(self, primitives: list[dict], weights: list[float] | None = None, name: str = "") -> int:
+        """primitives: dicts of positions, normals, indices ((T, 3) uint32), and optional uvs, material,
+        joints ((n, 4) uint16), weights ((n, 4) float32) and targets (position deltas, one array per target)."""
+        out = []
+        for p in primitives:
+            attributes = {"POSITION": self.accessor(np.float32(p["positions"]), minmax=True, target=34962),
+                          "NORMAL": self.accessor(np.float32(p["normals"]), target=34962)}
+            if p.get("uvs") is not None:
+                attributes["TEXCOORD_0"] = self.accessor(np.float32(p["uvs"]), target=34962)
+            if p.get("joints") is not None:
+                attributes["JOINTS_0"] = self.accessor(np.uint16(p["joints"]), target=34962)
+                attributes["WEIGHTS_0"] = self.accessor(np.float32(p["weights"]), target=34962)
+            primitive: dict = {"attributes": attributes,
+                               "indices": self.accessor(np.uint32(p["indices"]).reshape(-1), target=34963)}
+            if p.get("material") is not None:
+                primitive["material"] = p["material"]
+            if p.get("targets"):
+                primitive["targets"] = [{"POSITION": self.accessor(np.float32(d), minmax=True)} for d in p["targets"]]
+            out.append(primitive)
+        mesh: dict = {"primitives": out}
+        if name:
+            mesh["name"] = name
+        if weights is not None:
+            mesh["weights"] = list(weights)
+        self.doc["meshes"].append(mesh)
+        return len(self.doc["meshes"]) - 1
+
+    def node(self, parent: int | None = None, matrix: np.ndarray | None = None, **fields) -> int:
+        """A node under `parent` (None: a root of the scene); matrix: 4x4 with column vectors."""
+        if matrix is not None:
+            fields["matrix"] = np.asarray(matrix, float).T.reshape(-1).tolist()  # glTF stores columns
+        self.doc["nodes"].append({k: v for k, v in fields.items() if v is not None})
+        index = len(self.doc["nodes"]) - 1
+        if parent is None:
+            self.doc["scenes"][0]["nodes"].append(index)
+        else:
+            self.doc["nodes"][parent].setdefault("children", []).append(index)
+        return index
+
+    def skin(self, joints: list[int], inverse_binds: list[np.ndarray], skeleton: int | None = None) -> int:
+        matrices = np.stack([np.asarray(m, np.float32).T for m in inverse_binds])  # column-major, as glTF stores
+        skin = {"joints": list(joints), "inverseBindMatrices": self.accessor(matrices.reshape(len(joints), 16))}
+        if skeleton is not None:
+            skin["skeleton"] = skeleton
+        self.doc.setdefault("skins", []).append(skin)
+        return len(self.doc["skins"]) - 1
+
+    def animate(self, node: int, path: str, times, values, interpolation: str = "LINEAR") -> None:
+        """A channel of the scene's one animation: path is translation, rotation (x, y, z, w), scale or weights."""
+        animation = self.doc.setdefault("animations", [{"samplers": [], "channels": []}])[0]
+        t = self.accessor(np.float32(times), minmax=True)
+        v = self.accessor(np.float32(values).reshape(len(times), -1) if path != "weights"
+                          else np.float32(values).reshape(-1))
+        animation["samplers"].append({"input": t, "output": v, "interpolation": interpolation})
+        sampler = len(animation["samplers"]) - 1
+        animation["channels"].append({"sampler": sampler, "target": {"node": node, "path": path}})
+
+    def camera(self, yfov: float, aspect: float, position, name: str = "", znear: float = 0.1) -> int:
+        self.doc.setdefault("cameras", []).append(
+            {"type": "perspective", "perspective": {"yfov": yfov, "aspectRatio": aspect, "znear": znear}})
+        return self.node(name=name or None, camera=len(self.doc["cameras"]) - 1,
+                         translation=[float(c) for c in position])
+
+    def light(self, kind: str, color, intensity: float, translation=None, matrix=None, spot: dict | None = None,
+              name: str = "") -> int:
+        self._extension("KHR_lights_punctual")
+        lights = self.doc.setdefault("extensions", {}).setdefault("KHR_lights_punctual", {"lights": []})["lights"]
+        light = {"type": kind, "color": [float(c) for c in color], "intensity": float(intensity)}
+        if spot:
+            light["spot"] = spot
+        lights.append(light)
+        return self.node(name=name or None, matrix=matrix,
+                         translation=None if translation is None else [float(c) for c in translation],
+                         extensions={"KHR_lights_punctual": {"light": len(lights) - 1}})
+
+    def write(self, path: Path) -> Path:
+        """Writes path (.gltf) and path with .bin beside it."""
+        path = Path(path)
+        binary = path.with_suffix(".bin")
+        binary.write_bytes(bytes(self.blob))
+        self.doc["buffers"] = [{"byteLength": len(self.blob), "uri": binary.name}]
+        path.write_text(json.dumps(self.doc, indent=1))
+        return path

@@ -1,0 +1,168 @@
+"""`snell-usd info` and `snell-usd render` (run as python -m snell.usd)."""
+
+from __future__ import annotations
+
+import json
+import os
+import signal
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+from conftest import read_image, snell_usd
+from stages import bind, new_stage, preview_material, quad, texture
+
+SIZE = "64x48"
+
+
+def test_info_lists_prims_materials_cameras_lights_and_the_time_range(eyes):
+    done = snell_usd("info", eyes.usd)
+    assert done.returncode == 0, done.stderr
+    out = done.stdout
+    assert "time codes 1-48 at 24 per second" in out and "metres per unit 1 (authored)" in out
+    assert "/World/Rig/EyeballL (cornea): 193 vertices, 352 triangles, material /World/Looks/Cornea" in out
+    assert "skinned by /World/Rig/Skel" in out
+    assert "/World/Looks/Cornea: UsdPreviewSurface, glass (opacity 0, ior 1.376)" in out
+    assert "/World/Camera: focal length 35" in out
+    assert "/World/Key (SphereLight): point, 251.3 cd" in out and "/World/Rim (SphereLight): spot" in out
+    assert "warnings: 0" in out
+
+
+def test_info_json_is_the_same_listing(eyes):
+    done = snell_usd("info", eyes.usd, "--json", "--purpose", "full")
+    listing = json.loads(done.stdout)
+    assert listing["time_range"] == [1.0, 48.0] and listing["material_purpose"] == "full"
+    assert {m["prim"] for m in listing["materials"]} == {"/World/Looks/ScleraFull", "/World/Looks/CorneaFull",
+                                                        "/World/Looks/IrisAllPurpose"}
+    assert [c["prim"] for c in listing["cameras"]] == ["/World/Camera"] and len(listing["lights"]) == 3
+
+
+def test_info_on_a_broken_stage_lists_the_error_and_exits_1(tmp_path):
+    stage = new_stage(tmp_path / "broken.usda")
+    card = quad(stage, "/World/Card")
+    material = preview_material(stage, "/World/M")
+    texture(stage, material, "./gone.png")
+    bind(card.GetPrim(), material)
+    stage.GetRootLayer().Save()
+    done = snell_usd("info", tmp_path / "broken.usda")
+    assert done.returncode == 1
+    assert "  error: /World/M/Texture_diffuseColor: texture file ./gone.png not found" in done.stdout
+
+
+def test_render_writes_exactly_the_frames_asked(eyes, tmp_path):
+    done = snell_usd("render", eyes.usd, "-o", tmp_path / "shot.####.exr", "--frames", "1-9x4,20", "--size", SIZE)
+    assert done.returncode == 0, done.stderr
+    assert sorted(os.listdir(tmp_path)) == ["shot.0001.exr", "shot.0005.exr", "shot.0009.exr", "shot.0020.exr"]
+    assert done.stderr.count("frame ") == 4 and "frame 20 (4/4) -> " in done.stderr
+    pixels = read_image(tmp_path / "shot.0009.exr")
+    assert pixels.shape == (48, 64, 4) and pixels[..., :3].max() > 0.2
+
+
+def test_render_writes_a_png_of_the_single_frame(eyes, tmp_path):
+    done = snell_usd("render", eyes.usd, "-o", tmp_path / "still.png", "--size", SIZE, "--camera", "/World/Camera")
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.startswith(f"wrote {tmp_path / 'still.png'}: 64x48, camera /World/Camera, time code 1")
+    assert read_image(tmp_path / "still.png").shape == (48, 64, 4)
+
+
+def test_skip_existing_leaves_finished_frames_alone(eyes, tmp_path):
+    (tmp_path / "shot.0002.png").write_bytes(b"finished")
+    done = snell_usd("render", eyes.usd, "-o", tmp_path / "shot.####.png", "--frames", "1-3", "--size", SIZE,
+                     "--skip-existing")
+    assert done.returncode == 0, done.stderr
+    assert "skipping 1 of 3 frames: their files exist" in done.stdout
+    assert (tmp_path / "shot.0002.png").read_bytes() == b"finished"
+    assert sorted(os.listdir(tmp_path)) == ["shot.0001.png", "shot.0002.png", "shot.0003.png"]
+
+
+def test_quiet_prints_nothing(eyes, tmp_path):
+    done = snell_usd("render", eyes.usd, "-o", tmp_path / "s.####.png", "--frames", "1-2", "--size", SIZE, "-q")
+    assert done.returncode == 0 and done.stdout == "" and done.stderr == ""
+
+
+def test_a_stage_with_a_missing_texture_exits_1_and_writes_nothing(tmp_path):
+    stage = new_stage(tmp_path / "broken.usda")
+    card = quad(stage, "/World/Card")
+    material = preview_material(stage, "/World/M")
+    texture(stage, material, "./gone.png")
+    bind(card.GetPrim(), material)
+    stage.GetRootLayer().Save()
+    out = tmp_path / "out"
+    out.mkdir()
+    done = snell_usd("render", tmp_path / "broken.usda", "-o", out / "f.####.exr", "--frames", "1-3", "--size", SIZE)
+    assert done.returncode == 1
+    assert "/World/M/Texture_diffuseColor: texture file ./gone.png not found" in done.stderr
+    assert os.listdir(out) == []
+
+
+def test_a_stage_with_a_mesh_without_points_exits_1_and_writes_nothing(tmp_path):
+    from pxr import UsdGeom
+
+    stage = new_stage(tmp_path / "broken.usda")
+    quad(stage, "/World/Card")
+    empty = UsdGeom.Mesh.Define(stage, "/World/Pointless")
+    empty.CreateFaceVertexCountsAttr([4])
+    empty.CreateFaceVertexIndicesAttr([0, 1, 2, 3])
+    stage.GetRootLayer().Save()
+    out = tmp_path / "out"
+    out.mkdir()
+    done = snell_usd("render", tmp_path / "broken.usda", "-o", out / "f.png", "--size", SIZE)
+    assert done.returncode == 1 and "/World/Pointless: has 1 faces but no points" in done.stderr
+    assert os.listdir(out) == []
+
+
+def test_a_frame_outside_the_time_range_exits_1_and_writes_nothing(eyes, tmp_path):
+    done = snell_usd("render", eyes.usd, "-o", tmp_path / "f.####.png", "--frames", "40-50", "--size", SIZE)
+    assert done.returncode == 1
+    assert "frames 49, 50 are outside the stage's time range 1-48" in done.stderr
+    assert os.listdir(tmp_path) == []
+
+
+def test_a_stage_that_is_not_there_exits_1(tmp_path):
+    done = snell_usd("render", tmp_path / "nowhere.usda", "-o", tmp_path / "f.png")
+    assert done.returncode == 1 and f"{tmp_path / 'nowhere.usda'}: no such file" in done.stderr
+    assert os.listdir(tmp_path) == []
+
+
+@pytest.mark.parametrize("args, says", [
+    (["--frames", "9-1"], "--frames '9-1': '9-1' runs backwards"),
+    (["--frames", "1-3"], "3 frames need a slot for the frame number"),
+    (["--size", "big"], "'big' is not WIDTHxHEIGHT"),
+    (["--camera", "/World/Nope"], "--camera /World/Nope: "),
+])
+def test_a_bad_command_line_exits_2(eyes, tmp_path, args, says):
+    done = snell_usd("render", eyes.usd, "-o", tmp_path / "f.png", *args)
+    assert done.returncode == 2 and says in done.stderr
+    assert os.listdir(tmp_path) == []
+
+
+def test_sigterm_keeps_whole_frames_and_exits_143(eyes, tmp_path):
+    process = subprocess.Popen([sys.executable, "-m", "snell.usd", "render", str(eyes.usd), "-o",
+                                str(tmp_path / "f.####.exr"), "--frames", "1-48", "--size", "320x240"],
+                               stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    assert process.stderr.readline().startswith("frame 1 (1/48)")
+    process.send_signal(signal.SIGTERM)
+    _, err = process.communicate(timeout=60)
+    assert process.returncode == 143, err
+    written = sorted(os.listdir(tmp_path))
+    assert 1 <= len(written) < 48 and all(name.startswith("f.00") for name in written), written
+    for name in written:  # each file is whole: it reads back completely
+        assert read_image(tmp_path / name).shape == (240, 320, 4)
+    assert "stopped by signal 15" in err
+
+
+def test_help_lists_the_exit_codes():
+    done = snell_usd("render", "--help")
+    assert done.returncode == 0 and "exit codes: 0 done, 1 failed" in done.stdout and "--skip-existing" in done.stdout
+
+
+def test_the_frames_written_are_the_api_s_pictures(eyes, tmp_path, device):
+    import snell.usd
+
+    snell_usd("render", eyes.usd, "-o", tmp_path / "f.exr", "--frames", "17", "--size", SIZE, "--float")
+    with snell.usd.open(eyes.usd, device=device) as stage:
+        stage.set_time(17)
+        expected = stage.render(64, 48)
+    np.testing.assert_allclose(read_image(tmp_path / "f.exr"), expected, atol=1e-6)
