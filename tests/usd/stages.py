@@ -111,7 +111,6 @@ def texture(stage: Usd.Stage, material: UsdShade.Material, file: str, input_name
             varname: str = "st", output: str = "rgb", **texture_inputs) -> UsdShade.Shader:
     """A UsdUVTexture (reading `varname` through a UsdPrimvarReader_float2) into the surface's input."""
     path = material.GetPath()
-    surface = UsdShade.Shader(stage.GetPrimAtPath(path.AppendChild("Surface")))
     reader = UsdShade.Shader.Define(stage, path.AppendChild("Reader"))
     reader.CreateIdAttr("UsdPrimvarReader_float2")
     reader.CreateInput("varname", Sdf.ValueTypeNames.Token).Set(varname)
@@ -122,11 +121,37 @@ def texture(stage: Usd.Stage, material: UsdShade.Material, file: str, input_name
         kind = Sdf.ValueTypeNames.Token if isinstance(value, str) else Sdf.ValueTypeNames.Float4
         image.CreateInput(name, kind).Set(value if isinstance(value, str) else Gf.Vec4f(*value))
     image.CreateInput("st", Sdf.ValueTypeNames.Float2).ConnectToSource(reader.ConnectableAPI(), "result")
-    kind = Sdf.ValueTypeNames.Float3 if len(output) == 3 else Sdf.ValueTypeNames.Float
-    image.CreateOutput(output, kind)
-    kind = Sdf.ValueTypeNames.Normal3f if input_name == "normal" else Sdf.ValueTypeNames.Color3f
-    surface.CreateInput(input_name, kind).ConnectToSource(image.ConnectableAPI(), output)
+    connect(material, input_name, image, output)
     return image
+
+
+def connect(material: UsdShade.Material, input_name: str, shader: UsdShade.Shader, output: str) -> None:
+    """Connects the surface's input to a shader's output (rgb: a colour, or a normal; r, g, b, a: a float)."""
+    surface = UsdShade.Shader(material.GetPrim().GetStage().GetPrimAtPath(material.GetPath().AppendChild("Surface")))
+    kinds = {3: Sdf.ValueTypeNames.Float3, 4: Sdf.ValueTypeNames.Float4}
+    shader.CreateOutput(output, kinds.get(len(output), Sdf.ValueTypeNames.Float))
+    if len(output) == 1:
+        kind = Sdf.ValueTypeNames.Float
+    else:
+        kind = Sdf.ValueTypeNames.Normal3f if input_name == "normal" else Sdf.ValueTypeNames.Color3f
+    surface.CreateInput(input_name, kind).ConnectToSource(shader.ConnectableAPI(), output)
+
+
+def transform2d(image: UsdShade.Shader, rotation: float = 0.0, scale=(1.0, 1.0),
+                translation=(0.0, 0.0)) -> UsdShade.Shader:
+    """Puts a UsdTransform2d between a texture and the primvar reader its st reads (rotation in degrees)."""
+    st = image.GetInput("st")
+    reader, output, _ = st.GetConnectedSource()
+    path = image.GetPath().GetParentPath().AppendChild(f"{image.GetPath().name}_transform")
+    transform = UsdShade.Shader.Define(image.GetPrim().GetStage(), path)
+    transform.CreateIdAttr("UsdTransform2d")
+    transform.CreateInput("in", Sdf.ValueTypeNames.Float2).ConnectToSource(reader, output)
+    transform.CreateInput("rotation", Sdf.ValueTypeNames.Float).Set(float(rotation))
+    transform.CreateInput("scale", Sdf.ValueTypeNames.Float2).Set(Gf.Vec2f(*map(float, scale)))
+    transform.CreateInput("translation", Sdf.ValueTypeNames.Float2).Set(Gf.Vec2f(*map(float, translation)))
+    transform.CreateOutput("result", Sdf.ValueTypeNames.Float2)
+    st.ConnectToSource(transform.ConnectableAPI(), "result")
+    return transform
 
 
 def bind(prim: Usd.Prim, material: UsdShade.Material, purpose: str = UsdShade.Tokens.allPurpose) -> None:

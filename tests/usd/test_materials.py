@@ -7,7 +7,7 @@ import pytest
 from pxr import UsdShade
 
 import snell.usd
-from stages import bind, mesh, new_stage, preview_material, quad, texture, write_rgba_png
+from stages import bind, connect, mesh, new_stage, preview_material, quad, texture, transform2d, write_rgba_png
 
 
 def read_quad(tmp_path, build, **read_options):
@@ -79,13 +79,106 @@ def test_opacity_below_one_is_glass_with_the_materials_ior(tmp_path):
     np.testing.assert_allclose(fields["base_color"], (0.9, 1.0, 0.95, 1.0), rtol=1e-6)
 
 
-def test_a_cut_out_opacity_is_opaque_with_a_warning(tmp_path):
+def test_an_opacity_threshold_is_a_mask_cut_at_the_threshold(tmp_path):
     def build(stage, prim):
         bind(prim, preview_material(stage, "/World/Leaf", opacity=0.2, opacityThreshold=0.5))
 
     contents = read_quad(tmp_path, build)
-    assert material_of(contents).fields["transmission"] == 0.0
-    assert "/World/Leaf/Surface: opacity 0.2 under opacityThreshold 0.5" in messages(contents)
+    fields = material_of(contents).fields
+    assert (fields["alpha_mode"], fields["alpha_cutoff"], fields["transmission"]) == ("mask", 0.5, 0.0)
+    assert fields["base_color"][3] == pytest.approx(0.2)
+    assert not contents.problems.items
+
+
+def test_presence_opacity_is_blended_coverage_not_glass(tmp_path):
+    def build(stage, prim):
+        bind(prim, preview_material(stage, "/World/Veil", opacity=0.4, opacityMode="presence"))
+
+    fields = material_of(read_quad(tmp_path, build)).fields
+    assert (fields["alpha_mode"], fields["transmission"]) == ("blend", 0.0)
+    assert fields["base_color"][3] == pytest.approx(0.4)
+
+
+def test_opacity_from_the_diffuse_textures_alpha_is_the_base_colour_textures_alpha(tmp_path):
+    rgba = np.random.default_rng(3).integers(0, 256, (4, 4, 4), dtype=np.uint8)
+    write_rgba_png(tmp_path / "leaf.png", rgba)
+
+    def build(stage, prim):
+        material = preview_material(stage, "/World/Leaf", opacityThreshold=0.3)
+        connect(material, "opacity", texture(stage, material, "./leaf.png", sourceColorSpace="sRGB"), "a")
+        bind(prim, material)
+
+    contents = read_quad(tmp_path, build)
+    record = material_of(contents)
+    assert (record.fields["alpha_mode"], record.fields["alpha_cutoff"]) == ("mask", pytest.approx(0.3))
+    assert record.fields["base_color"] == (1.0, 1.0, 1.0, 1.0)
+    np.testing.assert_array_equal(contents.materials.textures[record.slots["base_color"].index], rgba)
+
+
+def test_opacity_from_another_texture_prim_of_the_diffuse_file_is_its_alpha_with_that_prims_scale(tmp_path):
+    rgba = np.random.default_rng(4).integers(0, 256, (4, 4, 4), dtype=np.uint8)
+    write_rgba_png(tmp_path / "leaf.png", rgba)
+
+    def build(stage, prim):
+        material = preview_material(stage, "/World/Leaf", opacityMode="presence")
+        texture(stage, material, "./leaf.png", sourceColorSpace="sRGB")
+        texture(stage, material, "./leaf.png", input_name="opacity", output="a", scale=(1.0, 1.0, 1.0, 0.5))
+        bind(prim, material)
+
+    contents = read_quad(tmp_path, build)
+    assert len(contents.materials.textures) == 1 and material_of(contents).fields["alpha_mode"] == "blend"
+    texels = contents.materials.textures[0]
+    np.testing.assert_array_equal(texels[..., :3], rgba[..., :3])
+    np.testing.assert_allclose(texels[..., 3], rgba[..., 3] * 0.5, atol=0.5)  # rounded to the nearest byte
+
+
+def test_an_opacity_texture_under_a_constant_diffuse_colour_is_a_white_texture_with_its_alpha(tmp_path):
+    grey = np.random.default_rng(5).integers(0, 256, (4, 4, 3), dtype=np.uint8)
+    write_rgba_png(tmp_path / "mask.png", grey)
+
+    def build(stage, prim):
+        material = preview_material(stage, "/World/Stencil", diffuseColor=(0.9, 0.5, 0.3), opacityThreshold=0.5)
+        texture(stage, material, "./mask.png", input_name="opacity", output="r", sourceColorSpace="raw")
+        bind(prim, material)
+
+    contents = read_quad(tmp_path, build)
+    record = material_of(contents)
+    np.testing.assert_allclose(record.fields["base_color"], (0.9, 0.5, 0.3, 1.0), rtol=1e-6)
+    texels = contents.materials.textures[record.slots["base_color"].index]
+    assert (texels[..., :3] == 255).all()
+    np.testing.assert_array_equal(texels[..., 3], grey[..., 0])
+
+
+def test_opacity_from_another_file_than_the_diffuse_one_is_a_warning_naming_the_prim(tmp_path):
+    write_rgba_png(tmp_path / "colour.png", np.zeros((2, 2, 3), np.uint8))
+    write_rgba_png(tmp_path / "mask.png", np.zeros((2, 2, 4), np.uint8))
+
+    def build(stage, prim):
+        material = preview_material(stage, "/World/Leaf", opacityThreshold=0.5)
+        texture(stage, material, "./colour.png")
+        texture(stage, material, "./mask.png", input_name="opacity", output="a")
+        bind(prim, material)
+
+    contents = read_quad(tmp_path, build)
+    assert material_of(contents).fields.get("alpha_mode", "opaque") == "opaque"
+    assert ("/World/Leaf/Surface: inputs:opacity reads /World/Leaf/Texture_opacity (./mask.png), another file "
+            "than the diffuse texture /World/Leaf/Texture_diffuseColor (./colour.png); snell's alpha is its base "
+            "colour texture's alpha") in messages(contents)
+
+
+def test_a_textured_opacity_on_glass_is_a_warning_and_draws_opaque(tmp_path):
+    write_rgba_png(tmp_path / "mask.png", np.zeros((2, 2, 4), np.uint8))
+
+    def build(stage, prim):
+        material = preview_material(stage, "/World/Pane")
+        texture(stage, material, "./mask.png", input_name="opacity", output="a")
+        bind(prim, material)
+
+    contents = read_quad(tmp_path, build)
+    fields = material_of(contents).fields
+    assert fields["transmission"] == 0.0 and fields.get("alpha_mode", "opaque") == "opaque"
+    assert ("/World/Pane/Surface: inputs:opacity is connected to /World/Pane/Texture_opacity; without "
+            "opacityThreshold, in opacityMode 'transparent', opacity is glass") in messages(contents)
 
 
 def test_an_emissive_color_is_read(tmp_path):
@@ -95,18 +188,95 @@ def test_an_emissive_color_is_read(tmp_path):
     np.testing.assert_allclose(material_of(read_quad(tmp_path, build)).fields["emissive"], (2.0, 1.0, 0.5))
 
 
-def test_a_normal_map_and_an_emissive_texture_are_warnings_naming_the_input(tmp_path):
-    write_rgba_png(tmp_path / "n.png", np.full((2, 2, 3), 128, np.uint8))
+def test_an_emissive_texture_without_a_bias_folds_its_scale_into_the_emissive_factor(tmp_path):
+    rgb = np.random.default_rng(6).integers(0, 256, (4, 4, 3), dtype=np.uint8)
+    write_rgba_png(tmp_path / "glow.png", rgb)
+
+    def build(stage, prim):
+        material = preview_material(stage, "/World/Lamp")
+        texture(stage, material, "./glow.png", input_name="emissiveColor", scale=(4.0, 2.0, 0.5, 1.0))
+        bind(prim, material)
+
+    contents = read_quad(tmp_path, build)
+    record = material_of(contents)
+    assert record.fields["emissive"] == (4.0, 2.0, 0.5)  # brighter than 1 stays exact: the bytes are the file's
+    np.testing.assert_array_equal(contents.materials.textures[record.slots["emissive"].index][..., :3], rgb)
+    assert not contents.problems.items
+
+
+def test_an_emissive_texture_with_a_bias_is_stored_over_its_largest_value(tmp_path):
+    grey = np.array([[[0, 64, 128], [191, 255, 10]]], np.uint8)
+    write_rgba_png(tmp_path / "glow.png", grey)
+
+    def build(stage, prim):
+        material = preview_material(stage, "/World/Lamp")
+        texture(stage, material, "./glow.png", input_name="emissiveColor", sourceColorSpace="raw",
+                scale=(3.0, 1.0, 1.0, 1.0), bias=(0.5, 0.0, 0.1, 0.0))
+        bind(prim, material)
+
+    contents = read_quad(tmp_path, build)
+    record = material_of(contents)
+    expected = grey / 255.0 * np.array([3.0, 1.0, 1.0]) + np.array([0.5, 0.0, 0.1])
+    np.testing.assert_allclose(record.fields["emissive"], expected.reshape(-1, 3).max(axis=0).clip(1.0), rtol=1e-6)
+    texels = contents.materials.textures[record.slots["emissive"].index][..., :3] / 255.0
+    decoded = np.where(texels <= 0.04045, texels / 12.92, ((texels + 0.055) / 1.055) ** 2.4)
+    np.testing.assert_allclose(decoded * record.fields["emissive"], expected, rtol=0.01, atol=0.002)
+
+
+def test_a_normal_map_is_stored_as_data_snell_decodes_to_the_specs_normal(tmp_path):
+    rgb = np.random.default_rng(7).integers(0, 256, (4, 4, 3), dtype=np.uint8)
+    write_rgba_png(tmp_path / "n.png", rgb)
+
+    def build(scale, bias):
+        def inner(stage, prim):
+            material = preview_material(stage, "/World/M")
+            texture(stage, material, "./n.png", input_name="normal", scale=scale, bias=bias)  # sourceColorSpace auto
+            bind(prim, material)
+        return inner
+
+    # The specification's 8-bit convention: v = 2 byte/255 - 1, so the bytes are kept (not read as sRGB).
+    contents = read_quad(tmp_path, build((2.0, 2.0, 2.0, 1.0), (-1.0, -1.0, -1.0, 0.0)))
+    record = material_of(contents)
+    assert record.fields["normal_scale"] == 1.0 and not contents.problems.items
+    np.testing.assert_array_equal(contents.materials.textures[record.slots["normal"].index][..., :3], rgb)
+    # Any other scale and bias: the bytes hold (v + 1) / 2.
+    contents = read_quad(tmp_path, build((1.0, 1.5, 1.0, 1.0), (-0.5, -0.5, 0.0, 0.0)))
+    v = rgb / 255.0 * np.array([1.0, 1.5, 1.0]) - np.array([0.5, 0.5, 0.0])
+    texels = contents.materials.textures[material_of(contents).slots["normal"].index][..., :3]
+    np.testing.assert_allclose(2.0 * texels / 255.0 - 1.0, v.clip(-1, 1), atol=1.0 / 255 + 1e-9)
+
+
+def test_a_normal_map_scaled_beyond_the_usual_one_is_the_usual_one_with_a_normal_scale(tmp_path):
+    rgb = np.random.default_rng(8).integers(0, 256, (4, 4, 3), dtype=np.uint8)
+    write_rgba_png(tmp_path / "n.png", rgb)
 
     def build(stage, prim):
         material = preview_material(stage, "/World/M")
-        texture(stage, material, "./n.png", input_name="normal")
-        texture(stage, material, "./n.png", input_name="emissiveColor")
+        texture(stage, material, "./n.png", input_name="normal", sourceColorSpace="raw", scale=(5.0, 5.0, 2.0, 1.0),
+                bias=(-2.5, -2.5, -1.0, 0.0))
         bind(prim, material)
 
-    text = messages(read_quad(tmp_path, build))
-    assert "/World/M/Surface: inputs:normal is connected to /World/M/Texture_normal" in text
-    assert "/World/M/Surface: inputs:emissiveColor is connected to /World/M/Texture_emissiveColor" in text
+    contents = read_quad(tmp_path, build)
+    record = material_of(contents)
+    assert record.fields["normal_scale"] == 2.5
+    np.testing.assert_array_equal(contents.materials.textures[record.slots["normal"].index][..., :3], rgb)
+
+
+def test_a_normal_from_something_other_than_a_texture_is_a_warning_naming_the_input(tmp_path):
+    def build(stage, prim):
+        from pxr import Sdf
+
+        material = preview_material(stage, "/World/M")
+        reader = UsdShade.Shader.Define(stage, "/World/M/Normals")
+        reader.CreateIdAttr("UsdPrimvarReader_normal")
+        reader.CreateInput("varname", Sdf.ValueTypeNames.Token).Set("n")
+        connect(material, "normal", reader, "result")
+        bind(prim, material)
+
+    contents = read_quad(tmp_path, build)
+    assert "normal" not in material_of(contents).slots
+    assert ("/World/M/Surface: inputs:normal is connected to /World/M/Normals (UsdPrimvarReader_normal, output "
+            "result), which snell cannot evaluate") in messages(contents)
 
 
 def test_another_surface_shader_is_a_warning(tmp_path):
@@ -137,7 +307,7 @@ def test_an_srgb_texture_passes_through_byte_for_byte(tmp_path):
 
     contents = read_quad(tmp_path, build)
     record = material_of(contents)
-    assert record.texture_index == 0 and record.fields["base_color"] == (1, 1, 1, 1)
+    assert record.slots["base_color"].index == 0 and record.fields["base_color"] == (1, 1, 1, 1)
     np.testing.assert_array_equal(contents.materials.textures[0][..., :3], rgba[..., :3])
     assert (contents.materials.textures[0][..., 3] == 255).all()
 
@@ -169,6 +339,30 @@ def test_texture_coordinates_flip_v_as_st_starts_at_the_lower_left(tmp_path):
     part = read_quad(tmp_path, build).sources[0].parts[0]
     st = np.array([(0, 0), (1, 0), (1, 1), (0, 1)], np.float32)  # the quad's st at points 0..3
     np.testing.assert_allclose(part.uvs, np.stack([st[:, 0], 1 - st[:, 1]], axis=1)[part.vertex_point])
+
+
+def test_a_transform2d_is_the_slots_texture_transform_in_snells_uv_space(tmp_path):
+    write_rgba_png(tmp_path / "t.png", np.zeros((2, 2, 3), np.uint8))
+    rotation, scale, translation = 35.0, (1.5, 0.5), (0.25, -0.4)
+
+    def build(stage, prim):
+        material = preview_material(stage, "/World/T")
+        transform2d(texture(stage, material, "./t.png"), rotation, scale, translation)
+        bind(prim, material)
+
+    contents = read_quad(tmp_path, build)
+    part = contents.sources[0].parts[0]
+    quad_st = np.array([(0, 0), (1, 0), (1, 1), (0, 1)], np.float32)[part.vertex_point]
+    np.testing.assert_allclose(part.uvs, np.stack([quad_st[:, 0], 1 - quad_st[:, 1]], 1))  # the mesh keeps its st
+    # Where snell reads any st through the material's transform is where USD reads it, in snell's (s, 1 - t).
+    st = np.random.default_rng(9).uniform(-2, 2, (16, 2))
+    a = np.radians(rotation)
+    usd = (st * scale) @ np.array([[np.cos(a), -np.sin(a)], [np.sin(a), np.cos(a)]]).T + translation
+    t = material_of(contents).snell_material().base_color_transform
+    c, s = np.cos(t.rotation), np.sin(t.rotation)
+    khr = np.array([[c, s], [-s, c]]) @ np.diag(t.scale)  # KHR_texture_transform: rotate(rotation) scale(scale)
+    uv = np.stack([st[:, 0], 1 - st[:, 1]], 1) @ khr.T + np.asarray(t.offset)
+    np.testing.assert_allclose(uv, np.stack([usd[:, 0], 1 - usd[:, 1]], 1), atol=1e-6)
 
 
 def test_the_primvar_reader_picks_the_texture_coordinates(tmp_path):
@@ -210,21 +404,34 @@ def test_a_udim_texture_is_a_warning(tmp_path):
     assert "is a UDIM set" in messages(contents) and not contents.problems.errors
 
 
-def test_a_wrap_snell_cannot_draw_is_a_warning_only_where_st_leaves_the_unit_square(tmp_path):
+def test_clamp_and_mirror_wraps_are_snells_samplers(tmp_path):
+    write_rgba_png(tmp_path / "t.png", np.zeros((2, 2, 3), np.uint8))
+
+    def build(stage, prim):
+        from pxr import UsdGeom
+
+        UsdGeom.PrimvarsAPI(prim).GetPrimvar("st").Set([(0, 0), (3, 0), (3, 3), (0, 3)])
+        material = preview_material(stage, "/World/T")
+        texture(stage, material, "./t.png", wrapS="clamp", wrapT="mirror")
+        bind(prim, material)
+
+    contents = read_quad(tmp_path, build)
+    assert contents.materials.texture_wraps == [("clamp", "mirror")] and not contents.problems.items
+
+
+def test_a_black_wrap_is_a_warning_only_where_the_textures_st_leaves_the_unit_square(tmp_path):
     write_rgba_png(tmp_path / "t.png", np.zeros((2, 2, 3), np.uint8))
 
     def build(scale):
         def inner(stage, prim):
-            from pxr import UsdGeom
-
-            UsdGeom.PrimvarsAPI(prim).GetPrimvar("st").Set([(0, 0), (scale, 0), (scale, scale), (0, scale)])
             material = preview_material(stage, "/World/T")
-            texture(stage, material, "./t.png", wrapS="clamp", wrapT="clamp")
+            transform2d(texture(stage, material, "./t.png", wrapS="repeat", wrapT="black"), scale=(1.0, scale))
             bind(prim, material)
         return inner
 
     assert "wrap" not in messages(read_quad(tmp_path, build(1.0)))
-    assert "wrap 'clamp' where /World/Quad's st leaves [0, 1]" in messages(read_quad(tmp_path, build(2.0)))
+    assert ("/World/T/Texture_diffuseColor: wrap 'black' where /World/Quad's st (through its UsdTransform2d) leaves "
+            "[0, 1]: snell has no black border: the texture repeats there") in messages(read_quad(tmp_path, build(2)))
 
 
 def test_a_geom_subset_gets_its_own_snell_mesh_and_material(tmp_path):

@@ -11,7 +11,8 @@ What is read: UsdGeomMesh (n-gons fanned, normals of every interpolation,
 st, materialBind GeomSubsets, instance proxies, visibility and purpose),
 UsdSkel skinning and blend shapes evaluated by USD itself, UsdPreviewSurface
 materials bound for a purpose (preview first, then all-purpose) with
-UsdUVTexture diffuse textures, UsdLux lights, UsdGeomCamera; metersPerUnit
+UsdUVTexture diffuse, emissive, normal and opacity textures (their wraps and
+UsdTransform2d), cut-outs and coverage, UsdLux lights, UsdGeomCamera; metersPerUnit
 and upAxis map the stage onto snell's metres and +Y up. What snell cannot
 draw is a warning naming the prim (Stage.warnings). docs/usd.md has the
 rules; `snell-usd` (python -m snell.usd) is the command line.

@@ -7,22 +7,26 @@ fallback of the UsdPreviewSurface specification (PREVIEW_FALLBACKS). The
 refractive case: a surface whose opacity is below 1, in the 'transparent'
 opacity mode and without an opacityThreshold, is glass; snell's transmission
 is 1 - opacity (any value above 0 refracts), its IOR is `ior` and its
-diffuseColor tints the light through it (docs/usd.md). Everything else snell
-cannot draw is a warning that names the shader and the input.
+diffuseColor tints the light through it (docs/usd.md). An opacityThreshold
+above 0 is a cut-out (alpha mask) and opacityMode 'presence' is coverage
+(alpha blend); a textured opacity is the alpha of the base colour texture.
+UsdUVTextures feed diffuseColor, emissiveColor and normal, each with its own
+wraps and UsdTransform2d (as the slot's KHR_texture_transform). Everything
+else snell cannot draw is a warning that names the shader and the input.
 """
 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field, replace
 from typing import Any, Optional
 
 import numpy as np
 from pxr import Usd, UsdGeom, UsdShade
 
-from .. import Material
+from .. import Material, Texture, TextureTransform
 from ._problems import Problems
-from ._textures import TextureReadError, TextureRequest, read_texture
+from ._textures import IDENTITY_SCALE, NO_BIAS, TextureImage, TextureReadError, TextureRequest, read_texture
 
 # UsdPreviewSurface's fallbacks (usdImaging/plugin/usdShaders/shaders/shaderDefs.usda,
 # which usd-core does not ship) and UsdUVTexture's.
@@ -36,7 +40,11 @@ TEXTURE_FALLBACKS: dict[str, Any] = {
     "wrapS": "useMetadata", "wrapT": "useMetadata", "fallback": (0.0, 0.0, 0.0, 1.0), "scale": (1.0, 1.0, 1.0, 1.0),
     "bias": (0.0, 0.0, 0.0, 0.0), "sourceColorSpace": "auto",
 }
+TEXTURE_OUTPUTS = ("rgb", "rgba", "r", "g", "b", "a")
+SNELL_WRAPS = ("repeat", "clamp", "mirror")  # UsdUVTexture's 'black' has no snell sampler
 PURPOSES = {"preview": UsdShade.Tokens.preview, "full": UsdShade.Tokens.full, "all": UsdShade.Tokens.allPurpose}
+
+Transform = tuple[tuple[float, float], float, tuple[float, float]]  # KHR_texture_transform: offset, rotation, scale
 
 
 @dataclass
@@ -54,26 +62,60 @@ class Source:
     def path(self) -> str:
         return str(self.shader.GetPath())
 
+    @property
+    def is_texture(self) -> bool:
+        """A UsdUVTexture output snell can read (the float4 rgba reads as its rgb or alpha, as connected)."""
+        return self.id == "UsdUVTexture" and self.output in TEXTURE_OUTPUTS
+
+
+@dataclass
+class TextureSlot:
+    """One texture of a material: how snell's texture is made from a UsdUVTexture and how it is sampled."""
+
+    request: TextureRequest
+    prim: str  #: the UsdUVTexture, for messages
+    file: str  #: its file as authored, for summaries
+    wraps: tuple[str, str]  #: wrapS, wrapT as authored
+    st_primvar: str  #: the primvar its st reads
+    transform: Optional[Transform] = None  #: its UsdTransform2d in snell's UV space (KHR_texture_transform)
+    fallback: tuple[float, float, float] = (1.0, 1.0, 1.0)  #: the colour it gives when the file cannot be read
+    fallback_alpha: float = 1.0  #: and its alpha (coverage), where it gives alpha
+    factor: tuple[float, float, float] = (1.0, 1.0, 1.0)  #: emission: the scale folded into the emissive factor
+    index: int = -1  #: snell's texture
+
+    @property
+    def snell_wraps(self) -> tuple[str, str]:
+        """The sampler snell draws: 'black' and 'useMetadata' (black in files without wrap metadata) repeat."""
+        return tuple(w if w in SNELL_WRAPS else "repeat" for w in self.wraps)
+
+    def uv_matrix(self) -> np.ndarray:
+        """The transform as a 3x3 on snell's (u, v, 1), as snell applies it."""
+        return _khr_matrix(self.transform) if self.transform is not None else np.eye(3)
+
 
 @dataclass
 class MaterialRecord:
-    """One snell material and what the meshes using it must provide (their st primvar, transformed)."""
+    """One snell material and what the meshes using it must provide (the st primvar its textures read)."""
 
     path: str  #: the material prim, '' for a mesh without one
-    fields: dict[str, Any]  #: snell.Material's keyword arguments, base_color_texture left out
-    texture: Optional[TextureRequest] = None  #: the diffuse texture, if any
-    texture_fallback: tuple[float, float, float] = (0.0, 0.0, 0.0)
-    st_primvar: str = "st"
-    st_transform: Optional[np.ndarray] = None  #: UsdTransform2d as a 3x3 on (s, t, 1)
-    wraps: tuple[str, str] = ("repeat", "repeat")
-    texture_prim: str = ""
+    fields: dict[str, Any]  #: snell.Material's keyword arguments but the textures and their transforms
+    slots: dict[str, TextureSlot] = field(default_factory=dict)  #: 'base_color', 'emissive', 'normal'
     summary: str = ""
-    texture_index: int = -1
     double_sided: bool = False
 
+    @property
+    def st_primvar(self) -> Optional[str]:
+        """The primvar the material's textures read (one UV set per snell mesh), None without textures."""
+        return next(iter(self.slots.values())).st_primvar if self.slots else None
+
     def snell_material(self) -> Material:
-        return Material(name=self.path, base_color_texture=self.texture_index, double_sided=self.double_sided,
-                        **self.fields)
+        arguments = dict(self.fields)
+        for name, slot in self.slots.items():
+            arguments[f"{name}_texture"] = slot.index
+            if slot.transform is not None:
+                offset, rotation, scale = slot.transform
+                arguments[f"{name}_transform"] = TextureTransform(offset=offset, rotation=rotation, scale=scale)
+        return Material(name=self.path, double_sided=self.double_sided, **arguments)
 
 
 class MaterialTable:
@@ -89,9 +131,14 @@ class MaterialTable:
         self.records: list[MaterialRecord] = []
         self.textures: list[np.ndarray] = []
         self.texture_paths: list[str] = []
+        self.texture_wraps: list[tuple[str, str]] = []
         self._read: dict[str, MaterialRecord] = {}
         self._index: dict[tuple, int] = {}
-        self._texture_index: dict[TextureRequest, int] = {}
+        self._texture_index: dict[tuple, tuple[int, tuple[float, float, float]]] = {}
+
+    def snell_textures(self) -> list[Texture]:
+        return [Texture(rgba, name=path, wrap_s=wraps[0], wrap_t=wraps[1])
+                for rgba, path, wraps in zip(self.textures, self.texture_paths, self.texture_wraps)]
 
     def bound_material(self, prim: Usd.Prim) -> Optional[UsdShade.Material]:
         """The material bound to prim (or a GeomSubset) for the purpose, else its all-purpose one."""
@@ -117,35 +164,47 @@ class MaterialTable:
             if path not in self._read:
                 self._read[path] = self._read_material(material)
             template = self._read[path]
-            record = MaterialRecord(**{**template.__dict__, "fields": dict(template.fields),
-                                       "double_sided": double_sided})
+            record = replace(template, fields=dict(template.fields), double_sided=double_sided,
+                             slots={name: replace(slot) for name, slot in template.slots.items()})
             self._index[key] = self._append(record)
         return self._index[key]
 
     def _append(self, record: MaterialRecord) -> int:
-        if record.texture is not None:
-            record.texture_index = self._texture(record)
+        for name, slot in list(record.slots.items()):
+            index, gain = self._texture(slot)
+            if index < 0:  # unreadable (an error already): what the shader gives without its file
+                del record.slots[name]
+                if name == "base_color":
+                    r, g, b, a = record.fields["base_color"]
+                    record.fields["base_color"] = (r * slot.fallback[0], g * slot.fallback[1], b * slot.fallback[2],
+                                                   a * slot.fallback_alpha)
+                elif name == "emissive":
+                    record.fields["emissive"] = slot.fallback
+                continue
+            slot.index = index
+            if name == "emissive":
+                record.fields["emissive"] = tuple(f * g for f, g in zip(slot.factor, gain))
         self.records.append(record)
         return len(self.records) - 1
 
-    def _texture(self, record: MaterialRecord) -> int:
-        request = record.texture
-        if request in self._texture_index:
-            return self._texture_index[request]
+    def _texture(self, slot: TextureSlot) -> tuple[int, tuple[float, float, float]]:
+        """snell's texture for a slot (one per conversion and sampler) and its emission gain; -1 if unreadable."""
+        key = (slot.request, slot.snell_wraps)
+        if key in self._texture_index:
+            return self._texture_index[key]
         if self.load_textures:
             try:
-                rgba = read_texture(request)
+                image = read_texture(slot.request)
             except TextureReadError as e:
-                self.problems.fail(record.texture_prim, str(e))
-                record.fields["base_color"] = (*record.texture_fallback, 1.0)
-                record.texture = None
-                return -1
+                self.problems.fail(slot.prim, str(e))
+                return -1, (1.0, 1.0, 1.0)
         else:
-            rgba = np.zeros((1, 1, 4), np.uint8)
-        self.textures.append(rgba)
-        self.texture_paths.append(request.path)
-        self._texture_index[request] = len(self.textures) - 1
-        return self._texture_index[request]
+            image = TextureImage(np.zeros((1, 1, 4), np.uint8))
+        self.textures.append(image.rgba)
+        self.texture_paths.append(slot.request.path)
+        self.texture_wraps.append(slot.snell_wraps)
+        self._texture_index[key] = (len(self.textures) - 1, image.gain)
+        return self._texture_index[key]
 
     # ------------------------------------------------------------------ reading
 
@@ -191,27 +250,16 @@ class MaterialTable:
             return fallbacks[name]
         return fallbacks[name] if value is None else value
 
+    def _cannot_evaluate(self, where: Any, name: str, source: Source, fallback: Any) -> None:
+        self.problems.warn(where, f"inputs:{name} is connected to {source.path} ({source.id or 'no id'}, output "
+                                  f"{source.output}), which snell cannot evaluate: its fallback {_fmt(fallback)} "
+                                  "is used")
+
     def _read_preview_surface(self, path: str, shader: UsdShade.Shader) -> MaterialRecord:
         where = shader.GetPath()
         values = {name: self._value(shader, name, PREVIEW_FALLBACKS)
                   for name in ("roughness", "ior", "metallic", "opacityThreshold", "useSpecularWorkflow", "clearcoat",
                                "opacityMode")}
-        values["opacity"] = self._value(shader, "opacity", PREVIEW_FALLBACKS,
-                                        "snell cannot vary opacity across a surface: drawn opaque (opacity 1)")
-        emissive, emissive_source = self._input(shader, "emissiveColor")
-        if emissive_source is not None:
-            self.problems.warn(where, f"inputs:emissiveColor is connected to {emissive_source.path} "
-                                      f"({emissive_source.id or 'no id'}); snell's materials take no emissive texture "
-                                      "yet: no emission")
-            emissive = None
-        values["emissiveColor"] = PREVIEW_FALLBACKS["emissiveColor"] if emissive is None else emissive
-        normal, normal_source = self._input(shader, "normal")
-        if normal_source is not None:
-            self.problems.warn(where, f"inputs:normal is connected to {normal_source.path} "
-                                      f"({normal_source.id or 'no id'}); snell's materials take no normal map yet: "
-                                      "ignored")
-        elif normal is not None and not np.allclose(tuple(normal), PREVIEW_FALLBACKS["normal"]):
-            self.problems.warn(where, f"inputs:normal is {_fmt(normal)}; snell shades with the mesh's normals")
         for name, note in (("occlusion", "ignored"), ("displacement", "ignored: the mesh is drawn undisplaced"),
                            ("clearcoatRoughness", "ignored")):
             value, source = self._input(shader, name)
@@ -227,73 +275,174 @@ class MaterialTable:
             self.problems.warn(where, f"inputs:clearcoat is {values['clearcoat']:g}; snell has no clear coat: ignored")
 
         record = MaterialRecord(path=path, fields={})
-        diffuse, diffuse_source = self._input(shader, "diffuseColor")
-        colour = tuple(PREVIEW_FALLBACKS["diffuseColor"] if diffuse is None else diffuse)
-        if diffuse_source is not None:
-            if diffuse_source.id == "UsdUVTexture" and diffuse_source.output in ("rgb", "rgba", "r", "g", "b", "a"):
-                colour = self._read_texture(record, diffuse_source)
-            else:
-                self.problems.warn(where, f"inputs:diffuseColor is connected to {diffuse_source.path} "
-                                          f"({diffuse_source.id or 'no id'}, output {diffuse_source.output}), which "
-                                          f"snell cannot evaluate: its fallback {_fmt(colour)} is used")
-        opacity = float(values["opacity"])
+        colour = self._diffuse(record, shader)
+        values["emissiveColor"] = self._emissive(record, shader)
+        normal_scale = self._normal(record, shader)
         threshold = float(values["opacityThreshold"])
-        transmission = 0.0
-        if opacity < 1.0:
-            if threshold > 0.0:
-                if opacity < threshold:
-                    self.problems.warn(where, f"opacity {opacity:g} under opacityThreshold {threshold:g} cuts the "
-                                              "surface out; snell has no cut-outs: drawn opaque")
-            elif values["opacityMode"] == "presence":
-                self.problems.warn(where, f"opacity {opacity:g} in opacityMode 'presence' is coverage, not glass; "
-                                          "snell has no partial coverage: drawn opaque")
-            else:
-                transmission = 1.0 - max(opacity, 0.0)
+        # UsdPreviewSurface: a threshold above 0 makes opacity a cut-out mask; 'presence' makes it coverage;
+        # otherwise an opacity below 1 is a translucent (here refractive) surface.
+        coverage = "mask" if threshold > 0.0 else "blend" if values["opacityMode"] == "presence" else None
+        opacity, alpha_textured = self._opacity(record, shader, coverage)
         record.fields = _surface_fields(values)
-        record.fields["base_color"] = (*(float(c) for c in colour), 1.0) if record.texture is None else (1, 1, 1, 1)
-        record.fields["transmission"] = transmission
-        kind = f"glass (opacity {opacity:g}, ior {float(values['ior']):g})" if transmission > 0 else "opaque"
-        colour_text = f"texture {record.texture.path}" if record.texture is not None else f"colour {_fmt(colour)}"
-        record.summary = f"UsdPreviewSurface, {kind}, {colour_text}, roughness {float(values['roughness']):g}"
+        record.fields["base_color"] = (*(float(c) for c in colour), opacity if coverage else 1.0)
+        if coverage is not None and (alpha_textured or opacity < 1.0):
+            record.fields["alpha_mode"] = coverage
+            if coverage == "mask":
+                record.fields["alpha_cutoff"] = threshold
+        elif coverage is None and opacity < 1.0:
+            record.fields["transmission"] = 1.0 - max(opacity, 0.0)
+        if "normal" in record.slots:
+            record.fields["normal_scale"] = normal_scale
+        record.summary = self._summary(record, colour, opacity)
+        self._one_uv_set(record)
         return record
 
-    def _read_texture(self, record: MaterialRecord, source: Source) -> tuple:
-        """Fills record's texture from a UsdUVTexture; returns the colour to use when there is none."""
+    def _diffuse(self, record: MaterialRecord, shader: UsdShade.Shader) -> tuple[float, float, float]:
+        """diffuseColor: the base colour factor; a texture goes into record's base colour slot (factor 1)."""
+        diffuse, source = self._input(shader, "diffuseColor")
+        colour = tuple(PREVIEW_FALLBACKS["diffuseColor"] if diffuse is None else diffuse)
+        if source is None:
+            return colour
+        if not source.is_texture:
+            self._cannot_evaluate(shader.GetPath(), "diffuseColor", source, colour)
+            return colour
+        slot, seen = self._texture_slot(source, "colour")
+        if slot is None:
+            return _channel_colour(seen, source.output)
+        record.slots["base_color"] = slot
+        return (1.0, 1.0, 1.0)
+
+    def _emissive(self, record: MaterialRecord, shader: UsdShade.Shader) -> tuple[float, float, float]:
+        """emissiveColor: the emissive factor; a texture goes into the emissive slot (factor set on reading)."""
+        emissive, source = self._input(shader, "emissiveColor")
+        constant = tuple(PREVIEW_FALLBACKS["emissiveColor"] if emissive is None else emissive)
+        if source is None:
+            return constant
+        if not source.is_texture:
+            self._cannot_evaluate(shader.GetPath(), "emissiveColor", source, constant)
+            return constant
+        slot, seen = self._texture_slot(source, "emission")
+        if slot is None:
+            return _channel_colour(seen, source.output)
+        record.slots["emissive"] = slot
+        return slot.factor
+
+    def _normal(self, record: MaterialRecord, shader: UsdShade.Shader) -> float:
+        """normal: a texture goes into the normal slot; returns snell's normal_scale for it."""
+        where = shader.GetPath()
+        normal, source = self._input(shader, "normal")
+        if source is None:
+            if normal is not None and not np.allclose(tuple(normal), PREVIEW_FALLBACKS["normal"]):
+                self.problems.warn(where, f"inputs:normal is {_fmt(normal)}; snell shades with the mesh's normals")
+            return 1.0
+        if not (source.is_texture and source.output in ("rgb", "rgba")):
+            self.problems.warn(where, f"inputs:normal is connected to {source.path} ({source.id or 'no id'}, output "
+                                      f"{source.output}), which snell cannot evaluate: the mesh's normals are used")
+            return 1.0
+        slot, _ = self._texture_slot(source, "normal")
+        if slot is None:
+            self.problems.warn(where, f"inputs:normal's texture {source.path} has no file to read: the mesh's "
+                                      "normals are used")
+            return 1.0
+        record.slots["normal"] = slot
+        # snell reads m = (2 byte/255 - 1) * (k, k, 1). A texture scaled (2k, 2k, 2) and biased (-k, -k, -1) is
+        # k times the usual one in x and y: stored as the usual one, with normal_scale k, nothing clips.
+        request = slot.request
+        k = request.scale[0] / 2.0
+        if (k != 0.0 and request.scale[1] == request.scale[0] and request.scale[2] == 2.0
+                and request.bias[:3] == (-k, -k, -1.0)):
+            slot.request = replace(request, scale=(2.0, 2.0, 2.0, 1.0), bias=(-1.0, -1.0, -1.0, 0.0))
+            return k
+        return 1.0
+
+    def _opacity(self, record: MaterialRecord, shader: UsdShade.Shader, coverage: Optional[str]) -> tuple[float, bool]:
+        """opacity: its constant value, or 1 and True where a texture's channel became the base colour's alpha
+        (coverage: 'mask', 'blend', or None where opacity is glass)."""
+        where = shader.GetPath()
+        value, source = self._input(shader, "opacity")
+        opacity = float(PREVIEW_FALLBACKS["opacity"] if value is None else value)
+        if source is None:
+            return opacity, False
+        if coverage is None:
+            self.problems.warn(where, f"inputs:opacity is connected to {source.path}; without opacityThreshold, "
+                                      "in opacityMode 'transparent', opacity is glass, and snell's glass has one "
+                                      "transmission per material: drawn opaque (opacity 1)")
+            return 1.0, False
+        if not (source.is_texture and source.output in ("r", "g", "b", "a")):
+            self._cannot_evaluate(where, "opacity", source, 1.0)
+            return 1.0, False
+        slot, seen = self._texture_slot(source, "colour")
+        channel = "rgba".index(source.output)
+        if slot is None:
+            return float(seen[channel]), False
+        alpha = dict(alpha=source.output, alpha_scale=slot.request.scale[channel],
+                     alpha_bias=slot.request.bias[channel])
+        base = record.slots.get("base_color")
+        if base is None:
+            # A constant diffuseColor leaves the base colour texture free: white, with the opacity as its alpha.
+            record.slots["base_color"] = replace(slot, request=replace(slot.request, output="", scale=IDENTITY_SCALE,
+                                                                       bias=NO_BIAS, **alpha),
+                                                 fallback=(1.0, 1.0, 1.0), fallback_alpha=float(seen[channel]))
+            return 1.0, True
+        differs = _sampling_differs(base, slot, source.output)
+        if differs:
+            self.problems.warn(where, f"inputs:opacity reads {slot.prim} ({slot.file}), {differs} than the diffuse "
+                                      f"texture {base.prim} ({base.file}); snell's alpha is its base colour texture's "
+                                      "alpha: drawn opaque (opacity 1)")
+            return 1.0, False
+        base.request = replace(base.request, **alpha)
+        base.fallback_alpha = float(seen[channel])
+        return 1.0, True
+
+    def _texture_slot(self, source: Source, kind: str) -> tuple[Optional[TextureSlot], np.ndarray]:
+        """A UsdUVTexture as a slot of this kind (colour, emission or normal), and what it gives without its file
+        (its fallback, scaled and biased); no slot where there is no file to read (said as a warning or error)."""
         texture = source.shader
         where = texture.GetPath()
-        record.texture_prim = str(where)
         fallback = self._value(texture, "fallback", TEXTURE_FALLBACKS)
         scale = tuple(float(c) for c in self._value(texture, "scale", TEXTURE_FALLBACKS))
         bias = tuple(float(c) for c in self._value(texture, "bias", TEXTURE_FALLBACKS))
-        # What the shader sees when the file cannot be read: the fallback, scaled and biased.
         seen = np.asarray(tuple(fallback)[:4], float) * np.asarray(scale) + np.asarray(bias)
-        channel = "rgba".index(source.output) if source.output in "rgba" and len(source.output) == 1 else None
-        record.texture_fallback = tuple(float(seen[channel]) for _ in range(3)) if channel is not None else \
-            tuple(float(c) for c in seen[:3])
         asset = self._value(texture, "file", {"file": None})
         if asset is None or not asset.path:
             self.problems.warn(where, "inputs:file is not set: the texture's fallback is used")
-            return record.texture_fallback
+            return None, seen
         if "<UDIM>" in asset.path.upper():
             self.problems.warn(where, f"inputs:file {asset.path} is a UDIM set; snell reads single images: the "
                                       "texture's fallback is used")
-            return record.texture_fallback
+            return None, seen
         if not asset.resolvedPath:
             self.problems.fail(where, f"texture file {asset.path} not found (it resolves to nothing from "
                                       f"{_layer_of(texture, 'file')})")
-            return record.texture_fallback
+            return None, seen
         wraps = tuple(str(self._value(texture, name, TEXTURE_FALLBACKS)) for name in ("wrapS", "wrapT"))
         color_space = str(self._value(texture, "sourceColorSpace", TEXTURE_FALLBACKS))
         if color_space not in ("auto", "raw", "sRGB"):
             self.problems.warn(where, f"sourceColorSpace '{color_space}' is not auto, raw or sRGB: read as auto")
             color_space = "auto"
-        record.texture = TextureRequest(asset.resolvedPath, color_space, scale, bias, source.output)
-        record.wraps = wraps
-        record.st_primvar, record.st_transform = self._st_of(texture)
-        return (1.0, 1.0, 1.0)
+        if kind == "normal":
+            if color_space == "sRGB":
+                self.problems.warn(where, "sourceColorSpace is sRGB on a normal map: decoded from sRGB as the stage "
+                                          "says (normal maps are data, usually raw)")
+            else:
+                color_space = "raw"  # 'auto' guesses colour from 8-bit RGB files; a normal map is data
+        output = "rgb" if source.output == "rgba" else source.output
+        factor = (1.0, 1.0, 1.0)
+        if kind == "emission":
+            # Emission is factor x texture: with no bias the scale is folded into the factor (any size, and the
+            # file's bytes unchanged); otherwise the texture holds scale x texel + bias over a gain (see _textures).
+            used = range(3) if output == "rgb" else ["rgba".index(output)] * 3
+            if all(bias[c] == 0.0 and scale[c] >= 0.0 for c in used):
+                factor = tuple(scale[c] for c in used)
+                scale, bias = IDENTITY_SCALE, NO_BIAS
+        request = TextureRequest(asset.resolvedPath, color_space, scale, bias, output, kind)
+        st_primvar, transform = self._st_of(texture)
+        slot = TextureSlot(request, str(where), asset.path, wraps, st_primvar, transform,
+                           fallback=_channel_colour(seen, source.output), factor=factor)
+        return slot, seen
 
-    def _st_of(self, texture: UsdShade.Shader) -> tuple[str, Optional[np.ndarray]]:
-        """The primvar a texture's st reads, through a UsdTransform2d if there is one."""
+    def _st_of(self, texture: UsdShade.Shader) -> tuple[str, Optional[Transform]]:
+        """The primvar a texture's st reads, and the UsdTransform2d between them if there is one."""
         where = texture.GetPath()
         value, source = self._input(texture, "st")
         transform = None
@@ -316,15 +465,81 @@ class MaterialTable:
             return "st", transform
         return str(name), transform
 
-    def _transform2d(self, shader: UsdShade.Shader) -> np.ndarray:
-        # UsdTransform2d: result = in * scale, rotated counter-clockwise by rotation degrees, + translation.
-        rotation = math.radians(float(self._value(shader, "rotation", {"rotation": 0.0})))
-        scale = self._value(shader, "scale", {"scale": (1.0, 1.0)})
-        translation = self._value(shader, "translation", {"translation": (0.0, 0.0)})
-        c, s = math.cos(rotation), math.sin(rotation)
-        return np.array([[c * scale[0], -s * scale[1], translation[0]],
-                         [s * scale[0], c * scale[1], translation[1]],
-                         [0.0, 0.0, 1.0]])
+    def _transform2d(self, shader: UsdShade.Shader) -> Transform:
+        rotation = float(self._value(shader, "rotation", {"rotation": 0.0}))
+        scale = tuple(float(c) for c in self._value(shader, "scale", {"scale": (1.0, 1.0)}))
+        translation = tuple(float(c) for c in self._value(shader, "translation", {"translation": (0.0, 0.0)}))
+        return transform2d_as_khr(rotation, scale, translation)
+
+    def _one_uv_set(self, record: MaterialRecord) -> None:
+        """A snell mesh carries one UV set: every texture of the material reads the first one's primvar."""
+        first = record.st_primvar
+        for slot in record.slots.values():
+            if slot.st_primvar != first:
+                self.problems.warn(slot.prim, f"reads primvars:{slot.st_primvar}, but the material's other textures "
+                                              f"read primvars:{first}; snell's meshes carry one UV set: "
+                                              f"primvars:{first} is used")
+                slot.st_primvar = first
+
+    def _summary(self, record: MaterialRecord, colour: tuple, opacity: float) -> str:
+        fields = record.fields
+        base = record.slots.get("base_color")
+        alpha_file = f"{base.file} ({base.request.alpha})" if base is not None and base.request.alpha else ""
+        if fields.get("transmission", 0.0) > 0:
+            kind = f"glass (opacity {opacity:g}, ior {fields['ior']:g})"
+        elif fields.get("alpha_mode") == "mask":
+            kind = f"cut out where opacity < {fields['alpha_cutoff']:g}"
+        elif fields.get("alpha_mode") == "blend":
+            kind = "coverage: opacity blends" if alpha_file else f"coverage: opacity {opacity:g} blends"
+        else:
+            kind = "opaque"
+        colour_text = f"texture {base.file}" if base is not None and base.request.output else f"colour {_fmt(colour)}"
+        parts = [f"UsdPreviewSurface, {kind}, {colour_text}, roughness {fields['roughness']:g}"]
+        if alpha_file:
+            parts.append(f"opacity from {alpha_file}")
+        if "emissive" in record.slots:
+            parts.append(f"emissive texture {record.slots['emissive'].file}")
+        if "normal" in record.slots:
+            parts.append(f"normal map {record.slots['normal'].file}")
+        return ", ".join(parts)
+
+
+def transform2d_as_khr(rotation: float, scale: tuple[float, float], translation: tuple[float, float]) -> Transform:
+    """A UsdTransform2d as KHR_texture_transform's (offset, rotation, scale) in snell's UV space.
+
+    UsdTransform2d maps st to A st = T(translation) R(rotation, counter-clockwise, degrees) S(scale) st. snell's
+    UV is F st, F (s, t) = (s, 1 - t) (st's origin is the image's lower left, snell's v runs down), so snell
+    must read M = F A F. Its linear part diag(1, -1) R(a) S diag(1, -1) = R(-a) S is KHR's rotate(a) scale(S)
+    (KHR rotates clockwise in st's sense, as v runs down); its offset is M (0, 0) = F A (0, 1). Exact.
+    """
+    a = math.radians(rotation)
+    offset = (translation[0] - scale[1] * math.sin(a), 1.0 - translation[1] - scale[1] * math.cos(a))
+    return offset, a, (scale[0], scale[1])
+
+
+def _khr_matrix(transform: Transform) -> np.ndarray:
+    """KHR_texture_transform's matrix: translate(offset) rotate(rotation) scale(scale), as snell builds it."""
+    (ox, oy), rotation, (sx, sy) = transform
+    c, s = math.cos(rotation), math.sin(rotation)
+    return np.array([[c * sx, s * sy, ox], [-s * sx, c * sy, oy], [0.0, 0.0, 1.0]])
+
+
+def _sampling_differs(base: TextureSlot, other: TextureSlot, channel: str) -> str:
+    """Why another texture's channel is not the base colour texture's as snell samples it ('' if it is)."""
+    if other.request.path != base.request.path:
+        return "another file"
+    if (other.st_primvar, other.transform, other.snell_wraps) != (base.st_primvar, base.transform, base.snell_wraps):
+        return "the same file through another st, transform or wrap"
+    if channel != "a" and other.request.color_space != base.request.color_space:
+        return "the same file in another colour space"
+    return ""
+
+
+def _channel_colour(values: np.ndarray, output: str) -> tuple[float, float, float]:
+    """What a texture output gives a colour input: rgb, or one channel as grey."""
+    if output in ("r", "g", "b", "a"):
+        return (float(values["rgba".index(output)]),) * 3
+    return tuple(float(c) for c in values[:3])
 
 
 def _surface_fields(values: dict[str, Any]) -> dict[str, Any]:

@@ -205,7 +205,7 @@ class MeshSource:
         return bool(self.normals is not None and self.skin is not None and self.skin.skinned and not self.skin.rigid)
 
     def add_part(self, name: str, triangles: np.ndarray, material: int, st: Optional[Primvar],
-                 st_values: Optional[np.ndarray], st_transform: Optional[np.ndarray]) -> Part:
+                 st_values: Optional[np.ndarray]) -> Part:
         """A part of these triangles, with its vertices split where its normals or st differ."""
         t = self.topology
         corners = t.triangles[triangles]
@@ -232,8 +232,6 @@ class MeshSource:
         part.indices = np.ascontiguousarray(local, np.uint32)
         if vertex_st is not None:
             uv = st_values[vertex_st].astype(np.float64)
-            if st_transform is not None:
-                uv = uv @ st_transform[:2, :2].T + st_transform[:2, 2]
             uv[:, 1] = 1.0 - uv[:, 1]  # USD's st (0, 0) is the image's lower left; snell's v runs down
             part.uvs = uv.astype(np.float32)
         self.parts.append(part)

@@ -21,8 +21,8 @@ from pxr import Sdf, Tf, Usd, UsdGeom, UsdLux, UsdSkel
 from .. import Instance, Light, Material, Mesh
 from ._cameras import CameraState, camera_state
 from ._lights import LightRecord, read_light, unsupported_light
-from ._materials import MaterialTable
-from ._meshes import MeshSource, Pose, Topology, material_subsets, read_normals, read_primvar, read_topology
+from ._materials import MaterialRecord, MaterialTable
+from ._meshes import MeshSource, Part, Pose, Topology, material_subsets, read_normals, read_primvar, read_topology
 from ._problems import Problems, StageError
 from ._skinning import SkelFrame, Skin
 
@@ -234,22 +234,34 @@ class StageContents:
         for bind, triangles, material in parts:
             record = self.materials.records[material]
             st, st_values = None, None
-            if record.texture is not None:
+            if record.st_primvar is not None:
                 st, st_values = self._st(prim, record.st_primvar, topology, time, record.path)
             name = str(prim.GetPath()) if bind == prim else f"{prim.GetPath()} ({bind.GetName()})"
-            part = source.add_part(name, triangles, material, st, st_values, record.st_transform)
+            part = source.add_part(name, triangles, material, st, st_values)
             if flip:
                 part.indices = np.ascontiguousarray(part.indices[:, [0, 2, 1]])
-            if part.uvs is not None and any(w != "repeat" for w in record.wraps):
-                outside = (part.uvs < -1e-6) | (part.uvs > 1 + 1e-6)
-                if outside.any():
-                    axes = [w for w, o in zip(record.wraps, outside.any(axis=0)) if w != "repeat" and o]
-                    if axes:
-                        self.problems.warn(record.texture_prim, f"wrap '{axes[0]}' where {prim.GetPath()}'s st "
-                                                                "leaves [0, 1]: snell repeats textures")
+            if part.uvs is not None:
+                self._undrawn_wraps(prim, part, record)
         self.sources.append(source)
         self._initial[id(source)] = pose
         return source
+
+    def _undrawn_wraps(self, prim: Usd.Prim, part: Part, record: MaterialRecord) -> None:
+        """A wrap snell has no sampler for ('black', 'useMetadata') matters only where the texture's UVs leave
+        [0, 1]: said there, once per texture and mesh."""
+        for slot in record.slots.values():
+            if slot.snell_wraps == slot.wraps:
+                continue
+            matrix = slot.uv_matrix()  # the texture's own (s, t) axes, as snell samples them
+            uv = part.uvs.astype(np.float64) @ matrix[:2, :2].T + matrix[:2, 2]
+            outside = ((uv < -1e-6) | (uv > 1 + 1e-6)).any(axis=0)
+            axes = [w for w, s, o in zip(slot.wraps, slot.snell_wraps, outside) if w != s and o]
+            if axes:
+                through = " (through its UsdTransform2d)" if slot.transform is not None else ""
+                why = ("snell reads no wrap from the file (USD's fallback is black)" if axes[0] == "useMetadata"
+                       else "snell has no black border")
+                self.problems.warn(slot.prim, f"wrap '{axes[0]}' where {prim.GetPath()}'s st{through} leaves [0, 1]: "
+                                              f"{why}: the texture repeats there")
 
     def _st(self, prim: Usd.Prim, name: str, topology: Topology, time: Usd.TimeCode, material: str):
         primvar = UsdGeom.PrimvarsAPI(prim).GetPrimvar(name)

@@ -18,7 +18,7 @@ from typing import Any, Optional, Union
 
 import numpy as np
 
-from .. import Device, Renderer, Scene, Texture, View
+from .. import Device, Renderer, Scene, View
 from ._cameras import CameraState
 from ._problems import StageError, StageWarning
 from ._reader import Frame, StageContents
@@ -51,8 +51,7 @@ class Stage:
         try:
             self.scene = Scene.from_arrays(
                 meshes, materials=contents.snell_materials(),
-                textures=[Texture(rgba, name=path) for rgba, path in zip(contents.materials.textures,
-                                                                         contents.materials.texture_paths)],
+                textures=contents.materials.snell_textures(),
                 instances=contents.snell_instances(), lights=contents.snell_lights(), name=contents.path)
             self.renderer = Renderer(self.device, self.scene, frames_in_flight)
         except Exception:

@@ -1,11 +1,24 @@
 """UsdUVTexture images as snell textures: read with OpenImageIO, converted on the CPU.
 
-snell's textures are 8-bit sRGB RGBA, row 0 at the top (snell.Texture). A
-UsdUVTexture's result is `linear(texel) * scale + bias` (UsdPreviewSurface
-spec: the colour-space decode comes first), so the conversion decodes the
-file's colour space, applies scale and bias in linear light, and encodes the
-result back to 8-bit sRGB. An 8-bit sRGB file with scale 1 and bias 0 passes
-through byte for byte, so it reads as glTF's loader reads the same file.
+snell's textures are 8-bit RGBA, row 0 at the top (snell.Texture): sRGB
+colour in the base colour and emissive slots, data (bytes / 255) in the
+normal slot; alpha is bytes / 255 everywhere. A UsdUVTexture's result is
+`linear(texel) * scale + bias` (UsdPreviewSurface spec: the colour-space
+decode comes first), so the conversion decodes the file's colour space,
+applies scale and bias, and encodes the result for its slot:
+
+- colour: 8-bit sRGB; an 8-bit sRGB file with scale 1 and bias 0 passes
+  through byte for byte, so it reads as glTF's loader reads the same file;
+- emission: as colour, divided per channel by a gain (the largest value, when
+  above 1) that the material's emissive factor multiplies back, so emission
+  brighter than 1 survives 8 bits;
+- normal: snell decodes a normal map as 2 byte / 255 - 1, so the tangent-space
+  normal v is stored as (v + 1) / 2; the usual raw file with scale 2 and bias
+  -1 passes through byte for byte.
+
+Alpha is the coverage snell multiplies into the base colour's alpha: one
+channel of the file after its own scale and bias (never colour-decoded when it
+is the file's alpha), or opaque.
 """
 
 from __future__ import annotations
@@ -20,6 +33,7 @@ import numpy as np
 
 IDENTITY_SCALE = (1.0, 1.0, 1.0, 1.0)
 NO_BIAS = (0.0, 0.0, 0.0, 0.0)
+KINDS = ("colour", "emission", "normal")
 
 
 class TextureReadError(Exception):
@@ -28,13 +42,25 @@ class TextureReadError(Exception):
 
 @dataclass(frozen=True)
 class TextureRequest:
-    """One UsdUVTexture output as a snell texture: the file, how its texels become colour, and which output."""
+    """One snell texture made from a UsdUVTexture's file: how its texels become the slot's bytes."""
 
     path: str  #: the resolved file
     color_space: str  #: 'sRGB', 'raw' or 'auto'
     scale: tuple[float, float, float, float] = IDENTITY_SCALE
     bias: tuple[float, float, float, float] = NO_BIAS
-    output: str = "rgb"  #: the UsdUVTexture output connected: rgb, rgba, r, g, b or a
+    output: str = "rgb"  #: what gives the colour: rgb, one of r, g, b, a (as grey), or '' (white)
+    kind: str = "colour"  #: colour (sRGB), emission (sRGB over a gain) or normal (data)
+    alpha: str = ""  #: the channel that gives alpha (r, g, b or a), '' for opaque
+    alpha_scale: float = 1.0  #: the alpha channel's own scale and bias (its shader's)
+    alpha_bias: float = 0.0
+
+
+@dataclass
+class TextureImage:
+    """A converted texture: its bytes and the gain its slot's factor multiplies back (emission only)."""
+
+    rgba: np.ndarray  #: (height, width, 4) uint8, row 0 at the top
+    gain: tuple[float, float, float] = (1.0, 1.0, 1.0)
 
 
 def srgb_to_linear(c: np.ndarray) -> np.ndarray:
@@ -91,13 +117,22 @@ def _local_file(resolved: str) -> Iterator[str]:
         os.unlink(temporary)
 
 
-def read_texture(request: TextureRequest) -> np.ndarray:
-    """The texture as snell takes it: (height, width, 4) uint8 sRGB, alpha 255 unless the output is rgba."""
+def read_texture(request: TextureRequest) -> TextureImage:
+    """The texture as snell takes it for the request's slot (see the module's docstring)."""
     with _local_file(request.path) as path:
         return _read_texture(request, path)
 
 
-def _read_texture(request: TextureRequest, path: str) -> np.ndarray:
+def _passes_through(request: TextureRequest, bits8: bool, srgb: bool, channels: int) -> bool:
+    """Whether the file's bytes are already what snell's slot reads: 8-bit sRGB colour, unscaled."""
+    identity = request.scale == IDENTITY_SCALE and request.bias == NO_BIAS
+    plain_alpha = request.alpha == "" or (request.alpha == "a" and request.alpha_scale == 1.0
+                                          and request.alpha_bias == 0.0)
+    return (bits8 and srgb and identity and plain_alpha and request.kind in ("colour", "emission")
+            and request.output == "rgb" and channels >= 3)
+
+
+def _read_texture(request: TextureRequest, path: str) -> TextureImage:
     oiio = _oiio()
     # The file's own values: OpenImageIO would otherwise premultiply a PNG's colour by its alpha.
     config = oiio.ImageSpec()
@@ -110,38 +145,56 @@ def _read_texture(request: TextureRequest, path: str) -> np.ndarray:
         channels = spec.nchannels
         bits8 = spec.format == oiio.UINT8
         srgb = is_srgb(request.color_space, bits8, channels, spec.get_string_attribute("oiio:ColorSpace", ""))
-        identity = request.scale == IDENTITY_SCALE and request.bias == NO_BIAS
-        if bits8 and srgb and identity and request.output in ("rgb", "rgba") and channels >= 3:
+        if _passes_through(request, bits8, srgb, channels):
             pixels = image.read_image(0, 0, 0, channels, "uint8")
             if pixels is None:
                 raise TextureReadError(f"{request.path}: {image.geterror()}")
             rgba = np.full((spec.height, spec.width, 4), 255, np.uint8)
             rgba[..., :3] = pixels[..., :3]
-            if request.output == "rgba" and channels >= 4:
+            if request.alpha == "a" and channels >= 4:
                 rgba[..., 3] = pixels[..., 3]
-            return rgba
+            return TextureImage(rgba)
         pixels = image.read_image(0, 0, 0, channels, "float")
         if pixels is None:
             raise TextureReadError(f"{request.path}: {image.geterror()}")
     finally:
         image.close()
-    pixels = np.asarray(pixels, np.float64).reshape(spec.height, spec.width, channels)
-    # The four channels UsdUVTexture sees: grey files fill r, g and b; a missing alpha is 1.
-    if channels == 1:
-        rgba = np.concatenate([np.repeat(pixels, 3, axis=2), np.ones_like(pixels)], axis=2)
-    elif channels == 2:
-        rgba = np.concatenate([np.repeat(pixels[..., :1], 3, axis=2), pixels[..., 1:2]], axis=2)
-    elif channels == 3:
-        rgba = np.concatenate([pixels, np.ones_like(pixels[..., :1])], axis=2)
-    else:
-        rgba = pixels[..., :4].copy()
+    texels = _usd_channels(np.asarray(pixels, np.float64).reshape(spec.height, spec.width, channels))
     if srgb:
-        rgba[..., :3] = srgb_to_linear(rgba[..., :3])
-    rgba = rgba * np.asarray(request.scale) + np.asarray(request.bias)
-    if request.output in ("r", "g", "b", "a"):
-        grey = rgba[..., "rgba".index(request.output)]
-        rgba = np.stack([grey, grey, grey, np.ones_like(grey)], axis=2)
-    out = np.empty(rgba.shape, np.uint8)
-    out[..., :3] = np.rint(linear_to_srgb(rgba[..., :3]) * 255.0)
-    out[..., 3] = np.rint(np.clip(rgba[..., 3], 0.0, 1.0) * 255.0) if request.output == "rgba" else 255
-    return out
+        texels[..., :3] = srgb_to_linear(texels[..., :3])
+    values = texels * np.asarray(request.scale) + np.asarray(request.bias)
+    if request.output == "rgb":
+        colour = values[..., :3]
+    elif request.output in ("r", "g", "b", "a"):
+        colour = np.repeat(values[..., "rgba".index(request.output), None], 3, axis=2)
+    else:  # alpha alone: white, so the base colour factor is the colour
+        colour = np.ones(values.shape[:2] + (3,))
+    out = np.empty(values.shape[:2] + (4,), np.uint8)
+    gain = (1.0, 1.0, 1.0)
+    if request.kind == "normal":
+        out[..., :3] = np.rint(np.clip((colour + 1.0) * 0.5, 0.0, 1.0) * 255.0)
+    else:
+        if request.kind == "emission":
+            # Emission above 1 would clip in 8 bits: each channel is stored over its largest value.
+            colour = np.maximum(colour, 0.0)
+            gain = tuple(max(1.0, float(colour[..., c].max(initial=0.0))) for c in range(3))
+            colour = colour / np.asarray(gain)
+        out[..., :3] = np.rint(linear_to_srgb(colour) * 255.0)
+    if request.alpha:
+        alpha = texels[..., "rgba".index(request.alpha)] * request.alpha_scale + request.alpha_bias
+        out[..., 3] = np.rint(np.clip(alpha, 0.0, 1.0) * 255.0)
+    else:
+        out[..., 3] = 255
+    return TextureImage(out, gain)
+
+
+def _usd_channels(pixels: np.ndarray) -> np.ndarray:
+    """The four channels UsdUVTexture sees: grey files fill r, g and b; a missing alpha is 1."""
+    channels = pixels.shape[2]
+    if channels == 1:
+        return np.concatenate([np.repeat(pixels, 3, axis=2), np.ones_like(pixels)], axis=2)
+    if channels == 2:
+        return np.concatenate([np.repeat(pixels[..., :1], 3, axis=2), pixels[..., 1:2]], axis=2)
+    if channels == 3:
+        return np.concatenate([pixels, np.ones_like(pixels[..., :1])], axis=2)
+    return pixels[..., :4].copy()
