@@ -1,9 +1,11 @@
 """A small glTF 2.0 writer for test scenes: one .gltf (JSON) and one binary buffer (.bin) beside it.
 
 It writes what the USD tests compare against: meshes of several primitives
-with skins and morph targets, node animations, metallic-roughness materials
-with KHR_materials_transmission and KHR_materials_ior, an image texture by
-URI, a perspective camera and KHR_lights_punctual lights.
+with skins, morph targets and two UV sets, node animations, metallic-roughness
+materials with KHR_materials_transmission and KHR_materials_ior, base colour,
+emissive and normal textures by URI (each with its sampler's wraps, its UV set
+and a KHR_texture_transform), alphaMode and alphaCutoff, a perspective camera
+and KHR_lights_punctual lights.
 """
 
 from __future__ import annotations
@@ -13,6 +15,7 @@ from pathlib import Path
 
 import numpy as np
 
+_WRAPS = {"repeat": 10497, "clamp": 33071, "mirror": 33648}
 _COMPONENT = {np.dtype(np.float32): 5126, np.dtype(np.uint32): 5125, np.dtype(np.uint16): 5123}
 _TYPE = {1: "SCALAR", 2: "VEC2", 3: "VEC3", 4: "VEC4", 16: "MAT4"}
 
@@ -51,8 +54,33 @@ class GltfWriter:
         self.doc["accessors"].append(accessor)
         return len(self.doc["accessors"]) - 1
 
+    def texture(self, uri: str, wrap_s: str = "repeat", wrap_t: str = "repeat") -> int:
+        """An image by URI with a trilinear sampler of these wraps (repeat, clamp, mirror); the texture's index."""
+        self.doc.setdefault("images", []).append({"uri": uri})
+        sampler = {"magFilter": 9729, "minFilter": 9987, "wrapS": _WRAPS[wrap_s], "wrapT": _WRAPS[wrap_t]}
+        samplers = self.doc.setdefault("samplers", [])
+        if sampler not in samplers:
+            samplers.append(sampler)
+        self.doc.setdefault("textures", []).append({"source": len(self.doc["images"]) - 1,
+                                                    "sampler": samplers.index(sampler)})
+        return len(self.doc["textures"]) - 1
+
+    def texture_info(self, index: int, tex_coord: int = 0, transform: dict | None = None, **fields) -> dict:
+        """A material's reference to texture `index`: its UV set, a KHR_texture_transform (offset, rotation,
+        scale), and fields such as a normal map's scale."""
+        info: dict = {"index": index, **fields}
+        if tex_coord:
+            info["texCoord"] = tex_coord
+        if transform:
+            info["extensions"] = {"KHR_texture_transform": transform}
+            self._extension("KHR_texture_transform")
+        return info
+
     def material(self, base_color=(1, 1, 1, 1), roughness: float = 1.0, transmission: float = 0.0, ior: float = 1.5,
-                 texture_uri: str | None = None, emissive=(0, 0, 0)) -> int:
+                 texture_uri: str | None = None, emissive=(0, 0, 0), base_info: dict | None = None,
+                 emissive_info: dict | None = None, normal_info: dict | None = None, alpha_mode: str | None = None,
+                 alpha_cutoff: float | None = None) -> int:
+        """A material; *_info are texture_info() references (texture_uri: a repeating base colour texture)."""
         pbr: dict = {"baseColorFactor": list(base_color), "metallicFactor": 0.0, "roughnessFactor": roughness}
         m: dict = {"pbrMetallicRoughness": pbr}
         if any(emissive):
@@ -63,15 +91,21 @@ class GltfWriter:
             self._extension("KHR_materials_transmission")
             self._extension("KHR_materials_ior")
         if texture_uri is not None:
-            self.doc.setdefault("images", []).append({"uri": texture_uri})
-            self.doc.setdefault("samplers", [{"magFilter": 9729, "minFilter": 9987, "wrapS": 10497, "wrapT": 10497}])
-            self.doc.setdefault("textures", []).append({"source": len(self.doc["images"]) - 1, "sampler": 0})
-            pbr["baseColorTexture"] = {"index": len(self.doc["textures"]) - 1}
+            base_info = {"index": self.texture(texture_uri)}
+        for key, info in (("emissiveTexture", emissive_info), ("normalTexture", normal_info)):
+            if info is not None:
+                m[key] = info
+        if base_info is not None:
+            pbr["baseColorTexture"] = base_info
+        if alpha_mode is not None:
+            m["alphaMode"] = alpha_mode
+        if alpha_cutoff is not None:
+            m["alphaCutoff"] = alpha_cutoff
         self.doc["materials"].append(m)
         return len(self.doc["materials"]) - 1
 
     def mesh(self, primitives: list[dict], weights: list[float] | None = None, name: str = "") -> int:
-        """primitives: dicts of positions, normals, indices ((T, 3) uint32), and optional uvs, material,
+        """primitives: dicts of positions, normals, indices ((T, 3) uint32), and optional uvs, uvs1, material,
         joints ((n, 4) uint16), weights ((n, 4) float32) and targets (position deltas, one array per target)."""
         out = []
         for p in primitives:
@@ -79,6 +113,8 @@ class GltfWriter:
                           "NORMAL": self.accessor(np.float32(p["normals"]), target=34962)}
             if p.get("uvs") is not None:
                 attributes["TEXCOORD_0"] = self.accessor(np.float32(p["uvs"]), target=34962)
+            if p.get("uvs1") is not None:
+                attributes["TEXCOORD_1"] = self.accessor(np.float32(p["uvs1"]), target=34962)
             if p.get("joints") is not None:
                 attributes["JOINTS_0"] = self.accessor(np.uint16(p["joints"]), target=34962)
                 attributes["WEIGHTS_0"] = self.accessor(np.float32(p["weights"]), target=34962)
