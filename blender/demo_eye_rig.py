@@ -117,6 +117,10 @@ def eyeball_mesh(name: str) -> bpy.types.Mesh:
     for s in range(SEGMENTS):
         faces.append((ring_start(RINGS - 1) + s, ring_start(RINGS - 1) + (s + 1) % SEGMENTS, back))
         materials.append(0)
+    # Wound outwards: a renderer takes the side a face's winding points to as its outside. Wound
+    # inwards, the cornea bent light as glass left for air, and rays through its edge left the
+    # eye unseen: the dark crescent (the world) beside the iris, in Cycles as in snell.
+    faces = [face[::-1] for face in faces]
     mesh = bpy.data.meshes.new(name)
     mesh.from_pydata(vertices, [], faces)
     mesh.polygons.foreach_set("material_index", materials)
@@ -133,36 +137,37 @@ def eyeball_mesh(name: str) -> bpy.types.Mesh:
 def iris_mesh(name: str) -> bpy.types.Mesh:
     """A disc facing -Y just behind the limbus, UV-mapped to the iris texture (the pupil its centre).
 
-    It reaches the eyeball's wall, as a production eye's iris does: a disc
-    that stopped at the limbus left a ring of the eyeball's dark inside to
-    show through the cornea as the eye turned (a dark crescent at the iris's
-    edge, in Cycles as in snell).
+    Its rim turns forward to meet the eyeball at the limbus, as a production
+    eye's iris root does: a disc that stopped behind the limbus left a band of
+    the eyeball's dark inside to show through the cornea as the eye turned (a
+    dark crescent beside the iris, in Cycles as in snell).
     """
     limbus = math.sin(LIMBUS) * 0.99  # the texture's edge: the iris as seen through the cornea
-    outer = math.sqrt(1.0 - IRIS_DEPTH**2) * 0.995  # the wall, hidden behind the sclera: the rim's colour
-    radii = [limbus * ring / 12 for ring in range(1, 13)] + [limbus + (outer - limbus) * k / 2 for k in (1, 2)]
-    rings = len(radii)
-    vertices, uvs = [(0.0, -IRIS_DEPTH, 0.0)], [(0.5, 0.5)]
-    for r in radii:
-        t = min(r / limbus, 1.0)
+    limbus_y = -math.cos(LIMBUS) * 0.995  # just inside the opening, so the rim meets the sclera's edge
+    rings = [(limbus * ring / 12, -IRIS_DEPTH - 0.04 * (1 - ring / 12), ring / 12) for ring in range(1, 13)]
+    rings += [(limbus, -IRIS_DEPTH + (limbus_y + IRIS_DEPTH) * k / 2, 1.0) for k in (1, 2)]  # the root, forward
+    vertices, uvs = [(0.0, -IRIS_DEPTH - 0.04, 0.0)], [(0.5, 0.5)]
+    for r, y, t in rings:
         for s in range(SEGMENTS):
             phi = 2 * math.pi * s / SEGMENTS
-            # A shallow cone: the iris bows towards the cornea at the pupil.
-            vertices.append((r * math.cos(phi), -IRIS_DEPTH - 0.04 * (1 - t), r * math.sin(phi)))
+            vertices.append((r * math.cos(phi), y, r * math.sin(phi)))
             uvs.append((0.5 + 0.5 * t * math.cos(phi), 0.5 + 0.5 * t * math.sin(phi)))
-    faces = [(0, 1 + (s + 1) % SEGMENTS, 1 + s) for s in range(SEGMENTS)]
+    rings = len(rings)
+    # Wound to face the cornea (-Y), as the eyeball's faces face out.
+    faces = [(0, 1 + s, 1 + (s + 1) % SEGMENTS) for s in range(SEGMENTS)]
     for ring in range(1, rings):
         base = 1 + (ring - 1) * SEGMENTS
         for s in range(SEGMENTS):
-            faces.append((base + s, base + (s + 1) % SEGMENTS, base + SEGMENTS + (s + 1) % SEGMENTS,
-                          base + SEGMENTS + s))
+            faces.append((base + SEGMENTS + s, base + SEGMENTS + (s + 1) % SEGMENTS, base + (s + 1) % SEGMENTS,
+                          base + s))
     mesh = bpy.data.meshes.new(name)
     mesh.from_pydata(vertices, [], faces)
     layer = mesh.uv_layers.new(name="UVMap")
     for polygon in mesh.polygons:
         for loop in polygon.loop_indices:
             layer.data[loop].uv = uvs[mesh.loops[loop].vertex_index]
-    mesh.polygons.foreach_set("use_smooth", [True] * len(faces))
+    root = 2 * SEGMENTS  # the root's faces, last: flat, so the disc's normals do not bend round its edge
+    mesh.polygons.foreach_set("use_smooth", [True] * (len(faces) - root) + [False] * root)
     mesh.update()
     return mesh, limbus
 
