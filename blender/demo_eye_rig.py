@@ -173,7 +173,8 @@ def iris_mesh(name: str) -> bpy.types.Mesh:
 
 
 def add_dilation(obj, outer: float) -> None:
-    """A "Dilate" shape key: the pupil (the texture's centre) opens to 1.7 times its width; from `outer` out nothing moves."""
+    """A "Dilate" shape key: the pupil (the texture's centre) opens to 1.7 times its width; from `outer` out
+    nothing moves."""
     obj.shape_key_add(name="Basis")
     key = obj.shape_key_add(name="Dilate")
     for i, vertex in enumerate(obj.data.vertices):

@@ -85,7 +85,8 @@ class Textures:
         import snell
 
         image = node.image
-        wrap = {"REPEAT": "repeat", "EXTEND": "clamp", "CLIP": "clamp", "MIRROR": "mirror"}.get(node.extension, "repeat")
+        wraps = {"REPEAT": "repeat", "EXTEND": "clamp", "CLIP": "clamp", "MIRROR": "mirror"}
+        wrap = wraps.get(node.extension, "repeat")
         nearest = node.interpolation == "Closest"
         key = (image.name, colour, wrap, nearest)
         if key in self.index:
@@ -117,6 +118,7 @@ def _same_image(a: Optional[TextureUse], b: Optional[TextureUse]) -> bool:
     """Whether two texture slots read the same image the same way (or neither reads one)."""
     if a is None or b is None:
         return a is None and b is None
+
     def fields(t) -> tuple:
         return (*t.offset, t.rotation, *t.scale)
 
@@ -251,7 +253,8 @@ class MaterialReader:
         if source is None:
             return
         if source.bl_idname != "ShaderNodeNormalMap":
-            self.problem(source, "on Normal is not read (snell reads a Normal Map node); the surface's own normal is used")
+            self.problem(source, "on Normal is not read (snell reads a Normal Map node); the surface's own normal is "
+                                 "used")
             return
         if source.space != "TANGENT":
             self.problem(source, f"is in {source.space} space; snell reads tangent-space maps only")

@@ -157,7 +157,7 @@ class SnellRenderEngine(bpy.types.RenderEngine):
         from .convert import view_of
 
         view = view_of(scene, region.width, region.height, rv3d.view_matrix, rv3d.window_matrix, True,
-                               self.sync.background)
+                       self.sync.background)
         if self.display is None:
             self.display = display.Display(runtime.device())
         try:
@@ -210,7 +210,8 @@ def _frame_index(scene, animation: bool) -> tuple:
 
 
 def _rows_up(plane):
-    """A (height, width[, channels]) plane as a (pixels, channels) float32 block, bottom row first, as passes hold it."""
+    """A (height, width[, channels]) plane as a (pixels, channels) float32 block, bottom row first, as passes
+    hold it."""
     import numpy as np
 
     return np.ascontiguousarray(plane[::-1], np.float32).reshape(plane.shape[0] * plane.shape[1], -1)

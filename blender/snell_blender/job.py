@@ -187,4 +187,3 @@ def unregister() -> None:
         if _on_render_end in handlers:
             handlers.remove(_on_render_end)
     end()
-

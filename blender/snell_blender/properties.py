@@ -1,5 +1,5 @@
 # SPDX-License-Identifier: GPL-3.0-or-later
-"""The add-on's settings: per scene (how glass is drawn), per view layer (which passes) and per user (where snell is)."""
+"""The add-on's settings: per scene (how glass is drawn), per view layer (which passes), per user (where snell is)."""
 
 from __future__ import annotations
 

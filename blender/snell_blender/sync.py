@@ -297,7 +297,8 @@ class SceneSync:
             # A material's own tree is a ShaderNodeTree; a node group's may be any NodeTree.
             if kind in ("Material", "Light", "World", "Image", "NodeTree", "ShaderNodeTree"):
                 raise TopologyChanged(f"{kind} {data.name} changed")
-            if kind == "Object" and data.type == "LIGHT" and (update.is_updated_geometry or update.is_updated_transform):
+            moved = update.is_updated_geometry or update.is_updated_transform
+            if kind == "Object" and data.type == "LIGHT" and moved:
                 raise TopologyChanged(f"light {data.name} changed")  # lights are part of snell's scene
             if kind == "Object" and update.is_updated_geometry:
                 obj = data

@@ -52,7 +52,8 @@ def export_gltf(path: Path) -> Path:
     """Blender's own glTF export of the scene (GLB, cameras, lights, animations), lights in its 'COMPAT'
     (unitless) units, the add-on's own; 4.2 renamed that option, so it is found by either name."""
     options = bpy.ops.export_scene.gltf.get_rna_type().properties.keys()
-    lighting = next(name for name in ("export_import_convert_lighting_mode", "convert_lighting_mode") if name in options)
+    names = ("export_import_convert_lighting_mode", "convert_lighting_mode")
+    lighting = next(name for name in names if name in options)
     bpy.ops.export_scene.gltf(filepath=str(path), export_format="GLB", export_cameras=True, export_lights=True,
                               export_animations=True, **{lighting: "COMPAT"})
     return path

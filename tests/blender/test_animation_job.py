@@ -64,7 +64,7 @@ for frame in range(1, ESC_FRAME):
     values = progress.get(frame, [])
     check(values and values[-1] == 1.0 and all(b >= a for a, b in zip(values, values[1:])),
           f"frame {frame}'s progress rose to 1 ({len(values)} steps)")
-check(any(f"Frame 5 (5 of 20)" in line for line in stats[5]), f"the status line names the frame ({stats[5][-1]})")
+check(any("Frame 5 (5 of 20)" in line for line in stats[5]), f"the status line names the frame ({stats[5][-1]})")
 check(ESC_FRAME in asked and 1.0 not in progress.get(ESC_FRAME, []), f"frame {ESC_FRAME} was stopped before its end")
 check(any("stopped" in line for line in stats[ESC_FRAME]), f"the status line says so ({stats[ESC_FRAME][-1]})")
 

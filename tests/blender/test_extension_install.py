@@ -32,8 +32,8 @@ package = SCRATCH / "snell_blender-0.1.0.zip"
 check(built.returncode == 0 and package.exists(), f"it builds a package ({built.stdout.strip()[-200:]})")
 with zipfile.ZipFile(package) as archive:
     names = set(archive.namelist())
-check({"blender_manifest.toml", "__init__.py", "compat.py", "LICENSE"} <= names, f"the package holds the add-on "
-                                                                                  f"({sorted(names)[:6]} ...)")
+check({"blender_manifest.toml", "__init__.py", "compat.py", "LICENSE"} <= names,
+      f"the package holds the add-on ({sorted(names)[:6]} ...)")
 
 # Installed by hand into the user repository, as Blender's installer would unpack it, then enabled as an extension.
 repository = Path(bpy.utils.user_resource("EXTENSIONS", path="user_default", create=True))

@@ -21,7 +21,7 @@ import bpy
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).parent))  # Blender runs the script without its folder on the path
-from blender_support import SCRATCH, check, demo_scene, pixels, srgb  # noqa: E402
+from blender_support import SCRATCH, check, demo_scene, pixels  # noqa: E402
 
 RESULT = SCRATCH / "viewport.json"
 DEFORMING = {"Eyeball.L", "Eyeball.R", "Iris.L", "Iris.R"}
