@@ -7,7 +7,7 @@ wall behind it where something shows through) seen from above and to the
 right, lit by the headlight, so a normal bent up differs from one bent down.
 The twin is written by hand from glTF's own definitions, not from snell.usd's
 code: UV sets baked through UsdTransform2d's formula, a KHR_texture_transform
-derived in its docstring. Both sides render in one device at 64 x 48: cheap
+derived by hand where it is written. Both sides render in one device at 64 x 48: cheap
 on lavapipe.
 """
 

@@ -380,6 +380,29 @@ def test_the_primvar_reader_picks_the_texture_coordinates(tmp_path):
     np.testing.assert_allclose(read_quad(tmp_path, build).sources[0].parts[0].uvs, 0.5)
 
 
+def test_textures_of_one_material_reading_other_primvars_read_the_first_ones_with_a_warning(tmp_path):
+    write_rgba_png(tmp_path / "t.png", np.zeros((2, 2, 3), np.uint8))
+
+    def build(stage, prim):
+        from pxr import Sdf, UsdGeom
+
+        UsdGeom.PrimvarsAPI(prim).CreatePrimvar("uv2", Sdf.ValueTypeNames.TexCoord2fArray, "vertex").Set(
+            [(0.5, 0.5)] * 4)
+        material = preview_material(stage, "/World/T")
+        texture(stage, material, "./t.png")
+        glow = texture(stage, material, "./t.png", input_name="emissiveColor")
+        other = UsdShade.Shader.Define(stage, "/World/T/Reader2")
+        other.CreateIdAttr("UsdPrimvarReader_float2")
+        other.CreateInput("varname", Sdf.ValueTypeNames.Token).Set("uv2")
+        glow.GetInput("st").ConnectToSource(other.ConnectableAPI(), "result")
+        bind(prim, material)
+
+    contents = read_quad(tmp_path, build)
+    assert contents.sources[0].parts[0].uvs.max() == 1.0  # primvars:st, not uv2's constant 0.5
+    assert ("/World/T/Texture_emissiveColor: reads primvars:uv2, but the material's other textures read "
+            "primvars:st; snell's meshes carry one UV set: primvars:st is used") in messages(contents)
+
+
 def test_a_missing_texture_is_an_error_naming_the_file(tmp_path):
     def build(stage, prim):
         material = preview_material(stage, "/World/T")
