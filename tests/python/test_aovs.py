@@ -61,8 +61,7 @@ def test_depth_and_normal_are_the_first_surfaces_in_camera_and_world_space(aovs)
     rows, columns = np.nonzero(card)
     t = np.tan(0.3)
     sx = (2 * (columns + 0.5) / WIDTH - 1) * t * WIDTH / HEIGHT
-    sy = (1 - 2 * (rows + 0.5) / HEIGHT) * t
-    # Ray (0, 0, 3) + s (sx, sy, -1) meets n . (p - (-0.6, 0, 0)) = 0 at camera depth s.
+    # Ray (0, 0, 3) + s (sx, sy, -1) meets n . (p - (-0.6, 0, 0)) = 0 at camera depth s (n has no y: sy drops out).
     depth = (normal[0] * 0.6 + normal[2] * 3.0) / (-normal[0] * sx + normal[2])
     np.testing.assert_allclose(planes["depth"][card], depth, rtol=1e-4)
     miss = planes["instance"] == MISS

@@ -67,7 +67,8 @@ def every_feature_arrays(materials: list[snell.Material] | None = None) -> snell
     meshes = [snell.Mesh(*WALL, material=0), snell.Mesh(*CARD, material=1), snell.Mesh(*SPHERE, material=2),
               snell.Mesh(*SMALL_CARD, material=3)]
     instances = [snell.Instance(0), snell.Instance(1, translation(*PLACES["card"])),
-                 snell.Instance(2, translation(*PLACES["sphere"])), snell.Instance(3, translation(*PLACES["small card"]))]
+                 snell.Instance(2, translation(*PLACES["sphere"])),
+                 snell.Instance(3, translation(*PLACES["small card"]))]
     camera = snell.Camera(transform=translation(0.0, 0.0, CAMERA_Z), yfov=YFOV)
     return snell.Scene.from_arrays(meshes, materials=materials or every_feature_materials(), textures=textures,
                                    instances=instances, cameras=[camera], name="every feature")

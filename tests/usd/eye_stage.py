@@ -360,7 +360,7 @@ def _write_usd(path: Path, a: EyeArrays, texture: Path) -> Path:
         ball.CreateFaceVertexIndicesAttr(Vt.IntArray.FromNumpy(a.ball_indices))
         ball.CreateSubdivisionSchemeAttr("none")
         normals = UsdGeom.PrimvarsAPI(ball).CreatePrimvar("normals", Sdf.ValueTypeNames.Normal3fArray,
-                                                           UsdGeom.Tokens.faceVarying)
+                                                          UsdGeom.Tokens.faceVarying)
         normals.Set(Vt.Vec3fArray.FromNumpy(a.ball_normals))
         normals.SetIndices(Vt.IntArray.FromNumpy(a.ball_normal_indices))
         skin = UsdSkel.BindingAPI.Apply(ball.GetPrim())

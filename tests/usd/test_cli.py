@@ -34,8 +34,8 @@ def test_info_json_is_the_same_listing(eyes):
     done = snell_usd("info", eyes.usd, "--json", "--purpose", "full")
     listing = json.loads(done.stdout)
     assert listing["time_range"] == [1.0, 48.0] and listing["material_purpose"] == "full"
-    assert {m["prim"] for m in listing["materials"]} == {"/World/Looks/ScleraFull", "/World/Looks/CorneaFull",
-                                                        "/World/Looks/IrisAllPurpose"}
+    materials = {"/World/Looks/ScleraFull", "/World/Looks/CorneaFull", "/World/Looks/IrisAllPurpose"}
+    assert {m["prim"] for m in listing["materials"]} == materials
     assert [c["prim"] for c in listing["cameras"]] == ["/World/Camera"] and len(listing["lights"]) == 3
 
 

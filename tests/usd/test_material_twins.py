@@ -152,8 +152,8 @@ def _wraps(stage: Usd.Stage, mapped: bool) -> UsdShade.Material:
 def _wraps_twin(g: GltfWriter) -> int:
     # USD: s' = 2s - 0.5, t' = 2t - 0.5. glTF: u = s, v = 1 - t, so v' = 1 - t' = 2(1 - t) - 0.5 = 2v - 0.5:
     # KHR_texture_transform scale 2 and offset -0.5 on both axes.
-    info = g.texture_info(g.texture("pattern.png", "clamp", "mirror"), transform={"offset": [-0.5, -0.5],
-                                                                                "scale": [2.0, 2.0]})
+    transform = {"offset": [-0.5, -0.5], "scale": [2.0, 2.0]}
+    info = g.texture_info(g.texture("pattern.png", "clamp", "mirror"), transform=transform)
     return g.material(roughness=0.5, base_info=info)
 
 

@@ -201,7 +201,7 @@ def test_rigid_skinning_moves_the_instance_as_vertex_skinning_moves_the_points(t
     """A mesh bound to one joint with constant influences (UsdSkel's rigid case) is placed where the same
     mesh with per-vertex influences is skinned to."""
     stage = new_stage(tmp_path / "k.usda", time_range=(0, 10))
-    root = UsdSkel.Root.Define(stage, "/World/Rig")
+    UsdSkel.Root.Define(stage, "/World/Rig")
     skeleton = UsdSkel.Skeleton.Define(stage, "/World/Rig/Skel")
     skeleton.CreateJointsAttr(["Arm"])
     skeleton.CreateBindTransformsAttr([Gf.Matrix4d(1.0)])

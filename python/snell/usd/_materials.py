@@ -582,5 +582,3 @@ def _fmt(value: Any) -> str:
 
 def _time_text(time: Usd.TimeCode) -> str:
     return "default" if time.IsDefault() else f"{time.GetValue():g}"
-
-

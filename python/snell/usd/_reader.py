@@ -368,5 +368,3 @@ def _open_stage(path: str) -> Usd.Stage:
     if stage is None:
         raise StageError(f"{path}: not a stage USD opens")
     return stage
-
-

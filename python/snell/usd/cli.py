@@ -127,7 +127,8 @@ def _parser() -> argparse.ArgumentParser:
     reading.add_argument("--meters-per-unit", type=_positive, metavar="M",
                          help="the stage's unit in metres, instead of its metersPerUnit")
 
-    parser = _Parser(prog="snell-usd", parents=[_global_options(defaults=True)], formatter_class=argparse.RawDescriptionHelpFormatter,
+    parser = _Parser(prog="snell-usd", parents=[_global_options(defaults=True)],
+                     formatter_class=argparse.RawDescriptionHelpFormatter,
                      description="snell-usd - USD stages drawn by snell (refraction through deforming meshes).\n"
                                  "Run 'snell-usd COMMAND --help' for a command's options.", epilog=FOOTER)
     parser.add_argument("--version", action="store_true", help="print snell's version and exit")
