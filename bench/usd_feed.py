@@ -45,6 +45,9 @@ def main() -> int:
     parser.add_argument("--segments", type=int, default=32, help="and segments round (default 32)")
     parser.add_argument("--stage", help="measure this stage instead of the eye pair")
     parser.add_argument("--viewport", action="store_true", help="render the viewport composite, not the trace")
+    parser.add_argument("--no-textures", action="store_true",
+                        help="read the stage without its textures (a machine without OpenImageIO, as the GPU machine "
+                             "is: each texture is a 1x1 stand-in, which no per-frame column reads)")
     parser.add_argument("--json", help="write the report here")
     args = parser.parse_args()
     width, height = (int(v) for v in args.size.split("x"))
@@ -60,7 +63,7 @@ def main() -> int:
             stage_path, about = written.usd, {"stage": "tests/usd eye pair", "rings": args.rings,
                                               "segments": args.segments}
         with snell.Device() as device:
-            report = run(device, stage_path, width, height, args.frames, args.viewport)
+            report = run(device, stage_path, width, height, args.frames, args.viewport, not args.no_textures)
     report.update(about)
     report["command"] = "python bench/usd_feed.py " + " ".join(sys.argv[1:])
     print_table(report)
@@ -70,9 +73,10 @@ def main() -> int:
     return 0
 
 
-def run(device: snell.Device, path: Path, width: int, height: int, frames: int, viewport: bool) -> dict:
+def run(device: snell.Device, path: Path, width: int, height: int, frames: int, viewport: bool,
+        textures: bool = True) -> dict:
     started = time.perf_counter()
-    contents = snell.usd.read(path)
+    contents = snell.usd.read(path, load_textures=textures)
     read_s = time.perf_counter() - started
     built = time.perf_counter()
     stage = snell.usd.Stage(contents, device=device)
@@ -111,6 +115,7 @@ def run(device: snell.Device, path: Path, width: int, height: int, frames: int, 
     stage.close()
     keys = ("evaluate", "copy", "render", "gpu", "total")
     return {"device": device.name, "size": [width, height], "output": "viewport" if viewport else "trace",
+            "textures": textures,
             "frames": frames, "warmup_frames": warmup, **facts,
             "load_s": {"read": read_s, "build": build_s, "first_frame": first_s, "total": read_s + build_s + first_s},
             "median_ms": {k: statistics.median(r[k] for r in rows) for k in keys}, "per_frame": rows}
