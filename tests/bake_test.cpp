@@ -9,6 +9,7 @@
 #include "io/image_compare.h"
 #include "io/image_file.h"
 #include "render/method.h"
+#include "render/one_view.h"
 #include "render/renderer.h"
 #include "scene/evaluate.h"
 #include "scene/view.h"
@@ -52,7 +53,7 @@ io::Rgb8Image drawWithMap(vk::Context& context, const scene::Scene& s, const sce
   render::FrameRequest request;
   request.pose = &pose;
   request.views.push_back(render::methodView(render::Method::RefractionMap, settings, raster));
-  request.views.back().readback.enabled = true;
+  request.readbacks.push_back({.view = 0});
   const render::FrameResult& result = renderer.wait(renderer.submit(request));
   return io::toSrgb8({settings.width, settings.height, result.views.at(0).composite});
 }
@@ -115,7 +116,7 @@ TEST_F(GpuTest, ARendererDrawsWithTheRefractionMapItBakedLast) {
   render::FrameRequest request;
   request.pose = &b.pose;
   request.views.push_back(render::methodView(render::Method::RefractionMap, b.settings, render::RasterOptions{}));
-  request.views.back().readback.enabled = true;
+  request.readbacks.push_back({.view = 0});
   const render::FrameResult& result = renderer.wait(renderer.submit(request));
   io::Rgb8Image kept = io::toSrgb8({kWidth, kHeight, result.views.at(0).composite});
   render::RefractionMapBuffer map = render::uploadRefractionMap(context(), b.bake);

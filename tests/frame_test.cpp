@@ -23,6 +23,7 @@ using render::FrameResult;
 using render::FrameStats;
 using render::Renderer;
 using render::ViewOutput;
+using render::ViewPixels;
 using render::ViewRequest;
 
 constexpr uint32_t kWidth = 96, kHeight = 72;
@@ -51,6 +52,15 @@ const FrameResult& frame(Renderer& renderer, const scene::Pose& pose, std::vecto
   request.pose = &pose;
   request.views = std::move(views);
   return renderer.wait(renderer.submit(request));
+}
+
+// One view's frame with its pixels read back.
+const ViewPixels& readFrame(Renderer& renderer, const scene::Pose& pose, const ViewRequest& view) {
+  FrameRequest request;
+  request.pose = &pose;
+  request.views = {view};
+  request.readbacks = {{.view = 0}};
+  return renderer.wait(renderer.submit(request)).views.at(0);
 }
 
 scene::View lookFrom(const glm::dvec3& eye, const glm::dvec3& target = glm::dvec3(0.0)) {
@@ -200,8 +210,7 @@ TEST_F(GpuTest, TheMaskedCompositeMatchesTheFullTraceComposite) {
     ViewRequest v = compositeView(view, masked);
     v.settings.width = 192;
     v.settings.height = 144;
-    v.readback.enabled = true;
-    return frame(renderer, pose, {v}).views.at(0).composite;
+    return readFrame(renderer, pose, v).composite;
   };
   std::vector<glm::vec4> masked = composite(true), full = composite(false);
   Comparison result = compare(io::toSrgb8({192, 144, masked}), io::toSrgb8({192, 144, full}));
@@ -245,20 +254,17 @@ TEST_F(GpuTest, TwoFramesInFlightEachDrawTheirOwnPose) {
   scene::View view = scene::resolveView(s, a, {});
   auto alone = [&](const scene::Pose& pose) {
     Renderer renderer(context(), s, pose);
-    ViewRequest v = traceView(view);
-    v.readback.enabled = true;
-    return frame(renderer, pose, {v}).views.at(0).trace;
+    return readFrame(renderer, pose, traceView(view)).trace;
   };
   std::vector<glm::vec4> wantA = alone(a), wantB = alone(b);
   ASSERT_NE(std::memcmp(wantA.data(), wantB.data(), wantA.size() * sizeof(glm::vec4)), 0) << "the poses look the same";
 
   Renderer renderer(context(), s, a);
-  ViewRequest v = traceView(view);
-  v.readback.enabled = true;
   FrameRequest first, second;
   first.pose = &a;
   second.pose = &b;
-  first.views = second.views = {v};
+  first.views = second.views = {traceView(view)};
+  first.readbacks = second.readbacks = {{.view = 0}};
   uint64_t fa = renderer.submit(first);
   uint64_t fb = renderer.submit(second);  // recorded before the first is waited for
   std::vector<glm::vec4> gotA = renderer.wait(fa).views.at(0).trace;

@@ -3,6 +3,7 @@
 #pragma once
 
 #include "io/image_file.h"
+#include "render/one_view.h"
 #include "render/renderer.h"
 #include "scene/evaluate.h"
 #include "scene/scene.h"

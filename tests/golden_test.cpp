@@ -10,6 +10,7 @@
 
 #include "io/image_file.h"
 #include "ref/reference_tracer.h"
+#include "render/one_view.h"
 #include "render/renderer.h"
 #include "scene/evaluate.h"
 #include "scene/gltf_loader.h"

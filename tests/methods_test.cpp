@@ -43,7 +43,7 @@ Shot draw(vk::Context& context, const scene::Scene& s, Method method, float offs
   render::FrameRequest request;
   request.pose = &pose;
   request.views.push_back(render::methodView(method, settings, raster));
-  request.views.back().readback.enabled = true;
+  request.readbacks.push_back({.view = 0});
   const render::FrameResult& result = renderer.wait(renderer.submit(request));
   const render::ViewPixels& pixels = result.views.at(0);
   Shot shot;
@@ -179,8 +179,8 @@ TEST(DriverRt, DrawsTheTracesPictureWithTheSameFirstHits) {
     render::FrameRequest request;
     request.pose = &pose;
     request.views.push_back(render::methodView(m, settings, {}));
-    request.views.back().readback.enabled = true;
     request.views.back().aov = true;
+    request.readbacks.push_back({.view = 0});
     pixels.push_back(renderer.wait(renderer.submit(request)).views.at(0));
   }
   size_t agreeing = 0;

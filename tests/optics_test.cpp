@@ -7,6 +7,7 @@
 #include "gpu_test.h"
 
 #include "ref/reference_tracer.h"
+#include "render/one_view.h"
 #include "render/renderer.h"
 #include "scene/evaluate.h"
 #include "scene/scene_builder.h"

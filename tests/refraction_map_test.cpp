@@ -7,6 +7,7 @@
 
 #include "bake/refraction_map.h"
 #include "ref/reference_tracer.h"
+#include "render/one_view.h"
 #include "render/renderer.h"
 #include "vk/buffer.h"
 #include "vk/commands.h"

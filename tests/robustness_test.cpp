@@ -6,6 +6,7 @@
 #include "command_run.h"
 #include "gpu_test.h"
 
+#include "io/image_file.h"
 #include "render/renderer.h"
 #include "scene/evaluate.h"
 #include "scene/procedural_eye.h"
@@ -14,6 +15,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <fstream>
 #include <filesystem>
 #include <string>
 #include <vector>
@@ -85,6 +87,22 @@ TEST_F(Robustness, SigtermDuringTheThirdFrameKeepsTwoWholeFramesAndExits143) {
   std::sort(names.begin(), names.end());
   EXPECT_EQ(names, (std::vector<std::string>{"f_1.png", "f_2.png"})) << "no partial or temporary file: " << run.output;
   for (const std::string& name : names) EXPECT_GT(fs::file_size(dir_ / name), 1000u) << name;
+}
+
+// Nothing to draw is not a mistake: the picture is the background, and no
+// step of the frame reads the empty tables it has (the sanitizers watch).
+TEST_F(Robustness, ASceneWithoutAMeshRendersItsBackground) {
+  std::ofstream((dir_ / "empty.gltf").string())
+      << R"({"asset":{"version":"2.0"},"scene":0,"scenes":[{"nodes":[0]}],"nodes":[{"name":"nothing here"}]})";
+  for (std::string mode : {"", "--viewport "}) {
+    CommandRun run = snell("", "render empty.gltf " + mode + "--size 32x24 --background 0.25,0.5,1 -o empty.png");
+    ASSERT_EQ(run.exitCode, 0) << mode << run.output;
+    io::PngRgba png = io::readPngRgba((dir_ / "empty.png").string());
+    ASSERT_EQ(png.width * png.height, 32u * 24u);
+    for (uint32_t p = 0; p < png.width * png.height; ++p) {
+      ASSERT_EQ(png.rgba8[4 * p + 2], 255) << mode << "pixel " << p << " is not the background";
+    }
+  }
 }
 
 TEST_F(Robustness, AFailedAllocationNamesWhatWasBeingAllocated) {

@@ -3,6 +3,7 @@
 // no leak and no self-hit anywhere. The full-size sweep is `snell bench stress`.
 #include "gpu_test.h"
 
+#include "render/one_view.h"
 #include "render/renderer.h"
 #include "scene/evaluate.h"
 #include "vk/commands.h"

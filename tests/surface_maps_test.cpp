@@ -5,6 +5,7 @@
 #include "gpu_test.h"
 
 #include "io/image_file.h"
+#include "render/one_view.h"
 #include "render/renderer.h"
 #include "scene/evaluate.h"
 #include "scene/scene_builder.h"

@@ -8,6 +8,7 @@
 
 #include "io/image_file.h"
 #include "ref/reference_tracer.h"
+#include "render/one_view.h"
 #include "render/renderer.h"
 #include "render/scene_gpu.h"
 #include "scene/texture_mips.h"

@@ -9,6 +9,7 @@
 
 #include "io/image_file.h"
 #include "render/raster_pass.h"
+#include "render/one_view.h"
 #include "render/renderer.h"
 #include "scene/evaluate.h"
 #include "scene/view.h"

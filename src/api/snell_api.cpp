@@ -149,10 +149,9 @@ void Device::waitIdle() {
 struct Scene::Impl {
   scene::Scene scene;
   render::HostBuffers host;  ///< null handles for a glTF scene or kept vertices
-  /// Kept vertices (HostScene::vertices), packed mesh after mesh: positions,
-  /// then normals, vertexCapacity * 3 floats each; each Renderer copies them.
-  std::vector<float> kept;
-  uint32_t keptVertices = 0;
+  /// The shapes carry the host's first vertices (HostScene::vertices), and
+  /// each Renderer keeps a copy for the host to rewrite.
+  bool keep = false;
 };
 
 Scene::Scene(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
@@ -235,18 +234,8 @@ scene::Shape toShape(const Mesh& m, int index, size_t materials, const std::stri
   return shape;
 }
 
-// The box around `count` packed float triples; NaN and infinite vertices are
-// left out (the trees drop their triangles too).
-void boundsOf(const float* xyz, uint32_t count, glm::vec3& lo, glm::vec3& hi) {
-  lo = glm::vec3(INFINITY), hi = glm::vec3(-INFINITY);
-  for (uint32_t v = 0; v < count; ++v) {
-    glm::vec3 p(xyz[3 * v], xyz[3 * v + 1], xyz[3 * v + 2]);
-    if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) continue;
-    lo = glm::min(lo, p), hi = glm::max(hi, p);
-  }
-}
-
-// Packs HostScene::vertices into `impl`, numbering the meshes' vertices one after another.
+// Gives each mesh its vertices from HostScene::vertices: the scene's shapes
+// are then snell's own, with a rest pose each Renderer keeps a copy of.
 void keepVertices(const HostScene& host, Scene::Impl& impl) {
   if (host.vertices.size() != host.meshes.size()) {
     throw Error(host.name + ": " + std::to_string(host.vertices.size()) + " vertex lists for " +
@@ -255,9 +244,6 @@ void keepVertices(const HostScene& host, Scene::Impl& impl) {
   uint64_t total = 0;
   for (const Mesh& m : host.meshes) total += m.vertexCount;
   if (total > (1u << 31) / 3) throw Error(host.name + ": " + std::to_string(total) + " vertices are too many for one scene");
-  impl.keptVertices = uint32_t(total);
-  impl.kept.assign(size_t(total) * 6, 0.0f);
-  uint32_t first = 0;
   for (size_t i = 0; i < host.meshes.size(); ++i) {
     const Mesh& m = host.meshes[i];
     const MeshVertices& v = host.vertices[i];
@@ -267,13 +253,14 @@ void keepVertices(const HostScene& host, Scene::Impl& impl) {
       throw Error(where + ": " + std::to_string(v.positions.size()) + " position and " + std::to_string(v.normals.size()) +
                   " normal floats for " + std::to_string(m.vertexCount) + " vertices (3 each)");
     }
-    std::copy(v.positions.begin(), v.positions.end(), impl.kept.begin() + ptrdiff_t(first) * 3);
-    std::copy(v.normals.begin(), v.normals.end(), impl.kept.begin() + ptrdiff_t(total + first) * 3);
     scene::Shape& shape = impl.scene.shapes[i];
-    shape.host->first = first;
-    boundsOf(v.positions.data(), m.vertexCount, shape.host->lo, shape.host->hi);
-    first += m.vertexCount;
+    shape.host.reset();
+    shape.positions.resize(m.vertexCount);
+    shape.normals.resize(m.vertexCount);
+    std::memcpy(shape.positions.data(), v.positions.data(), v.positions.size() * sizeof(float));
+    std::memcpy(shape.normals.data(), v.normals.data(), v.normals.size() * sizeof(float));
   }
+  impl.keep = true;
 }
 
 // A light's node: it shines down its -Z axis from `position`.
@@ -390,7 +377,7 @@ uint32_t Scene::vertexCount(int mesh) const {
   }
   return uint32_t(impl_->scene.shapes[size_t(mesh)].vertexCount());
 }
-bool Scene::keepsVertices() const { return impl_->keptVertices > 0; }
+bool Scene::keepsVertices() const { return impl_->keep; }
 double Scene::duration() const { return scene::animationDuration(impl_->scene); }
 
 // ---------------------------------------------------------------- Renderer
@@ -447,34 +434,17 @@ scene::View viewFromMatrices(const CameraMatrices& m, uint32_t width, uint32_t h
 
 }  // namespace
 
-namespace {
-std::function<void(vk::Commands&)> uploadsOf(Renderer::Impl& impl);
-}  // namespace
-
-// The GPU copies of a kept scene's vertices (Scene::keepsVertices): buffers
-// the frames read, and a mapped copy in cached host memory that the host
-// rewrites and snell reads back to bound it.
-struct KeptVertices {
-  vk::Buffer staging;  ///< positions, then normals
-  vk::Buffer positions, normals;
-  uint32_t count = 0;
-  std::set<int> pending;  ///< meshes to copy to the GPU at the next frame
-};
-
 struct Renderer::Impl {
   std::recursive_mutex& mutex;  ///< the Device's
   vk::Context& context;
   Scene::Impl& scene;
   scene::Pose pose;
   std::map<size_t, glm::dmat4> transforms;  ///< setTransform's, kept over setTime
-  std::optional<KeptVertices> kept;
   std::unique_ptr<render::Renderer> renderer;
   FrameInfo last;
   std::string method;      ///< the last request's method
   std::optional<render::AutoMethod> chooser;  ///< method "auto": trace or driver-rt, timed over the first frames
   render::Method drawn = render::Method::Trace;  ///< the last request's method before the viewport's substitutions
-  uint32_t uploading = 0;  ///< kept meshes the frame being recorded copies
-  bool composite = false;  ///< the last request draws the viewport composite (render() blits it)
 
   Impl(Device& device, Scene& s, const RendererOptions& options)
       : mutex(device.impl().mutex), context(*device.impl().context), scene(s.impl()),
@@ -484,35 +454,8 @@ struct Renderer::Impl {
     o.framesInFlight = options.framesInFlight;
     o.passTimes = options.passTimes;
     o.host = scene.host;
-    if (scene.keptVertices > 0) {
-      KeptVertices& k = kept.emplace();
-      k.count = scene.keptVertices;
-      VkDeviceSize bytes = VkDeviceSize(k.count) * 12;
-      k.staging = vk::Buffer(context, {2 * bytes, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, vk::MemoryDomain::Readback,
-                                       scene.scene.source + " vertices (host copy)"});
-      std::memcpy(k.staging.mapped().data(), scene.kept.data(), 2 * bytes);
-      const VkBufferUsageFlags usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT;
-      k.positions = vk::Buffer(context, {bytes, usage, vk::MemoryDomain::Device, scene.scene.source + " positions"});
-      k.normals = vk::Buffer(context, {bytes, usage, vk::MemoryDomain::Device, scene.scene.source + " normals"});
-      for (size_t i = 0; i < scene.scene.shapes.size(); ++i) k.pending.insert(int(i));
-      o.host = {k.positions.handle(), k.normals.handle(), k.count};
-    }
+    o.keepVertices = scene.keep;
     renderer = std::make_unique<render::Renderer>(context, scene.scene, pose, o);
-  }
-
-  // Records the copies of the kept meshes rewritten since the last frame.
-  void recordUploads(vk::Commands& commands) {
-    uploading = 0;
-    if (!kept || kept->pending.empty()) return;
-    const VkDeviceSize normalsAt = VkDeviceSize(kept->count) * 12;
-    for (int mesh : kept->pending) {
-      const scene::HostVertices& h = *scene.scene.shapes[size_t(mesh)].host;
-      VkDeviceSize at = VkDeviceSize(h.first) * 12, bytes = VkDeviceSize(h.count) * 12;
-      commands.copyBuffer(kept->staging, kept->positions, bytes, at, at);
-      commands.copyBuffer(kept->staging, kept->normals, bytes, normalsAt + at, at);
-    }
-    uploading = uint32_t(kept->pending.size());
-    kept->pending.clear();
   }
 
   // The renderer's request for a view of the current pose.
@@ -568,12 +511,6 @@ struct Renderer::Impl {
   void bakeMap(const render::FrameSettings& settings) {
     const render::RefractionMapBuffer& map = renderer->refractionMap();
     if (map.width == settings.width && map.height == settings.height) return;
-    if (kept && !kept->pending.empty()) {  // the bake's frame has no prologue: copy the vertices first
-      render::FrameRequest flush;
-      flush.pose = &pose;
-      flush.prologue = uploadsOf(*this);
-      renderer->wait(renderer->submit(flush));
-    }
     render::FrameSettings traced = settings;
     traced.backgroundAlpha = 1.0f;
     renderer->bakeRefractionMap(pose, traced);
@@ -588,23 +525,13 @@ struct Renderer::Impl {
     last.pixelsTraced = s.pixelsTraced;
     last.skipped = s.viewsSkipped > 0;
     last.itemsDeformed = s.itemsDeformed;
-    last.meshesUploaded = uploading;
+    last.meshesUploaded = s.shapesCopied;
     last.topLevelBuilt = s.topLevelBuilt > 0, last.topLevelRefit = s.topLevelRefit > 0;
     last.dispatches = s.dispatches, last.draws = s.draws;
     last.method = method;
     for (const vk::PassTime& p : result.passes) last.passes.push_back(PassTime{p.name, p.milliseconds});
   }
 };
-
-namespace {
-
-// A frame's prologue: the kept vertices' copies. Made here, in an unnamed
-// namespace, so its type stays out of libsnell.so's exported symbols.
-std::function<void(vk::Commands&)> uploadsOf(Renderer::Impl& impl) {
-  return [&impl](vk::Commands& commands) { impl.recordUploads(commands); };
-}
-
-}  // namespace
 
 Renderer::Renderer(Device& device, Scene& scene, const RendererOptions& options)
     : impl_(guarded([&] { return std::make_unique<Impl>(device, scene, options); })) {}
@@ -641,30 +568,22 @@ void Renderer::setTransform(size_t instance, const Mat4& transform) {
 void Renderer::markDirty(int mesh) {
   guarded([&] {
     std::lock_guard lock(impl_->mutex);
+    if (mesh < 0 || size_t(mesh) >= impl_->scene.scene.shapes.size()) {
+      throw Error("markDirty: no mesh " + std::to_string(mesh) + " of " + std::to_string(impl_->scene.scene.shapes.size()));
+    }
     impl_->renderer->markDirty(mesh);
-    if (!impl_->kept) return;
-    // The kept copy is the truth now: copy it at the next frame, and bound it
-    // (the trees' culling and the depth range need the box).
-    impl_->kept->pending.insert(mesh);
-    const scene::HostVertices& h = *impl_->scene.scene.shapes[size_t(mesh)].host;
-    const auto* xyz = reinterpret_cast<const float*>(impl_->kept->staging.mapped().data());
-    glm::vec3 lo, hi;
-    boundsOf(xyz + size_t(h.first) * 3, h.count, lo, hi);
-    impl_->renderer->setShapeBounds(mesh, glm::dvec3(lo), glm::dvec3(hi));
   });
 }
 
 Vertices Renderer::vertices(int mesh) {
   return guarded([&] {
     std::lock_guard lock(impl_->mutex);
-    if (!impl_->kept) throw Error("vertices: the scene's vertices are the host's own (only a HostScene without buffers has kept ones)");
+    if (!impl_->scene.keep) throw Error("vertices: the scene's vertices are the host's own (only a HostScene without buffers has kept ones)");
     if (mesh < 0 || size_t(mesh) >= impl_->scene.scene.shapes.size()) {
       throw Error("vertices: no mesh " + std::to_string(mesh) + " of " + std::to_string(impl_->scene.scene.shapes.size()));
     }
-    impl_->renderer->finish();  // no frame in flight reads the copy the host is about to write
-    const scene::HostVertices& h = *impl_->scene.scene.shapes[size_t(mesh)].host;
-    auto* xyz = reinterpret_cast<float*>(impl_->kept->staging.mapped().data());
-    return Vertices{xyz + size_t(h.first) * 3, xyz + (size_t(impl_->kept->count) + h.first) * 3, h.count};
+    render::KeptVertices kept = impl_->renderer->keptVertices(mesh);  // waits for the frames that read them
+    return Vertices{kept.positions, kept.normals, kept.count};
   });
 }
 
@@ -677,36 +596,15 @@ uint64_t Renderer::render(const View& view, const Target& target, const Sync& sy
                   ", the view " + std::to_string(view.width) + "x" + std::to_string(view.height));
     }
     render::Renderer& renderer = *impl_->renderer;
-    auto blit = [&](vk::Commands& commands) {
-      const render::ViewImages& images = renderer.viewImages(0);
-      const vk::Image& source = images.composite.handle() && impl_->composite ? images.composite : images.trace;
-      // The view's image lives in GENERAL; a blit reads best from TRANSFER_SRC_OPTIMAL.
-      commands.imageBarrier(source.handle(), VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_LAYOUT_GENERAL,
-                            VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT,
-                            VK_ACCESS_MEMORY_WRITE_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_READ_BIT);
-      commands.imageBarrier(target.image, VK_IMAGE_ASPECT_COLOR_BIT, target.layoutBefore,
-                            VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, 0,
-                            VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT);
-      VkImageBlit region{};
-      region.srcSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
-      region.dstSubresource = region.srcSubresource;
-      region.srcOffsets[1] = {int32_t(view.width), int32_t(view.height), 1};
-      region.dstOffsets[1] = region.srcOffsets[1];
-      vkCmdBlitImage(commands.handle(), source.handle(), VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, target.image,
-                     VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &region, VK_FILTER_NEAREST);
-      commands.imageBarrier(source.handle(), VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
-                            VK_IMAGE_LAYOUT_GENERAL, VK_PIPELINE_STAGE_TRANSFER_BIT, 0,
-                            VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, VK_ACCESS_MEMORY_READ_BIT | VK_ACCESS_MEMORY_WRITE_BIT);
-      commands.imageBarrier(target.image, VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
-                            target.layoutAfter, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT,
-                            VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, VK_ACCESS_MEMORY_READ_BIT | VK_ACCESS_MEMORY_WRITE_BIT);
-    };
     render::FrameRequest frame;
     frame.pose = &impl_->pose;
     frame.views.push_back(impl_->request(view));
-    impl_->composite = frame.views.back().output == render::ViewOutput::Composite;
-    frame.prologue = uploadsOf(*impl_);
-    frame.record = blit;
+    const bool composite = frame.views.back().output == render::ViewOutput::Composite;
+    frame.record = [&](vk::Commands& commands) {
+      const render::ViewImages& images = renderer.viewImages(0);
+      commands.blitToImage(composite ? images.composite : images.trace,
+                           {target.image, target.width, target.height, target.layoutBefore, target.layoutAfter});
+    };
     frame.waitSemaphore = sync.wait;
     frame.waitStage = sync.wait ? sync.waitStage : 0;
     frame.signalSemaphore = sync.signal;
@@ -734,10 +632,9 @@ void Renderer::read(const View& view, float* rgba) {
     render::FrameRequest frame;
     frame.pose = &impl_->pose;
     frame.views.push_back(impl_->request(view));
-    frame.views.back().readback.enabled = true;
-    frame.views.back().readback.half = true;  // converted once, straight into the host's memory
-    frame.views.back().readback.trace = false;  // a composite's own picture is all the host asked for
-    frame.prologue = uploadsOf(*impl_);
+    // Half floats, converted once, straight into the host's memory; a
+    // composite's own picture is all the host asked for.
+    frame.readbacks.push_back({.view = 0, .half = true, .trace = false});
     bool composite = frame.views.back().output == render::ViewOutput::Composite;
     const render::FrameResult& result = impl_->renderer->wait(impl_->renderer->submit(frame));
     impl_->note(result);
@@ -763,8 +660,7 @@ Aovs Renderer::readAovs(const View& view) {
     frame.views.push_back(impl_->request(traced));
     render::ViewRequest& request = frame.views.back();
     request.aov = true;
-    request.readback.enabled = true;
-    frame.prologue = uploadsOf(*impl_);
+    frame.readbacks.push_back({.view = 0});
     const render::FrameResult& result = impl_->renderer->wait(impl_->renderer->submit(frame));
     impl_->note(result);
     const render::ViewPixels& pixels = result.views.at(0);
@@ -782,9 +678,7 @@ Aovs Renderer::readAovs(const View& view) {
     out.cost.resize(count);
     const scene::Scene& model = impl_->scene.scene;
     auto kept = [&](int shape) -> const float* {
-      if (!impl_->kept) return nullptr;
-      const auto* xyz = reinterpret_cast<const float*>(impl_->kept->staging.mapped().data());
-      return xyz + size_t(model.shapes[size_t(shape)].host->first) * 3;
+      return impl_->scene.keep ? impl_->renderer->keptVertices(shape).positions : nullptr;
     };
     render::FaceNormals normals(model, impl_->pose, kept);
     const std::vector<render::PixelHit> hits = render::pixelHits(pixels.aov);

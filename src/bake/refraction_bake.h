@@ -7,6 +7,7 @@
 #include "bake/refraction_map.h"
 #include "render/refraction_map.h"
 #include "render/raster_pass.h"
+#include "render/one_view.h"
 #include "render/renderer.h"
 #include "scene/evaluate.h"
 #include "scene/scene.h"

@@ -5,6 +5,7 @@
 #include "bake/map_file.h"
 #include "bake/refraction_bake.h"
 #include "io/image_file.h"
+#include "render/one_view.h"
 #include "render/renderer.h"
 #include "scene/evaluate.h"
 

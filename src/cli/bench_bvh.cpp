@@ -5,6 +5,7 @@
 #include "io/json.h"
 
 #include "ref/sah_bvh.h"
+#include "render/one_view.h"
 #include "render/renderer.h"
 #include "scene/evaluate.h"
 #include "scene/gltf_loader.h"

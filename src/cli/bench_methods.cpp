@@ -375,11 +375,11 @@ int runMethods(const Options& o) {
     settings.optics = row.optics;
     render::RasterOptions raster = frame.raster;
     render::ViewRequest view = render::methodView(row.info.method, settings, raster);
-    view.readback.enabled = readback;
     view.aov = readback && hitsOf(row.info.method);
     render::FrameRequest r;
     r.pose = &frame.pose;
     r.views.push_back(view);
+    if (readback) r.readbacks.push_back({.view = 0});
     return r;
   };
   auto timed = [](MethodResult& result, const render::FrameResult& out) {

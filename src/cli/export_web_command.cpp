@@ -217,10 +217,10 @@ int runExportWeb(const Options& o) {
 
   // The viewport's picture at the baked pose, for everything but the glass that lands.
   render::ViewRequest request = render::methodView(render::Method::RefractionMap, settings, render::RasterOptions{});
-  request.readback.enabled = true;
   render::FrameRequest frame;
   frame.pose = &pose;
   frame.views.push_back(request);
+  frame.readbacks.push_back({.view = 0});
   std::vector<glm::vec4> picture = renderer.wait(renderer.submit(frame)).views.at(0).composite;
 
   size_t pixels = baked.texels.size();

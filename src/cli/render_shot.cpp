@@ -261,12 +261,11 @@ class Worker {
       // Coverage (EXR alpha) comes from the trace's AOV, so an EXR trace asks for it.
       const bool wantAov = o_.exr() && !render::drawsComposite(*o_.method) && *o_.method != render::Method::DriverRt;
       render::ViewRequest request = render::methodView(method, settings, raster);
-      request.readback.enabled = true;
-      request.readback.half = true;
       request.aov = request.aov || wantAov;
       render::FrameRequest frame;
       frame.pose = &pose;
       frame.views.push_back(request);
+      frame.readbacks.push_back({.view = 0, .half = true});
       auto waitStart = Clock::now();
       const render::FrameResult& result = renderer_->wait(renderer_->submit(frame));
       report_.gpuWaitSeconds += secondsSince(waitStart);

@@ -37,9 +37,9 @@ glm::vec3 FaceNormals::of(uint32_t item, uint32_t triangle) {
   auto [at, fresh] = items_.try_emplace(item);
   Deformed& d = at->second;
   if (fresh) {
-    if (shape.host) {
-      const float* xyz = hostPositions_ ? hostPositions_(drawn.shape) : nullptr;
-      for (uint32_t v = 0; xyz && v < shape.host->count; ++v) {
+    const float* xyz = hostPositions_ ? hostPositions_(drawn.shape) : nullptr;
+    if (xyz || shape.host) {
+      for (size_t v = 0; xyz && v < shape.vertexCount(); ++v) {
         d.positions.emplace_back(xyz[3 * v], xyz[3 * v + 1], xyz[3 * v + 2]);
       }
     } else {

@@ -36,8 +36,10 @@ double cameraDepth(const scene::View& view, uint32_t width, uint32_t height, siz
 /// draw item's vertices at a pose (deformed once per item, in double).
 class FaceNormals {
  public:
-  /// Positions of a shape whose vertices the host keeps (scene::Shape::host):
-  /// its packed float triples, or null where they are not known.
+  /// Positions of a shape as the host last wrote them (in its own buffers,
+  /// scene::Shape::host, or kept ones): packed float triples, or null where
+  /// the host wrote none (then a host shape's are unknown, and another's are
+  /// its rest pose as snell deforms it).
   using HostPositions = std::function<const float*(int shape)>;
 
   FaceNormals(const scene::Scene& scene, const scene::Pose& pose, HostPositions hostPositions = {});

@@ -17,116 +17,30 @@
 
 #include "render/bvh.h"
 #include "render/deform_pass.h"
+#include "render/frame_request.h"
 #include "render/frame_settings.h"
+#include "render/kept_vertices.h"
 #include "render/raster_pass.h"
+#include "render/refraction_map.h"
 #include "render/scene_gpu.h"
 #include "render/scene_state.h"
+#include "render/scene_trees.h"
 #include "render/trace_pass.h"
+#include "render/view_targets.h"
 #include "scene/evaluate.h"
 #include "scene/scene.h"
-#include "scene/view.h"
 #include "shared/trace.h"
 #include "vk/buffer.h"
 #include "vk/commands.h"
-#include "vk/compute_program.h"
 #include "vk/context.h"
-#include "vk/upload_arena.h"
 
 #include <glm/glm.hpp>
 
-#include <deque>
-#include <functional>
-#include <map>
 #include <memory>
+#include <string>
 #include <vector>
 
 namespace snell::render {
-
-enum class ViewOutput {
-  Trace,      ///< every pixel traced (the CLI's default image, the golden tests)
-  Composite,  ///< the viewport: raster pass, transmissive pixels traced
-};
-
-/// What a view brings back to the host with its frame. It never changes
-/// what the view draws, so it takes no part in comparing requests.
-struct ReadbackRequest {
-  bool enabled = false;  ///< bring the images (and AOV) back with the frame
-  /// Keep the images as the GPU's half floats (ViewPixels::*Half), for
-  /// writers that convert them once, straight to the file's encoding.
-  bool half = false;
-  /// A composite's trace image too (off: the composite alone).
-  bool trace = true;
-  friend bool operator==(const ReadbackRequest&, const ReadbackRequest&) { return true; }
-};
-
-/// One view of a frame.
-struct ViewRequest {
-  FrameSettings settings;
-  ViewOutput output = ViewOutput::Trace;
-  RasterOptions raster;  ///< composite only
-  /// Composite only: trace just the pixels whose visible face is transmissive
-  /// (off: trace every pixel, so the trace image is whole, for tests).
-  bool masked = true;
-  /// Trace output only: the closest hits come from the driver's own ray
-  /// tracing (the driver-rt peer; needs DeviceCaps::driverRayTracing).
-  bool driverTrace = false;
-  bool aov = false;       ///< per-pixel gpu::TraceAov of the traced pixels
-  ReadbackRequest readback;
-
-  /// Two requests that compare equal draw the same image: a frame may reuse
-  /// the last one (every field counts, so a new field can never reuse a stale image).
-  friend bool operator==(const ViewRequest&, const ViewRequest&) = default;
-};
-
-/// What one frame did and skipped.
-struct FrameStats {
-  uint64_t frame = 0;
-  uint32_t itemsDeformed = 0, itemsDeformSkipped = 0;
-  uint32_t treesBuilt = 0, treesRefit = 0, treesSkipped = 0;  ///< bottom level
-  uint64_t trianglesBuilt = 0, trianglesRefit = 0;
-  uint32_t topLevelBuilt = 0, topLevelRefit = 0, topLevelSkipped = 0;
-  uint32_t viewsRendered = 0, viewsSkipped = 0;
-  uint32_t traceDispatches = 0;  ///< trace dispatches recorded (a masked one may find no pixel)
-  uint64_t pixelsTraced = 0;     ///< counted on the GPU
-  uint32_t dispatches = 0, draws = 0;
-  uint32_t droppedTriangles = 0;  ///< non-finite triangles left out of this frame's trees
-  bool rebased = false;           ///< the frame origin moved this frame
-  /// The largest SAH cost of a refitted bottom-level tree over its cost just
-  /// after its build (1: as good as new); past RendererOptions::rebuildGrowth it is rebuilt.
-  double sahGrowth = 1.0;
-};
-
-/// A view's pixels as the frame left them, brought back when asked.
-struct ViewPixels {
-  uint32_t width = 0, height = 0;
-  std::vector<glm::vec4> trace;      ///< the trace image, linear RGBA, row 0 at the top
-  std::vector<glm::vec4> composite;  ///< composite views
-  std::vector<gpu::TraceAov> aov;    ///< when asked for
-  /// ReadbackRequest::half: the same images as 4 IEEE halves per pixel (then trace and composite stay empty).
-  std::vector<uint16_t> traceHalf, compositeHalf;
-};
-
-struct FrameResult {
-  FrameStats stats;
-  std::vector<vk::PassTime> passes;
-  std::vector<ViewPixels> views;  ///< per view asked to read back (empty otherwise)
-};
-
-/// What a frame is asked to do.
-struct FrameRequest {
-  const scene::Pose* pose = nullptr;
-  std::vector<ViewRequest> views;
-  /// Records work before the frame's own (a host's copy of new vertices into
-  /// the buffers the frame reads); the frame's first barrier makes it visible.
-  std::function<void(vk::Commands&)> prologue;
-  /// Records more work after the views (a viewer's display pass and UI),
-  /// once every view's images are written.
-  std::function<void(vk::Commands&)> record;
-  /// A swapchain's semaphores: waited for at `waitStage`, signalled at the end.
-  VkSemaphore waitSemaphore = VK_NULL_HANDLE;
-  VkPipelineStageFlags waitStage = 0;
-  VkSemaphore signalSemaphore = VK_NULL_HANDLE;
-};
 
 struct RendererOptions {
   /// Frames the host records ahead of the GPU; host-written data has a copy per frame.
@@ -138,22 +52,16 @@ struct RendererOptions {
   uint64_t rebuildBudget = 1u << 20;
   /// A host scene's vertex buffers (every shape a host shape); null handles: none.
   HostBuffers host;
+  /// Keep a host copy of every static shape's vertices for the caller to
+  /// rewrite (Renderer::keptVertices, then markDirty): the next frame copies
+  /// what changed to the GPU before its own work.
+  bool keepVertices = false;
   /// GPU timestamps around every pass (FrameResult::passes); off, a frame records none.
   bool passTimes = true;
   /// Each frame as if it were the renderer's first: the origin at its camera,
   /// every tree built afresh. Its pixels then depend on nothing drawn before
   /// it, so a farm's chunks and retries agree bit for bit, for a build a frame.
   bool independentFrames = false;
-};
-
-/// The images of one view; they keep the last frame's result until the next frame that renders the view.
-struct ViewImages {
-  uint32_t width = 0, height = 0;
-  vk::Image trace;           ///< rgba16f, storage
-  vk::Image composite;       ///< kCompositeFormat (composite views)
-  vk::Image depth, mask;     ///< the pre-pass's (composite views)
-  vk::Buffer pixels;         ///< the masked trace's pixel list
-  vk::Buffer aov;            ///< gpu::TraceAov per pixel, when asked for
 };
 
 class Renderer {
@@ -176,17 +84,18 @@ class Renderer {
 
   /// The images of view `index` (valid once a frame rendered it; a view's
   /// images are rewritten by later frames that render it).
-  const ViewImages& viewImages(size_t index) const;
+  const ViewImages& viewImages(size_t index) const { return targets_.images(index); }
 
-  /// The host rewrote shape `shape`'s vertices in its buffers (RendererOptions::host):
-  /// the next frame refits its tree and redraws every view.
+  /// Static shape `shape`'s vertices as the renderer keeps them
+  /// (RendererOptions::keepVertices). Waits for the frames in flight, so
+  /// none reads them while the caller rewrites them.
+  KeptVertices keptVertices(int shape);
+  /// Shape `shape`'s vertices changed (kept ones, or the host's in its own
+  /// buffers): the next frame copies kept ones, refits its tree and redraws
+  /// every view. A shape without a host's promised box is not culled until a
+  /// refit has measured its new box.
   void markDirty(int shape);
-  /// A host shape's vertices now lie in this box (its space), for culling;
-  /// an empty box (lo > hi) says nothing, and the shape is never culled.
-  void setShapeBounds(int shape, const glm::dvec3& lo, const glm::dvec3& hi);
 
-  /// Forces the next frame that needs trees to rebuild every tree.
-  void invalidateTrees();
   /// The refraction-map method's map for view `view` of later frames: every
   /// pixel of `settings` traced at `pose` with its AOVs, and baked (waits for
   /// the GPU). The renderer keeps the last one baked per view on the GPU,
@@ -207,33 +116,35 @@ class Renderer {
   /// (else a composite never traces).
   bool seeThrough() const { return seeThrough_; }
   /// The trees, built by the first frame that traces (null before).
-  const Bvh* blas() const { return blas_.get(); }
-  const Bvh* tlas() const { return tlas_.get(); }
-  BvhBuilder* builder() { return builder_.get(); }
-  /// The last update's instances (gpu::GpuInstance, rebased to the origin) and lights (gpu::GpuLight).
-  const vk::Buffer& instances() const { return instances_; }
-  const vk::Buffer& lights() const { return lights_; }
-  uint32_t lightCount() const { return lightCount_; }
+  const Bvh* blas() const { return trees_.blas(); }
+  const Bvh* tlas() const { return trees_.tlas(); }
+  BvhBuilder* builder() { return trees_.builder(); }
   /// GPU memory of geometry, deformation, trees and per-frame tables (not view images).
   uint64_t memoryBytes() const;
   /// The driver's statistics of the trace pipelines made so far (vk::ContextDesc::pipelineStatistics).
   std::vector<std::string> pipelineStatistics() const;
   /// Bytes of tree memory (both levels) per bottom-level triangle, build scratch apart.
-  double treeBytesPerTriangle() const;
+  double treeBytesPerTriangle() const { return trees_.treeBytesPerTriangle(); }
 
  private:
   struct Slot;
-  struct View;
+  struct ViewPlan;
+  struct ViewState;
   struct Update;
-  void prepareTrees();
-  Update planUpdate(const scene::Pose& pose, const std::vector<ViewRequest>& views, FrameStats& stats);
+  ViewPlan plan(const ViewRequest& request) const;
+  Update planUpdate(const scene::Pose& pose, const FrameRequest& request, const std::vector<ViewPlan>& plans,
+                    Slot& slot);
+  void planDeform(const scene::Pose& pose, Update& update, FrameStats& stats);
   void recordUpdate(vk::Commands& commands, Slot& slot, const scene::Pose& pose, const Update& update);
-  void recordView(vk::Commands& commands, Slot& slot, size_t index, const ViewRequest& request, FrameStats& stats);
-  /// The view's trace, by snell's own traversal or (driverTrace) the driver's.
-  void recordTrace(vk::Commands& commands, const ViewRequest& request, View& view, bool masked, FrameStats& stats);
+  void recordView(vk::Commands& commands, Slot& slot, size_t index, const ViewRequest& request, const ViewPlan& plan);
+  /// The view's trace, by snell's own traversal or (plan.driver) the driver's.
+  void recordTrace(vk::Commands& commands, size_t index, const ViewRequest& request, const ViewPlan& plan,
+                   FrameStats& stats);
+  void recordReadbacks(vk::Commands& commands, Slot& slot, const FrameRequest& request);
+  void recordStatistics(vk::Commands& commands, Slot& slot, size_t views);
   void collect(Slot& slot);
-  bool viewNeedsTrees(const ViewRequest& request) const;
-  bool transmissiveInView(const FrameSettings& settings) const;
+  /// Bottom-level group `geometry`'s positions changed.
+  void noteMoved(uint32_t geometry);
 
   vk::Context& context_;
   const scene::Scene& sceneModel_;
@@ -242,12 +153,13 @@ class Renderer {
   std::unique_ptr<DeformPass> deform_;
   std::unique_ptr<RasterPass> raster_;
   std::unique_ptr<TracePass> trace_;
-  std::unique_ptr<BvhBuilder> builder_;
-  std::unique_ptr<Bvh> blas_, tlas_;
+  SceneTrees trees_;
   vk::Buffer instances_, lights_;
   uint32_t lightCount_ = 0;
   bool seeThrough_ = false;
   std::vector<RefractionMapBuffer> maps_;  ///< per view index, baked by bakeRefractionMap
+  ViewTargets targets_;
+  std::vector<ViewState> views_;  ///< per view index: what it last drew
 
   // What the GPU holds, to find what changed.
   struct ItemState {
@@ -259,51 +171,14 @@ class Renderer {
   std::vector<uint32_t> itemDeformOutput_; ///< per pose item: its DeformPass output, or ~0
   std::vector<gpu::GpuInstance> uploadedInstances_;
   std::vector<gpu::GpuLight> uploadedLights_;
-  std::vector<char> geometryDirty_;  ///< per bottom-level group: positions changed since its tree last saw them
-  bool treesBuilt_ = false, topDirty_ = true, topBuilt_ = false;
   uint64_t sceneVersion_ = 0;  ///< bumps whenever what a view shows may have changed
   SceneBounds bounds_;
   FrameOrigin origin_;
-  RebuildQueue rebuilds_;
+
+  std::unique_ptr<KeptVertexCopy> kept_;  ///< RendererOptions::keepVertices
 
   std::vector<std::unique_ptr<Slot>> slots_;
-  std::vector<View> views_;
   uint64_t submitted_ = 0;
 };
-
-/// A frame brought back to the host: linear RGBA, row 0 at the top.
-struct RenderedFrame {
-  uint32_t width = 0, height = 0;
-  std::vector<glm::vec4> rgba;
-  std::vector<gpu::TraceAov> aov;  ///< empty unless asked for
-  /// Triangles left out of this frame's tree because deformation made a vertex
-  /// NaN or infinite (all triangles are checked on a build, deforming ones on a refit).
-  uint32_t droppedTriangles = 0;
-  std::vector<vk::PassTime> passes;
-  FrameStats stats;
-};
-
-/// Renders one view's trace of every pixel and reads it back (waits for the GPU).
-RenderedFrame renderFrame(Renderer& renderer, const scene::Pose& pose, const FrameSettings& settings,
-                          bool withAov = false);
-
-/// A traced frame and its raster composite, read back (tests, `snell render --viewport`).
-struct CompositeFrame {
-  RenderedFrame trace;          ///< the trace image (whole unless masked) and its AOV
-  std::vector<glm::vec4> rgba;  ///< the composite, row 0 at the top
-};
-
-/// Renders one viewport composite (update, trace, raster) and reads both images back.
-CompositeFrame renderComposite(Renderer& renderer, const scene::Pose& pose, const FrameSettings& settings,
-                               const RasterOptions& options, bool withAov = false, bool masked = false);
-
-/// The refraction-map method's map of `settings` at `pose`, traced and baked
-/// on the host only (waits for the GPU), for a map file;
-/// Renderer::bakeRefractionMap also keeps it on the GPU for the raster pass.
-RefractionBake bakeRefraction(Renderer& renderer, const scene::Pose& pose, const FrameSettings& settings);
-
-/// Checks a requested image size against the device: throws
-/// std::invalid_argument saying what is wrong.
-void checkImageSize(const vk::Context& context, uint32_t width, uint32_t height);
 
 }  // namespace snell::render

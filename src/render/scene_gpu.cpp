@@ -1,10 +1,9 @@
 // Packing a scene into the buffers the passes read (shaders/shared/trace.h).
 #include "render/scene_gpu.h"
 
+#include "render/deform_pass.h"
 #include "scene/scene_summary.h"
-
 #include "scene/texture_mips.h"
-
 #include "shared/trace.h"
 #include "vk/commands.h"
 #include "vk/compute_program.h"
@@ -12,6 +11,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstring>
 #include <stdexcept>
 #include <string>
@@ -321,6 +321,54 @@ SceneGpu uploadScene(vk::Context& context, const scene::Scene& scene, const scen
   uploadTextures(context, scene, place, gpu);
   gpu.textureUploadSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return gpu;
+}
+
+namespace {
+
+// A matrix's top three rows, as the shaders read an affine transform.
+void rows(const glm::dmat4& m, glm::vec4 out[3]) {
+  for (int r = 0; r < 3; ++r) out[r] = glm::vec4(glm::dvec4(m[0][r], m[1][r], m[2][r], m[3][r]));
+}
+
+}  // namespace
+
+std::vector<gpu::GpuInstance> SceneGpu::packInstances(const scene::Pose& pose, const glm::dvec3& origin) const {
+  std::vector<gpu::GpuInstance> instances(pose.items.size());
+  for (size_t i = 0; i < pose.items.size(); ++i) {
+    const scene::DrawItem& item = pose.items[i];
+    // Skinned positions come out of the deform pass relative to the item's anchor.
+    glm::dmat4 toWorld = item.world;
+    if (item.skinned) toWorld = glm::dmat4(1.0), toWorld[3] = glm::dvec4(DeformPass::anchorOf(item), 1.0);
+    toWorld[3] -= glm::dvec4(origin, 0.0);
+    gpu::GpuInstance& inst = instances[i];
+    rows(toWorld, inst.objectToWorld);
+    rows(glm::inverse(toWorld), inst.worldToObject);
+    inst.geometry = itemGeometry[i];
+    inst.material = itemMaterial[i];
+  }
+  return instances;
+}
+
+std::vector<gpu::GpuLight> SceneGpu::packLights(const scene::Scene& scene, const scene::Pose& pose,
+                                                const glm::dvec3& origin) {
+  std::vector<gpu::GpuLight> lights;
+  for (size_t n = 0; n < scene.nodes.size() && n < pose.world.size(); ++n) {
+    int index = scene.nodes[n].light;
+    if (index < 0 || size_t(index) >= scene.lights.size()) continue;
+    const scene::Light& light = scene.lights[size_t(index)];
+    glm::dmat4 world(pose.world[n]);
+    gpu::GpuLight g{};
+    uint32_t type = light.type == scene::LightType::Directional ? gpu::kLightDirectional
+                    : light.type == scene::LightType::Point     ? gpu::kLightPoint
+                                                                : gpu::kLightSpot;
+    g.positionType = glm::vec4(glm::vec3(glm::dvec3(world[3]) - origin), float(type));
+    glm::dvec3 direction = -glm::normalize(glm::dvec3(world[2]));
+    g.direction = glm::vec4(glm::vec3(direction), std::isfinite(light.range) ? light.range : 0.0f);
+    g.radiance = glm::vec4(light.color * light.intensity, 0.0f);
+    g.cone = glm::vec4(std::cos(light.innerConeAngle), std::cos(light.outerConeAngle), 0.0f, 0.0f);
+    lights.push_back(g);
+  }
+  return lights;
 }
 
 void SceneGpu::appendBindings(std::vector<vk::BufferBinding>& out, const vk::Buffer& instances,

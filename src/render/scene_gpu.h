@@ -6,10 +6,13 @@
 
 #include "scene/evaluate.h"
 #include "scene/scene.h"
+#include "shared/bvh.h"
 #include "shared/trace.h"
 #include "vk/buffer.h"
 #include "vk/context.h"
 #include "vk/descriptors.h"
+
+#include <glm/glm.hpp>
 
 #include <array>
 #include <cstdint>
@@ -44,6 +47,14 @@ struct SceneGpu {
   std::array<vk::Buffer, gpu::kTexelPages> texelPages;  ///< RGBA8 mip chains (unused pages: 16 bytes)
   uint64_t textureBytes = 0;      ///< GPU memory the texel pages take, mips included
   double textureUploadSeconds = 0.0;  ///< level 0 through the staging ring, then the mips made on the GPU
+
+  /// Each pose item's instance record relative to `origin`, in double until
+  /// the cast, so float data near the camera keeps its precision however far
+  /// the scene is from the world's origin.
+  std::vector<gpu::GpuInstance> packInstances(const scene::Pose& pose, const glm::dvec3& origin) const;
+  /// The lights of `scene`'s nodes at the pose, relative to `origin`.
+  static std::vector<gpu::GpuLight> packLights(const scene::Scene& scene, const scene::Pose& pose,
+                                               const glm::dvec3& origin);
 
   /// Appends the scene binding set (shared/scene.h) with the renderer's
   /// `instances` and `lights`: every pass that reads the scene binds these.

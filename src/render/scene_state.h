@@ -21,7 +21,8 @@ class SceneBounds {
  public:
   explicit SceneBounds(const scene::Scene& scene);
 
-  /// A host shape's vertices now lie in this box (its space); an empty box says nothing.
+  /// A shape's vertices now lie in this box (its space): a host's promise, or
+  /// what a refit measured; an empty box says nothing, and the shape is never culled.
   void setShapeBox(int shape, const glm::dvec3& lo, const glm::dvec3& hi);
   /// Places every item's sphere at the pose (morph weights widen a shape's, skins move it).
   void place(const scene::Pose& pose);

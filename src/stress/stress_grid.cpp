@@ -2,6 +2,7 @@
 // CPU reference) and compared.
 #include "io/image_file.h"
 #include "ref/reference_tracer.h"
+#include "render/one_view.h"
 #include "render/renderer.h"
 #include "stress/stress.h"
 #include "vk/commands.h"

@@ -212,8 +212,8 @@ void Image::release() {
   context_ = nullptr;
 }
 
-uint32_t Image::bytesPerPixel() const {
-  switch (format_) {
+uint32_t formatBytes(VkFormat format) {
+  switch (format) {
     case VK_FORMAT_R8G8B8A8_UNORM:
     case VK_FORMAT_R8G8B8A8_SRGB:
     case VK_FORMAT_B8G8R8A8_UNORM:
@@ -227,8 +227,14 @@ uint32_t Image::bytesPerPixel() const {
     case VK_FORMAT_R32G32B32A32_SFLOAT:
       return 16;
     default:
-      throw VulkanError("image '" + name_ + "' has a format snell cannot size");
+      return 0;
   }
+}
+
+uint32_t Image::bytesPerPixel() const {
+  uint32_t bytes = formatBytes(format_);
+  if (bytes == 0) throw VulkanError("image '" + name_ + "' has a format snell cannot size");
+  return bytes;
 }
 
 }  // namespace snell::vk

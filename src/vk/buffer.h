@@ -79,7 +79,11 @@ struct ImageDesc {
 /// The aspect of an image of `format`: depth for D32_SFLOAT, else colour.
 VkImageAspectFlags aspectOf(VkFormat format);
 
+/// Bytes one pixel takes in a format snell uses (0 for one it does not).
+uint32_t formatBytes(VkFormat format);
+
 /// A 2D VkImage in device memory with a view of its one mip level.
+
 class Image {
  public:
   Image() = default;

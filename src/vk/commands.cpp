@@ -166,16 +166,6 @@ void Commands::computeToGraphics() {
                 VK_PIPELINE_STAGE_VERTEX_SHADER_BIT | VK_PIPELINE_STAGE_FRAGMENT_SHADER_BIT, VK_ACCESS_SHADER_READ_BIT);
 }
 
-void Commands::graphicsToTransfer() {
-  barrier(VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT, VK_ACCESS_COLOR_ATTACHMENT_WRITE_BIT,
-                VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_READ_BIT);
-}
-
-void Commands::transferToTransfer() {
-  barrier(VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT,
-                VK_ACCESS_TRANSFER_READ_BIT | VK_ACCESS_TRANSFER_WRITE_BIT);
-}
-
 void Commands::imageLayout(const Image& image, VkImageLayout from, VkImageLayout to) {
   imageBarrier(image.handle(), aspectOf(image.format()), from, to, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT,
                VK_ACCESS_MEMORY_WRITE_BIT, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT,
@@ -239,6 +229,34 @@ void Commands::copyImageToBuffer(const Image& image, const Buffer& buffer, VkDev
   vkCmdCopyImageToBuffer(buffer_, image.handle(), VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, buffer.handle(), 1, &region);
   imageBarrier(image.handle(), aspect, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, VK_IMAGE_LAYOUT_GENERAL,
                VK_PIPELINE_STAGE_TRANSFER_BIT, 0, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT,
+               VK_ACCESS_MEMORY_READ_BIT | VK_ACCESS_MEMORY_WRITE_BIT);
+}
+
+void Commands::blitToImage(const Image& image, const ImageTarget& target) {
+  if (target.width != image.width() || target.height != image.height()) {
+    throw VulkanError("blit of image '" + image.name() + "' (" + std::to_string(image.width()) + "x" +
+                      std::to_string(image.height()) + ") onto a " + std::to_string(target.width) + "x" +
+                      std::to_string(target.height) + " image");
+  }
+  const VkImageAspectFlags aspect = VK_IMAGE_ASPECT_COLOR_BIT;
+  // Both through the layouts blits are meant for, and back to where they were.
+  imageBarrier(image.handle(), aspect, VK_IMAGE_LAYOUT_GENERAL, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
+               VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, VK_ACCESS_MEMORY_WRITE_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT,
+               VK_ACCESS_TRANSFER_READ_BIT);
+  imageBarrier(target.image, aspect, target.layoutBefore, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
+               VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, 0, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT);
+  VkImageBlit region{};
+  region.srcSubresource = {aspect, 0, 0, 1};
+  region.dstSubresource = region.srcSubresource;
+  region.srcOffsets[1] = {int32_t(image.width()), int32_t(image.height()), 1};
+  region.dstOffsets[1] = region.srcOffsets[1];
+  vkCmdBlitImage(buffer_, image.handle(), VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, target.image,
+                 VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &region, VK_FILTER_NEAREST);
+  imageBarrier(image.handle(), aspect, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, VK_IMAGE_LAYOUT_GENERAL,
+               VK_PIPELINE_STAGE_TRANSFER_BIT, 0, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT,
+               VK_ACCESS_MEMORY_READ_BIT | VK_ACCESS_MEMORY_WRITE_BIT);
+  imageBarrier(target.image, aspect, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, target.layoutAfter,
+               VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT,
                VK_ACCESS_MEMORY_READ_BIT | VK_ACCESS_MEMORY_WRITE_BIT);
 }
 

@@ -20,6 +20,14 @@ struct PassTime {
   double milliseconds = 0;
 };
 
+/// An image someone else owns (a host application's), with the layouts it
+/// is in before a command writes it and must be in after.
+struct ImageTarget {
+  VkImage image = VK_NULL_HANDLE;
+  uint32_t width = 0, height = 0;
+  VkImageLayout layoutBefore = VK_IMAGE_LAYOUT_UNDEFINED, layoutAfter = VK_IMAGE_LAYOUT_GENERAL;
+};
+
 /// Records commands, submits them and waits; reusable after wait().
 class Commands {
  public:
@@ -64,10 +72,6 @@ class Commands {
   /// vertex and fragment shaders of later draws: the one barrier between the
   /// trace and the raster pass.
   void computeToGraphics();
-  /// Colour attachment writes become visible to transfers (readbacks).
-  void graphicsToTransfer();
-  /// Transfer writes become visible to later transfers.
-  void transferToTransfer();
   /// Any other dependency: writes of `srcAccess` at `srcStage` become visible
   /// to `dstAccess` at `dstStage`.
   void barrier(VkPipelineStageFlags srcStage, VkAccessFlags srcAccess, VkPipelineStageFlags dstStage,
@@ -89,6 +93,10 @@ class Commands {
   void updateBuffer(const Buffer& buffer, const void* data, VkDeviceSize bytes, VkDeviceSize offset = 0);
   /// Copies a whole image (GENERAL layout, one mip, one layer) into a buffer, tightly packed.
   void copyImageToBuffer(const Image& image, const Buffer& buffer, VkDeviceSize offset = 0);
+
+  /// Copies a whole colour image (GENERAL) onto another's image of the same
+  /// size (a host's), and leaves each as it found it, `target` in its layoutAfter.
+  void blitToImage(const Image& image, const ImageTarget& target);
 
   /// Starts timing a pass once every earlier command has finished; passes do
   /// not nest; at most 128 per submission. No-op where the queue has no timestamps.
