@@ -442,9 +442,9 @@ struct Renderer::Impl {
   std::map<size_t, glm::dmat4> transforms;  ///< setTransform's, kept over setTime
   std::unique_ptr<render::Renderer> renderer;
   FrameInfo last;
-  std::string method;      ///< the last request's method
-  std::optional<render::AutoMethod> chooser;  ///< method "auto": trace or driver-rt, timed over the first frames
-  render::Method drawn = render::Method::Trace;  ///< the last request's method before the viewport's substitutions
+  std::optional<render::MethodChoice> choice;  ///< the last request's (auto keeps timing while it stays)
+  render::Method drawn = render::Method::Trace;  ///< the last request's method
+  bool viewportShown = false;                    ///< the last request's output was the viewport
 
   Impl(Device& device, Scene& s, const RendererOptions& options)
       : mutex(device.impl().mutex), context(*device.impl().context), scene(s.impl()),
@@ -483,27 +483,23 @@ struct Renderer::Impl {
     settings.optics.dispersion = view.dispersion;
     settings.optics.volume = view.volume;
 
-    std::string name = view.method.empty() ? "auto" : view.method;
-    std::optional<render::Method> chosen = name == "auto" ? std::optional<render::Method>(render::Method::Trace)
-                                                          : render::methodFromName(name);
-    if (!chosen) throw Error("view: no method '" + name + "' (the methods: auto, " + render::methodNames() + ")");
-    render::Method m = *chosen;
-    bool viewportOutput = view.output == View::Output::Viewport;
-    if (name == "auto") {
-      if (!chooser) chooser.emplace(context.caps().driverRayTracing, viewportOutput);
-      m = chooser->next();
+    const std::string name = view.method.empty() ? "auto" : view.method;
+    const bool viewportOutput = view.output == View::Output::Viewport;
+    if (!choice || choice->name() != name || viewportOutput != viewportShown) {
+      try {
+        choice.emplace(name, context.caps().driverRayTracing, viewportOutput);
+      } catch (const std::invalid_argument& e) {
+        throw Error(std::string("view: ") + e.what() +
+                    (name == "driver-rt" ? " (make the Device with DeviceOptions::driverRayTracing)" : ""));
+      }
+      viewportShown = viewportOutput;
     }
-    drawn = m;
-    if (render::needsDriverRayTracing(m) && !context.caps().driverRayTracing) {
-      throw Error("view: method " + name + " needs a Device made with DeviceOptions::driverRayTracing on a device that has it");
-    }
-    bool viewport = view.output == View::Output::Viewport || render::drawsComposite(m);
-    if (viewport && (m == render::Method::Trace || m == render::Method::DriverRt)) m = render::Method::Masked;
-    method = render::methodName(m);
+    drawn = choice->next();
     render::RasterOptions raster;
-    if (viewport && view.transparentBackground) settings.background = glm::vec3(0.0f), settings.backgroundAlpha = 0.0f;
-    if (m == render::Method::RefractionMap) bakeMap(settings);
-    return viewport ? render::methodViewport(m, settings, raster) : render::methodView(m, settings, raster);
+    const bool composite = viewportOutput || render::drawsComposite(drawn);
+    if (composite && view.transparentBackground) settings.background = glm::vec3(0.0f), settings.backgroundAlpha = 0.0f;
+    if (drawn == render::Method::RefractionMap) bakeMap(settings);
+    return choice->view(drawn, settings, raster);
   }
 
   // The refraction-map method's map: the trace of this view at this pose,
@@ -517,7 +513,7 @@ struct Renderer::Impl {
   }
 
   void note(const render::FrameResult& result) {
-    if (chooser) chooser->note(drawn, result.passes);
+    if (choice) choice->note(drawn, result.passes);
     const render::FrameStats& s = result.stats;
     last = FrameInfo{};
     last.frame = s.frame;
@@ -528,7 +524,7 @@ struct Renderer::Impl {
     last.meshesUploaded = s.shapesCopied;
     last.topLevelBuilt = s.topLevelBuilt > 0, last.topLevelRefit = s.topLevelRefit > 0;
     last.dispatches = s.dispatches, last.draws = s.draws;
-    last.method = method;
+    last.method = render::methodName(drawn);
     for (const vk::PassTime& p : result.passes) last.passes.push_back(PassTime{p.name, p.milliseconds});
   }
 };

@@ -45,7 +45,7 @@ void resetPeakResident() { std::ofstream("/proc/self/clear_refs") << "5"; }
 
 struct Run {
   std::string devices;
-  ShotReport report;
+  render::ShotReport report;
   uint64_t peakBytes = 0;
   std::map<long, std::string> hashes;  // frame: image_hash
 };
@@ -80,7 +80,7 @@ Run renderRun(const Options& o, const std::string& scenePath, const std::string&
 }
 
 double framesPerSecond(const Run& run) {
-  return run.report.seconds > 0 ? double(run.report.framesWritten) / run.report.seconds : 0.0;
+  return run.report.seconds > 0 ? double(run.report.frames) / run.report.seconds : 0.0;
 }
 
 int runBench(Options& o) {
@@ -114,13 +114,13 @@ int runBench(Options& o) {
   const double base = framesPerSecond(runs.front());
   std::printf("\n%-10s %7s %9s %9s %8s %12s\n", "devices", "frames", "seconds", "frames/s", "speed-up", "peak host");
   for (const Run& run : runs) {
-    std::printf("%-10s %7zu %9.2f %9.2f %7.2fx %8llu MiB\n", run.devices.c_str(), run.report.framesWritten,
+    std::printf("%-10s %7zu %9.2f %9.2f %7.2fx %8llu MiB\n", run.devices.c_str(), run.report.frames,
                 run.report.seconds, framesPerSecond(run), base > 0 ? framesPerSecond(run) / base : 0.0,
                 static_cast<unsigned long long>(run.peakBytes >> 20));
     for (size_t k = 0; k < run.report.workers.size(); ++k) {
-      const WorkerReport& w = run.report.workers[k];
+      const render::ShotWorker& w = run.report.workers[k];
       std::printf("  worker %zu %s: %zu frames, load %.2f s, trees %.1f ms on the GPU, GPU waits %.2f s, writes %.2f s\n",
-                  k, w.device.c_str(), w.frames, w.loadSeconds, w.treeMs, w.gpuWaitSeconds, w.writeSeconds);
+                  k, w.device.c_str(), w.frames, w.loadSeconds, w.treeMs, w.gpuWaitSeconds, w.sinkSeconds);
     }
   }
   bool identical = runs.size() < 2 || runs[0].hashes == runs[1].hashes;
@@ -139,17 +139,17 @@ int runBench(Options& o) {
     io::Json list = io::Json::array();
     for (const Run& run : runs) {
       io::Json workers = io::Json::array();
-      for (const WorkerReport& w : run.report.workers) {
+      for (const render::ShotWorker& w : run.report.workers) {
         workers.push_back({{"device", w.device},
                            {"frames", w.frames},
                            {"load_seconds", w.loadSeconds},
                            {"tree_gpu_ms", w.treeMs},
                            {"gpu_wait_seconds", w.gpuWaitSeconds},
-                           {"write_seconds", w.writeSeconds},
+                           {"write_seconds", w.sinkSeconds},
                            {"frames_per_second", double(w.frames) / run.report.seconds}});
       }
       list.push_back({{"devices", run.devices},
-                      {"frames_written", run.report.framesWritten},
+                      {"frames_written", run.report.frames},
                       {"seconds", run.report.seconds},
                       {"frames_per_second", framesPerSecond(run)},
                       {"speed_up", base > 0 ? framesPerSecond(run) / base : 0.0},

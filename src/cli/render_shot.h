@@ -1,15 +1,15 @@
-// The frames of `snell render` (render_command.cpp parses its options): on
-// one device, or with --devices on several, one worker per device, each with
-// its own Vulkan device, scene upload and trees, taking frames from one
-// queue so a slower device takes fewer. Frames are written whole, skipped
-// where they exist, recorded with --stats-json; SIGTERM drops only the frames
-// under way, and a lost device hands its frames back to the others.
+// The frames of `snell render` (render_command.cpp parses its options), drawn
+// as a shot (render/shot.h: one worker per --devices entry) or by the CPU
+// reference, and written here: whole, skipped where they exist, recorded
+// with --stats-json, with the EXR's layers; SIGTERM drops only the frames
+// under way.
 #pragma once
 
 #include "cli/frames.h"
 #include "cli/options.h"
 #include "render/method.h"
 #include "render/raster_pass.h"
+#include "render/shot.h"
 
 #include <algorithm>
 #include <cstdint>
@@ -54,26 +54,9 @@ struct RenderOptions {
   bool wants(const std::string& aov) const { return std::find(aovs.begin(), aovs.end(), aov) != aovs.end(); }
 };
 
-/// What one worker did: for progress, --stats-json and `snell bench shot`.
-struct WorkerReport {
-  std::string device;
-  size_t frames = 0;
-  double loadSeconds = 0.0;  ///< its device, the scene's upload and pipelines, before its first frame
-  double treeMs = 0.0;       ///< GPU time building trees (with timePasses)
-  double gpuWaitSeconds = 0.0;  ///< waiting for its frames' GPU work
-  double writeSeconds = 0.0;    ///< encoding and writing its images
-  std::string lost;             ///< why it stopped early ("" when it ran to the end)
-};
-
-struct ShotReport {
-  std::vector<WorkerReport> workers;
-  double seconds = 0.0;  ///< from the start to the last frame written, loads included
-  size_t framesWritten = 0;
-};
-
 /// Renders what `o` asks for; returns the exit code (0, 1 from validation,
 /// 3 when a lost device left frames unwritten, 128+N after signal N) or
 /// throws naming the problem. `report`, when given, receives each worker's figures.
-int renderShot(RenderOptions& o, ShotReport* report = nullptr);
+int renderShot(RenderOptions& o, render::ShotReport* report = nullptr);
 
 }  // namespace snell::cli

@@ -130,6 +130,41 @@ std::string AutoMethod::describe() const {
   return std::string("auto: ") + methodName(*chosen_) + " (" + why_ + ")";
 }
 
+MethodChoice::MethodChoice(const std::string& name, bool driverRayTracing, bool viewport, uint64_t frames)
+    : name_(name), viewport_(viewport) {
+  if (name == "auto") {
+    chooser_.emplace(driverRayTracing, viewport, frames);
+    return;
+  }
+  fixed_ = methodFromName(name);
+  if (!fixed_) throw std::invalid_argument("no method '" + name + "' (the methods: auto, " + methodNames() + ")");
+  if (needsDriverRayTracing(*fixed_) && !driverRayTracing) {
+    throw std::invalid_argument("method " + name + " needs the driver's ray tracing (VK_KHR_ray_tracing_pipeline), "
+                                "which this device or context does not offer");
+  }
+}
+
+Method MethodChoice::next() const {
+  Method m = chooser_ ? chooser_->next() : *fixed_;
+  const bool viewport = viewport_ || drawsComposite(m);
+  if (viewport && (m == Method::Trace || m == Method::DriverRt)) m = Method::Masked;
+  return m;
+}
+
+ViewRequest MethodChoice::view(Method method, const FrameSettings& settings, const RasterOptions& raster) const {
+  return viewport_ ? methodViewport(method, settings, raster) : methodView(method, settings, raster);
+}
+
+void MethodChoice::note(Method drawn, const std::vector<vk::PassTime>& passes) {
+  if (chooser_) chooser_->note(drawn, passes);
+}
+
+std::string MethodChoice::describe() const {
+  if (chooser_) return chooser_->describe();
+  const MethodInfo& m = methodInfo(next());
+  return std::string(m.name) + ": " + m.summary;
+}
+
 bool isRefractionPass(const std::string& passName) {
   return passName != pass::kDeform && passName != pass::kRasterDepth && passName != pass::kRasterShading;
 }

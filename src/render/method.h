@@ -98,6 +98,34 @@ class AutoMethod {
   std::vector<double> traceMs_, driverMs_;
 };
 
+/// A method as a caller names it (auto, or one of methods()) made into each
+/// frame's method and view: the name checked, auto's timing, and a viewport's
+/// substitution (a traced method shown as a viewport traces only its glass
+/// pixels). The API, the CLI and the shots choose through it.
+class MethodChoice {
+ public:
+  /// `viewport`: the caller shows the composite. Throws std::invalid_argument
+  /// for an unknown name (listing the methods), or for a method that needs the
+  /// driver's ray tracing on a context without it.
+  MethodChoice(const std::string& name, bool driverRayTracing, bool viewport, uint64_t frames = UINT64_MAX);
+  const std::string& name() const { return name_; }
+  bool isAuto() const { return chooser_.has_value(); }
+  /// The method the next frame draws with.
+  Method next() const;
+  /// The view that draws `settings` with `method` (next()'s), as the caller shows it.
+  ViewRequest view(Method method, const FrameSettings& settings, const RasterOptions& raster) const;
+  /// A frame drawn with `drawn` is done: auto hears its pass times.
+  void note(Method drawn, const std::vector<vk::PassTime>& passes);
+  /// What auto draws with and why, or the method and its summary.
+  std::string describe() const;
+
+ private:
+  std::string name_;
+  bool viewport_;
+  std::optional<Method> fixed_;
+  std::optional<AutoMethod> chooser_;
+};
+
 /// The passes that draw refraction, as opposed to those every viewport pays
 /// (deform, the raster pass's own depth and shading). The one list every
 /// benchmark sums; bench frame and bench scale add deform to it.
