@@ -21,10 +21,12 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 // libsnell.so exports this header's names and hides everything else.
@@ -450,6 +452,58 @@ class Renderer {
  private:
   std::unique_ptr<Impl> impl_;
 };
+
+/// One frame of a shot (renderFrames): a time of the scene's animation, and
+/// what the host changes at it over the scene's own pose (a DCC's animation).
+struct ShotFrame {
+  long number = 0;       ///< the host's frame number, handed back with its picture
+  double seconds = 0.0;  ///< the scene's time (a glTF scene's animations)
+  /// The camera at this frame (a DCC's matrices); none: the shot's View's camera.
+  std::optional<CameraMatrices> camera;
+  /// Instances placed at this frame (mesh space to world), as Renderer::setTransform takes them.
+  std::vector<std::pair<size_t, Mat4>> transforms;
+  /// Kept meshes' vertices at this frame (Scene::keepsVertices), by mesh index.
+  std::vector<std::pair<int, MeshVertices>> vertices;
+};
+
+/// A frame of a shot, drawn.
+struct ShotPicture {
+  long number = 0;
+  double seconds = 0.0;
+  uint32_t width = 0, height = 0;
+  std::vector<float> rgba;  ///< linear RGBA, row 0 at the top
+  size_t worker = 0;        ///< which entry of the devices drew it
+  std::string device;       ///< that device's name
+  std::string method;       ///< how its glass was drawn
+};
+
+/// What a shot did, per worker.
+struct ShotSummary {
+  struct Worker {
+    std::string device;
+    size_t frames = 0;
+    double loadSeconds = 0.0;     ///< its device, the scene's upload and pipelines, before its first frame
+    double gpuWaitSeconds = 0.0;  ///< waiting for its frames' GPU work
+    std::string lost;             ///< why its device stopped early ("" when it ran to the end)
+  };
+  std::vector<Worker> workers;
+  size_t frames = 0;
+  double seconds = 0.0;
+};
+
+/// Draws a shot: each frame `next` gives (until it gives none) as `view`
+/// sets it up, handed to `done` once drawn, in the order the frames finish.
+/// One worker per device of `devices` ("all": every GPU, or every one a
+/// launcher's CUDA_VISIBLE_DEVICES lists; or indices and UUIDs, "0,1", an
+/// entry twice giving two workers on one device) with its own Vulkan
+/// device made by `options` (its `device` ignored), scene upload and trees,
+/// so a slower device takes fewer frames, and a lost one hands its frames to
+/// the others. Every frame is drawn afresh, so its pixels do not depend on
+/// which device drew it. `next` and `done` run on the calling thread (a DCC's
+/// main thread), a few frames ahead of the workers. "auto" on several devices is "trace".
+ShotSummary renderFrames(const std::string& devices, Scene& scene, const View& view,
+                         const std::function<std::optional<ShotFrame>()>& next,
+                         const std::function<void(ShotPicture&&)>& done, const DeviceOptions& options = {});
 
 /// An image whose memory another API imports: OpenGL through
 /// GL_EXT_memory_object_fd (glImportMemoryFdEXT, then glTextureStorageMem2DEXT

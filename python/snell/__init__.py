@@ -11,7 +11,8 @@ a Device; each frame updates only what moved::
         renderer.set_time(0.5)
         rgba = renderer.render(snell.View(640, 480, camera=0))  # (480, 640, 4) float32
 
-Pixels are scene-linear Rec.709 RGBA, row 0 at the top. Every failure is a
+A shot's frames go to every GPU at once with snell.render_frames. Pixels
+are scene-linear Rec.709 RGBA, row 0 at the top. Every failure is a
 snell.Error whose message names the file, array or option at fault.
 docs/python.md covers the module.
 """
@@ -27,10 +28,12 @@ from ._snell import (
     Renderer,
     Scene,
     SharedImage,
+    ShotFrame,
     Texture,
     TextureTransform,
     View,
     methods,
+    render_frames,
     version,
 )
 
@@ -47,9 +50,11 @@ __all__ = [
     "Renderer",
     "Scene",
     "SharedImage",
+    "ShotFrame",
     "Texture",
     "TextureTransform",
     "View",
     "methods",
+    "render_frames",
     "version",
 ]

@@ -1,7 +1,7 @@
 """Type stubs for snell's compiled module (python/snell_module.cpp), so editors complete its names."""
 
 from types import TracebackType
-from typing import Any, Optional, Sequence
+from typing import Any, Callable, Iterable, Optional, Sequence, Union
 
 import numpy as np
 import numpy.typing as npt
@@ -290,3 +290,30 @@ class Renderer:
     def close(self) -> None: ...
     def __enter__(self) -> "Renderer": ...
     def __exit__(self, *args: Any) -> None: ...
+
+class ShotFrame:
+    """One frame of a shot (render_frames): a time, and what the host changes at it."""
+
+    def __init__(
+        self,
+        number: int,
+        seconds: float = 0.0,
+        view_matrix: Optional[Matrix] = None,
+        projection: Optional[Matrix] = None,
+        transforms: Optional[dict[int, Matrix]] = None,
+        vertices: Optional[dict[int, tuple[npt.NDArray[np.float32], npt.NDArray[np.float32]]]] = None,
+    ) -> None: ...
+    @property
+    def number(self) -> int: ...
+    @property
+    def seconds(self) -> float: ...
+
+def render_frames(
+    scene: Scene,
+    view: View,
+    frames: Iterable[Union[ShotFrame, float]],
+    on_frame: Callable[[dict[str, Any]], None],
+    devices: str = "all",
+    validation: bool = False,
+    driver_ray_tracing: bool = False,
+) -> dict[str, Any]: ...

@@ -9,6 +9,7 @@
 #include "render/pixel_aovs.h"
 #include "render/raster_pass.h"
 #include "render/renderer.h"
+#include "render/shot.h"
 #include "scene/evaluate.h"
 #include "scene/gltf_loader.h"
 #include "scene/view.h"
@@ -88,20 +89,28 @@ Device::~Device() = default;
 Device::Device(Device&&) noexcept = default;
 Device& Device::operator=(Device&&) noexcept = default;
 
+namespace {
+
+vk::ContextDesc contextDesc(const DeviceOptions& options) {
+  vk::ContextDesc desc;
+  desc.applicationName = "snell (embedded)";
+  desc.deviceOverride = options.device;
+  desc.validation = options.validation;
+  desc.synchronizationValidation = options.synchronizationValidation;
+  desc.driverRayTracing = options.driverRayTracing;
+  if (options.interop) {
+    desc.deviceExtensions = {VK_KHR_EXTERNAL_MEMORY_FD_EXTENSION_NAME};
+    desc.optionalDeviceExtensions = {VK_KHR_EXTERNAL_SEMAPHORE_FD_EXTENSION_NAME};  // lavapipe lacks it
+  }
+  return desc;
+}
+
+}  // namespace
+
 Device Device::create(const DeviceOptions& options) {
   return guarded([&] {
-    vk::ContextDesc desc;
-    desc.applicationName = "snell (embedded)";
-    desc.deviceOverride = options.device;
-    desc.validation = options.validation;
-    desc.synchronizationValidation = options.synchronizationValidation;
-    desc.driverRayTracing = options.driverRayTracing;
-    if (options.interop) {
-      desc.deviceExtensions = {VK_KHR_EXTERNAL_MEMORY_FD_EXTENSION_NAME};
-      desc.optionalDeviceExtensions = {VK_KHR_EXTERNAL_SEMAPHORE_FD_EXTENSION_NAME};  // lavapipe lacks it
-    }
     auto impl = std::make_unique<Impl>();
-    impl->context = vk::Context::create(desc);
+    impl->context = vk::Context::create(contextDesc(options));
     return Device(std::move(impl));
   });
 }
@@ -432,6 +441,36 @@ scene::View viewFromMatrices(const CameraMatrices& m, uint32_t width, uint32_t h
   return v;
 }
 
+// The camera `view` names, at the pose.
+scene::View cameraOf(const View& view, const scene::Scene& model, const scene::Pose& pose) {
+  if (view.sceneCamera >= 0) {
+    scene::ViewRequest which;
+    which.camera = view.sceneCamera;
+    return scene::resolveView(model, pose, which);
+  }
+  if (view.matrices) return viewFromMatrices(*view.matrices, view.width, view.height);
+  const Camera& c = view.camera;
+  scene::ViewRequest which;
+  which.lookAt = scene::LookAt{glm::dvec3(toVec(c.eye)), glm::dvec3(toVec(c.target)), glm::dvec3(toVec(c.up))};
+  which.yfov = c.yfov;
+  return scene::resolveView(model, pose, which);
+}
+
+// The frame settings of `view` at the pose (its method apart).
+render::FrameSettings frameSettings(const View& view, const scene::Scene& model, const scene::Pose& pose) {
+  render::FrameSettings settings;
+  settings.width = view.width;
+  settings.height = view.height;
+  settings.view = cameraOf(view, model, pose);
+  settings.background = toVec(view.background);
+  if (view.maxInterfaces > 1024) throw Error("view: maxInterfaces " + std::to_string(view.maxInterfaces) + " is past 1024");
+  settings.maxInterfaces = view.maxInterfaces;
+  settings.optics.fresnel = view.fresnel;
+  settings.optics.dispersion = view.dispersion;
+  settings.optics.volume = view.volume;
+  return settings;
+}
+
 }  // namespace
 
 struct Renderer::Impl {
@@ -460,29 +499,7 @@ struct Renderer::Impl {
 
   // The renderer's request for a view of the current pose.
   render::ViewRequest request(const View& view) {
-    render::FrameSettings settings;
-    settings.width = view.width;
-    settings.height = view.height;
-    if (view.sceneCamera >= 0) {
-      scene::ViewRequest which;
-      which.camera = view.sceneCamera;
-      settings.view = scene::resolveView(scene.scene, pose, which);
-    } else if (view.matrices) {
-      settings.view = viewFromMatrices(*view.matrices, view.width, view.height);
-    } else {
-      const Camera& c = view.camera;
-      scene::ViewRequest which;
-      which.lookAt = scene::LookAt{glm::dvec3(toVec(c.eye)), glm::dvec3(toVec(c.target)), glm::dvec3(toVec(c.up))};
-      which.yfov = c.yfov;
-      settings.view = scene::resolveView(scene.scene, pose, which);
-    }
-    settings.background = toVec(view.background);
-    if (view.maxInterfaces > 1024) throw Error("view: maxInterfaces " + std::to_string(view.maxInterfaces) + " is past 1024");
-    settings.maxInterfaces = view.maxInterfaces;
-    settings.optics.fresnel = view.fresnel;
-    settings.optics.dispersion = view.dispersion;
-    settings.optics.volume = view.volume;
-
+    render::FrameSettings settings = frameSettings(view, scene.scene, pose);
     const std::string name = view.method.empty() ? "auto" : view.method;
     const bool viewportOutput = view.output == View::Output::Viewport;
     if (!choice || choice->name() != name || viewportOutput != viewportShown) {
@@ -698,6 +715,77 @@ Aovs Renderer::readAovs(const View& view) {
 }
 
 FrameInfo Renderer::lastFrame() const { return impl_->last; }
+
+// ---------------------------------------------------------------- Shots
+
+ShotSummary renderFrames(const std::string& devices, Scene& scene, const View& view,
+                         const std::function<std::optional<ShotFrame>()>& next,
+                         const std::function<void(ShotPicture&&)>& done, const DeviceOptions& options) {
+  return guarded([&] {
+    if (!next || !done) throw Error("renderFrames: give both the frames (next) and where they go (done)");
+    const scene::Scene& model = scene.impl().scene;
+    if (scene.impl().host.positions) {
+      throw Error("renderFrames: " + model.source + "'s vertices are in the host's buffers, which only its own device reads");
+    }
+    const std::string method = view.method.empty() ? "auto" : view.method;
+    const std::optional<render::Method> named = render::methodFromName(method);
+    if (method != "auto" && !named) {
+      throw Error("view: no method '" + method + "' (the methods: auto, " + render::methodNames() + ")");
+    }
+    render::ShotSettings settings;
+    const render::FrameSettings first = frameSettings(view, model, scene::evaluate(model, 0.0));
+    settings.width = first.width;
+    settings.height = first.height;
+    settings.view = [&](const scene::Pose& pose) { return cameraOf(view, model, pose); };
+    settings.background = first.background;
+    settings.maxInterfaces = first.maxInterfaces;
+    settings.optics = first.optics;
+    settings.method = method;
+    settings.viewport = view.output == View::Output::Viewport;
+    if (view.transparentBackground && (settings.viewport || (named && render::drawsComposite(*named)))) {
+      settings.background = glm::vec3(0.0f), settings.backgroundAlpha = 0.0f;
+    }
+    settings.keepVertices = scene.impl().keep;
+
+    std::string why;
+    std::vector<render::ShotDevice> workers;
+    for (uint32_t index : vk::devicesForList(devices, why)) workers.push_back({std::to_string(index), why});
+    DeviceOptions shared = options;
+    shared.device.clear();
+
+    render::ShotIo io;
+    io.next = [&]() -> std::optional<render::ShotFrame> {
+      std::optional<ShotFrame> f = next();
+      if (!f) return std::nullopt;
+      render::ShotFrame frame{.number = f->number, .seconds = f->seconds};
+      if (!std::isfinite(f->seconds)) throw Error("renderFrames: frame " + std::to_string(f->number) + "'s time is not finite");
+      if (f->camera) frame.view = viewFromMatrices(*f->camera, view.width, view.height);
+      for (const auto& [instance, matrix] : f->transforms) frame.transforms.emplace_back(instance, toMatrix(matrix));
+      for (auto& [mesh, vertices] : f->vertices) {
+        if (!scene.impl().keep) throw Error("renderFrames: frame " + std::to_string(f->number) + " gives vertices of a scene whose vertices snell does not keep");
+        frame.vertices.push_back({mesh, std::move(vertices.positions), std::move(vertices.normals)});
+      }
+      return frame;
+    };
+    io.done = [&](render::ShotImage&& image) {
+      ShotPicture picture{image.frame.number, image.frame.seconds, view.width, view.height, {}, image.worker,
+                          image.device, image.method};
+      const std::vector<uint16_t>& halves = image.rgbaHalf();
+      const std::array<float, 65536>& toFloat = halfTable();
+      picture.rgba.resize(halves.size());
+      for (size_t i = 0; i < halves.size(); ++i) picture.rgba[i] = toFloat[halves[i]];
+      done(std::move(picture));
+    };
+    const render::ShotReport report = render::renderShot(model, settings, contextDesc(shared), workers, io);
+    ShotSummary summary;
+    summary.frames = report.frames;
+    summary.seconds = report.seconds;
+    for (const render::ShotWorker& w : report.workers) {
+      summary.workers.push_back({w.device, w.frames, w.loadSeconds, w.gpuWaitSeconds, w.lost});
+    }
+    return summary;
+  });
+}
 
 // ---------------------------------------------------------------- SharedImage
 
