@@ -836,10 +836,11 @@ PYBIND11_MODULE(_snell, m) {
   m.def(
       "render_frames",
       [](const PyScene& scene, const snell::View& view, const py::iterable& frames, const py::function& onFrame,
-         const std::string& devices, bool validation, bool driverRayTracing) {
+         const std::string& devices, const std::string& device, bool validation, bool driverRayTracing) {
         std::shared_ptr<snell::Scene> s = scene.scene;
         if (!s) throw snell::Error("the scene is closed");
         snell::DeviceOptions options;
+        options.device = device;
         options.validation = validation;
         options.driverRayTracing = driverRayTracing;
         py::iterator it = py::iter(frames);
@@ -897,11 +898,12 @@ PYBIND11_MODULE(_snell, m) {
         }
         return py::dict("frames"_a = summary.frames, "seconds"_a = summary.seconds, "workers"_a = workers);
       },
-      "scene"_a, "view"_a, "frames"_a, "on_frame"_a, "devices"_a = "all", "validation"_a = false,
+      "scene"_a, "view"_a, "frames"_a, "on_frame"_a, "devices"_a = "all", "device"_a = "", "validation"_a = false,
       "driver_ray_tracing"_a = false,
       "Renders a shot on several GPUs: each of `frames` (snell.ShotFrame, or times in seconds,\n"
       "numbered from 0) as `view` sets it up, one worker per device of `devices` ('all', or indices\n"
-      "'0,1'; one twice gives two workers on it), each with its own device, upload and trees.\n"
+      "'0,1'; one twice gives two workers on it; '': the one `device` names, as snell.Device takes\n"
+      "it), each with its own device, upload and trees.\n"
       "on_frame(picture) gets each frame as it finishes, on this thread: a dict of number, seconds,\n"
       "rgba ((height, width, 4) float32, row 0 at the top), worker, device and method. The frames\n"
       "are read a few ahead of the GPUs, so a generator may pose a DCC's scene for each. A frame's\n"

@@ -19,16 +19,18 @@ bl_info = {
     "category": "Render",
 }
 
-from . import engine, properties, runtime, ui  # noqa: E402  (bl_info first, as Blender reads it)
+from . import engine, properties, runtime, shot, ui  # noqa: E402  (bl_info first, as Blender reads it)
 
 
 def register() -> None:
     properties.register()
     engine.register()
     ui.register()
+    shot.register()
 
 
 def unregister() -> None:
+    shot.unregister()
     ui.unregister()
     engine.unregister()
     properties.unregister()

@@ -77,12 +77,17 @@ class SnellPreferences(bpy.types.AddonPreferences):
     device: bpy.props.StringProperty(
         name="Device", default="",
         description="A Vulkan device index or name substring; empty: SNELL_DEVICE, else the first that fits")
+    every_gpu: bpy.props.BoolProperty(
+        name="Animations on every GPU", default=False,
+        description="Ctrl+F12 and Render > snell: Render Animation draw the frames on every GPU at once, one worker "
+                    "each (off: on the device above, and Ctrl+F12 is Blender's own animation render)")
 
     def draw(self, context) -> None:
         from . import runtime
 
         self.layout.prop(self, "module_path")
         self.layout.prop(self, "device")
+        self.layout.prop(self, "every_gpu")
         status = runtime.status()
         self.layout.label(text=status, icon="INFO" if runtime.problem() is None else "ERROR")
 

@@ -90,7 +90,11 @@ def _render_uv_layer(mesh):
 
 
 class SceneSync:
-    """A snell scene and renderer built from a depsgraph, updated from its later states."""
+    """A snell scene and renderer built from a depsgraph, updated from its later states.
+
+    Without a device it is the scene alone: a shot's workers make their own
+    renderers, and each frame carries its whole state (frame_state).
+    """
 
     def __init__(self, device, depsgraph) -> None:
         import snell
@@ -148,8 +152,8 @@ class SceneSync:
                        "instances": instances}
         self.scene = snell.Scene.from_arrays(meshes, materials=materials, textures=textures.textures, lights=lights,
                                              instances=instances, name=scene.name)
-        self.renderer = snell.Renderer(device, self.scene)
-        for geometry in self.geometry.values():
+        self.renderer = snell.Renderer(device, self.scene) if device is not None else None
+        for geometry in self.geometry.values() if device is not None else ():
             for part in geometry.parts:
                 part.positions = self.renderer.positions(part.mesh)
                 part.normals = self.renderer.normals(part.mesh)
@@ -212,6 +216,37 @@ class SceneSync:
         compat.read_corner_normals(mesh, geometry.loop_normals.reshape(-1))
         return geometry.co, geometry.loop_normals
 
+    def _evaluated_vertices(self, obj) -> tuple:
+        """An evaluated object's (positions, loop normals), in the object's scratch arrays."""
+        geometry = self.geometry[obj.original.name]
+        mesh = _read_mesh(obj)
+        try:
+            if mesh is None or len(mesh.vertices) != geometry.vertex_count or len(mesh.loops) != geometry.loop_count:
+                raise TopologyChanged(f"{obj.original.name}'s topology changed")
+            return self._read_vertices(mesh, geometry)
+        finally:
+            obj.to_mesh_clear()
+
+    def frame_state(self, depsgraph) -> tuple:
+        """The depsgraph's frame whole: every mesh's vertices {mesh: (positions, normals)} and every
+        instance's transform {instance: matrix}, changed or not (a shot's frame must not depend on the
+        frames a worker drew before it). Raises TopologyChanged as send_changed does."""
+        if self._lights_of(depsgraph) != self.light_state:
+            raise TopologyChanged("a light changed")
+        vertices = {}
+        for instance in depsgraph.object_instances:
+            obj = instance.object
+            if instance.is_instance or obj.original.name not in self.geometry:
+                continue
+            co, loop_normals = self._evaluated_vertices(obj)
+            for part in self.geometry[obj.original.name].parts:
+                vertices[part.mesh] = (co[part.vertex_of_loop], loop_normals[part.loops])
+        transforms = {}
+        for key, matrix in self._transforms_of(depsgraph).items():
+            for index in self.instances[key][1]:
+                transforms[index] = matrix
+        return vertices, transforms
+
     def send_vertices(self, obj, only_if_changed: bool = False) -> bool:
         """Writes an evaluated object's vertices into snell's memory and marks its meshes dirty.
 
@@ -220,13 +255,7 @@ class SceneSync:
         Returns whether they were sent.
         """
         geometry = self.geometry[obj.original.name]
-        mesh = _read_mesh(obj)
-        try:
-            if mesh is None or len(mesh.vertices) != geometry.vertex_count or len(mesh.loops) != geometry.loop_count:
-                raise TopologyChanged(f"{obj.original.name}'s topology changed")
-            co, loop_normals = self._read_vertices(mesh, geometry)
-        finally:
-            obj.to_mesh_clear()
+        co, loop_normals = self._evaluated_vertices(obj)
         if only_if_changed and geometry.sent is not None:
             if np.array_equal(geometry.sent[0], co) and np.array_equal(geometry.sent[1], loop_normals):
                 return False
@@ -308,34 +337,39 @@ class SceneSync:
         moved = self._update_transforms(depsgraph)
         return {"meshes_sent": sent, "instances_moved": moved, "feed_ms": (time.perf_counter() - started) * 1000}
 
-    def _update_transforms(self, depsgraph) -> int:
-        """Sets the transforms of instances that moved; a light that moved, or a new instance, rebuilds."""
-        moved, seen = 0, 0
+    def _transforms_of(self, depsgraph) -> dict:
+        """Every instance's matrix in snell's world, by key; a new instance, or one gone, rebuilds."""
+        matrices = {}
         for instance in depsgraph.object_instances:
             obj = instance.object
             if obj.type == "LIGHT":
                 continue  # light positions are in the scene: a moved light comes as a Light/Object update
             key = _instance_key(instance)
-            entry = self.instances.get(key)
-            if entry is None:
+            if key not in self.instances:
                 if obj.type in ("MESH", "CURVE", "SURFACE", "META", "FONT"):
                     raise TopologyChanged(f"{obj.name} appeared")
                 continue
-            seen += 1
-            matrix = _matrix(instance.matrix_world)
-            name, placed, old = entry
+            matrices[key] = _matrix(instance.matrix_world)
+        if len(matrices) != len(self.instances):
+            raise TopologyChanged("an object was hidden or deleted")
+        return matrices
+
+    def _update_transforms(self, depsgraph) -> int:
+        """Sets the transforms of instances that moved; returns how many moved."""
+        moved = 0
+        for key, matrix in self._transforms_of(depsgraph).items():
+            name, placed, old = self.instances[key]
             if not np.array_equal(matrix, old):
                 for index in placed:
                     self.renderer.set_transform(index, matrix)
                 self.instances[key] = (name, placed, matrix)
                 moved += 1
-        if seen != len(self.instances):
-            raise TopologyChanged("an object was hidden or deleted")
         return moved
 
     def close(self) -> None:
         for geometry in self.geometry.values():
             for part in geometry.parts:
                 part.positions = part.normals = None
-        self.renderer.close()
+        if self.renderer is not None:
+            self.renderer.close()
         self.scene.close()

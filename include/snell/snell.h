@@ -495,8 +495,8 @@ struct ShotSummary {
 /// sets it up, handed to `done` once drawn, in the order the frames finish.
 /// One worker per device of `devices` ("all": every GPU, or every one a
 /// launcher's CUDA_VISIBLE_DEVICES lists; or indices and UUIDs, "0,1", an
-/// entry twice giving two workers on one device) with its own Vulkan
-/// device made by `options` (its `device` ignored), scene upload and trees,
+/// entry twice giving two workers on one device; empty: the one device
+/// `options.device` names) with its own Vulkan device made by `options`, scene upload and trees,
 /// so a slower device takes fewer frames, and a lost one hands its frames to
 /// the others. Every frame is drawn afresh, so its pixels do not depend on
 /// which device drew it. `next` and `done` run on the calling thread (a DCC's

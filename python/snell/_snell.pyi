@@ -314,6 +314,7 @@ def render_frames(
     frames: Iterable[Union[ShotFrame, float]],
     on_frame: Callable[[dict[str, Any]], None],
     devices: str = "all",
+    device: str = "",
     validation: bool = False,
     driver_ray_tracing: bool = False,
 ) -> dict[str, Any]: ...

@@ -747,9 +747,13 @@ ShotSummary renderFrames(const std::string& devices, Scene& scene, const View& v
     }
     settings.keepVertices = scene.impl().keep;
 
-    std::string why;
-    std::vector<render::ShotDevice> workers;
-    for (uint32_t index : vk::devicesForList(devices, why)) workers.push_back({std::to_string(index), why});
+    // No list: one worker, on the device `options` names (or snell's own choice).
+    std::vector<render::ShotDevice> workers{{options.device, ""}};
+    if (!devices.empty()) {
+      std::string why;
+      workers.clear();
+      for (uint32_t index : vk::devicesForList(devices, why)) workers.push_back({std::to_string(index), why});
+    }
     DeviceOptions shared = options;
     shared.device.clear();
 
