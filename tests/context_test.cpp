@@ -3,6 +3,7 @@
 #include "gpu_test.h"
 #include "hand_made_device.h"
 
+#include "io/environment.h"
 #include "render/prefix_sum.h"
 #include "vk/commands.h"
 #include "vk/context.h"
@@ -31,7 +32,7 @@ TEST_F(ContextTest, PicksADeviceThatMeetsEveryRequirement) {
 }
 
 TEST(DeviceSurvey, ListsEveryDeviceWithAVerdict) {
-  vk::DeviceReport report = vk::surveyDevices("");
+  vk::DeviceReport report = vk::surveyDevices("", io::deviceEnvironment());
   ASSERT_FALSE(report.devices.empty()) << "CI always has lavapipe";
   ASSERT_TRUE(report.choice.chosen);
   EXPECT_EQ(report.choice.verdicts.size(), report.devices.size());
@@ -59,7 +60,7 @@ TEST(DeviceSurvey, SlurmsStepGpusNameTheDeviceWhenNoCudaListIsSet) {
   ScopedEnvironment step("SLURM_STEP_GPUS", "0");
   std::string why;
   try {
-    why = vk::surveyDevices("").why;
+    why = vk::surveyDevices("", io::deviceEnvironment()).why;
   } catch (const vk::VulkanError& e) {
     why = e.what();  // a machine without a GPU (lavapipe only): GPU 0 is not there, and the error says so
   }
@@ -75,7 +76,7 @@ TEST(DeviceSurvey, UnknownOverrideFailsWithTheListOfDevices) {
   } catch (const vk::VulkanError& e) {
     std::string message = e.what();
     EXPECT_NE(message.find("device=no-such-gpu-anywhere names another device"), std::string::npos) << message;
-    EXPECT_NE(message.find(vk::surveyDevices("").devices[0].name), std::string::npos) << message;
+    EXPECT_NE(message.find(vk::surveyDevices("", io::deviceEnvironment()).devices[0].name), std::string::npos) << message;
   }
 }
 

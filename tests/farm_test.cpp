@@ -4,11 +4,13 @@
 // Open Job Description commands themselves run in tests/farm/.
 #include "command_run.h"
 
-#include "cli/farm_plan.h"
-#include "cli/frames.h"
+#include "farm/frames.h"
+#include "farm/plan.h"
 #include "cli/options.h"
 
 #include <gtest/gtest.h>
+
+#include <stdexcept>
 #include <nlohmann/json.hpp>
 
 #include <filesystem>
@@ -20,15 +22,15 @@ namespace snell::test {
 namespace {
 
 namespace fs = std::filesystem;
-using cli::FrameList;
+using farm::FrameList;
 
 std::vector<long> framesOf(const std::string& list) { return FrameList::parse("--frames", list).frames; }
 
 std::string usageErrorOf(const std::string& list) {
   try {
     FrameList::parse("--frames", list);
-  } catch (const cli::UsageError& e) {
-    return e.message;
+  } catch (const std::invalid_argument& e) {
+    return std::string(e.what());
   }
   return "";
 }
@@ -44,23 +46,23 @@ TEST(FrameList, ReadsEveryFormFarmsWrite) {
   EXPECT_EQ(framesOf("10-12, 1 - 2"), (std::vector<long>{1, 2, 10, 11, 12})) << "spaced, and sorted";
 }
 
-TEST(FrameList, AReversedRangeIsAUsageErrorSayingSo) {
+TEST(FrameList, AReversedRangeIsACallersMistakeSayingSo) {
   EXPECT_NE(usageErrorOf("240-1").find("runs backwards"), std::string::npos) << usageErrorOf("240-1");
   EXPECT_NE(usageErrorOf("9:1").find("runs backwards"), std::string::npos);
 }
 
-TEST(FrameList, AZeroStepIsAUsageErrorSayingSo) {
+TEST(FrameList, AZeroStepIsACallersMistakeSayingSo) {
   EXPECT_NE(usageErrorOf("1-9x0").find("step"), std::string::npos) << usageErrorOf("1-9x0");
   EXPECT_NE(usageErrorOf("1:9:0").find("step"), std::string::npos);
 }
 
-TEST(FrameList, OverlappingItemsAreAUsageErrorNamingBoth) {
+TEST(FrameList, OverlappingItemsAreACallersMistakeNamingBoth) {
   std::string message = usageErrorOf("1-10,5-20");
   EXPECT_NE(message.find("'5-20' overlaps frames 1-10"), std::string::npos) << message;
   EXPECT_NE(usageErrorOf("3,1-4").find("overlaps"), std::string::npos);
 }
 
-TEST(FrameList, WordsEmptyItemsAndNegativeFramesAreUsageErrors) {
+TEST(FrameList, WordsEmptyItemsAndNegativeFramesAreCallersMistakes) {
   EXPECT_NE(usageErrorOf("lots").find("not a whole number"), std::string::npos);
   EXPECT_NE(usageErrorOf("1,,2").find("empty item"), std::string::npos);
   EXPECT_NE(usageErrorOf("").find("give frames"), std::string::npos);
@@ -76,19 +78,19 @@ TEST(FrameList, FormatsAsAListItReadsBack) {
 }
 
 TEST(FramePattern, HashesAndPrintfBothNumberTheFrame) {
-  EXPECT_EQ(cli::framePath("shot.####.exr", 42), "shot.0042.exr");
-  EXPECT_EQ(cli::framePath("shot.#.png", 1001), "shot.1001.png");
-  EXPECT_EQ(cli::framePath("shot.%04d.exr", 42), "shot.0042.exr");
-  EXPECT_EQ(cli::framePath("shot_%d.png", 7), "shot_7.png");
+  EXPECT_EQ(farm::framePath("shot.####.exr", 42), "shot.0042.exr");
+  EXPECT_EQ(farm::framePath("shot.#.png", 1001), "shot.1001.png");
+  EXPECT_EQ(farm::framePath("shot.%04d.exr", 42), "shot.0042.exr");
+  EXPECT_EQ(farm::framePath("shot_%d.png", 7), "shot_7.png");
 }
 
-TEST(FramePattern, SeveralFramesWithoutASlotIsAUsageError) {
-  EXPECT_THROW(cli::checkFramePattern("-o", "shot.exr", 2), cli::UsageError);
-  EXPECT_NO_THROW(cli::checkFramePattern("-o", "shot.exr", 1));
+TEST(FramePattern, SeveralFramesWithoutASlotIsACallersMistake) {
+  EXPECT_THROW(farm::checkFramePattern("-o", "shot.exr", 2), std::invalid_argument);
+  EXPECT_NO_THROW(farm::checkFramePattern("-o", "shot.exr", 1));
   try {
-    cli::checkFramePattern("-o", "shot.exr", 6);
-  } catch (const cli::UsageError& e) {
-    EXPECT_NE(e.message.find("slot for the frame number"), std::string::npos) << e.message;
+    farm::checkFramePattern("-o", "shot.exr", 6);
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("slot for the frame number"), std::string::npos) << e.what();
   }
 }
 
@@ -146,7 +148,7 @@ TEST_F(FarmFolder, StatsJsonRecordsEachFrameWithHashesThatFollowThePixels) {
 }
 
 TEST(FarmPlan, CutsTheFramesIntoTasksInOrder) {
-  cli::FarmPlan plan = cli::FarmPlan::make("eye.glb", "out/shot.####.exr", FrameList::parse("--frames", "1001-1010"), 4, {});
+  farm::FarmPlan plan = farm::FarmPlan::make("eye.glb", "out/shot.####.exr", FrameList::parse("--frames", "1001-1010"), 4, {});
   ASSERT_EQ(plan.tasks(), 3u);
   EXPECT_EQ(plan.taskFrames(0).frames, (std::vector<long>{1001, 1002, 1003, 1004}));
   EXPECT_EQ(plan.taskFrames(2).frames, (std::vector<long>{1009, 1010}));
@@ -155,37 +157,37 @@ TEST(FarmPlan, CutsTheFramesIntoTasksInOrder) {
 }
 
 TEST(FarmPlan, NamesItsFolderAfterTheImagesWithoutTheirFrameSlot) {
-  cli::FarmPlan plan = cli::FarmPlan::make("eye.glb", "/r/out/shot_%04d.exr", FrameList::parse("--frames", "1-2"), 1, {});
+  farm::FarmPlan plan = farm::FarmPlan::make("eye.glb", "/r/out/shot_%04d.exr", FrameList::parse("--frames", "1-2"), 1, {});
   EXPECT_EQ(plan.name(), "shot");
   EXPECT_EQ(plan.folder(), "/r/out/.snell-farm/shot");
   EXPECT_EQ(plan.statsPattern(), "/r/out/.snell-farm/shot/stats/shot_%04d.json");
 }
 
-TEST(FarmPlan, AChunkOfZeroIsAUsageError) {
-  EXPECT_THROW(cli::FarmPlan::make("a.glb", "f_#.png", FrameList::parse("--frames", "1-2"), 0, {}), cli::UsageError);
+TEST(FarmPlan, AChunkOfZeroIsACallersMistake) {
+  EXPECT_THROW(farm::FarmPlan::make("a.glb", "f_#.png", FrameList::parse("--frames", "1-2"), 0, {}), std::invalid_argument);
 }
 
 TEST(FarmPlan, ArrayListsJoinRuns) {
-  EXPECT_EQ(cli::arrayList({0, 1, 2, 5, 7, 8}), "0-2,5,7-8");
-  EXPECT_EQ(cli::arrayList({3}), "3");
+  EXPECT_EQ(farm::arrayList({0, 1, 2, 5, 7, 8}), "0-2,5,7-8");
+  EXPECT_EQ(farm::arrayList({3}), "3");
 }
 
 TEST_F(FarmFolder, OnlyTasksWithAMissingFrameRunAgain) {
-  cli::FarmPlan plan = cli::FarmPlan::make((dir_ / "eye.glb").string(), (dir_ / "f.##.png").string(),
+  farm::FarmPlan plan = farm::FarmPlan::make((dir_ / "eye.glb").string(), (dir_ / "f.##.png").string(),
                                            FrameList::parse("--frames", "1-6"), 2, {});
-  for (long f : {1, 2, 3, 5, 6}) touch(cli::framePath(plan.output, f));
+  for (long f : {1, 2, 3, 5, 6}) touch(farm::framePath(plan.output, f));
   EXPECT_EQ(plan.tasksToRun(), (std::vector<size_t>{1}));
   EXPECT_EQ(plan.missingFrames(), (std::vector<long>{4}));
 }
 
 TEST_F(FarmFolder, TheCheckNamesMissingFramesAndTheTaskThatFailed) {
-  cli::FarmPlan plan = cli::FarmPlan::make((dir_ / "eye.glb").string(), (dir_ / "f.##.png").string(),
+  farm::FarmPlan plan = farm::FarmPlan::make((dir_ / "eye.glb").string(), (dir_ / "f.##.png").string(),
                                            FrameList::parse("--frames", "1-6"), 2, {});
-  for (long f : {1, 2, 3, 5, 6}) touch(cli::framePath(plan.output, f));
+  for (long f : {1, 2, 3, 5, 6}) touch(farm::framePath(plan.output, f));
   touch(plan.statusPath("7", 0));
   std::ofstream(plan.statusPath("7", 0)) << "0\n";
   std::ofstream(plan.statusPath("7", 1)) << "1\n";  // task 2 left no status: it did not finish
-  cli::FarmCheck check = cli::checkFarm(plan, "7", {0, 1, 2});
+  farm::FarmCheck check = farm::checkFarm(plan, "7", {0, 1, 2});
   EXPECT_FALSE(check.ok());
   EXPECT_EQ(check.missing, (std::vector<long>{4}));
   ASSERT_EQ(check.failed.size(), 2u);
@@ -197,15 +199,15 @@ TEST_F(FarmFolder, TheCheckNamesMissingFramesAndTheTaskThatFailed) {
 }
 
 TEST_F(FarmFolder, APlanReadsBackAsWritten) {
-  cli::FarmPlan plan = cli::FarmPlan::make("eye.glb", (dir_ / "f.##.png").string(), FrameList::parse("--frames", "1-9x2"),
+  farm::FarmPlan plan = farm::FarmPlan::make("eye.glb", (dir_ / "f.##.png").string(), FrameList::parse("--frames", "1-9x2"),
                                            2, {"--size", "16x12"});
   std::ofstream(dir_ / "plan.json") << plan.toJson().dump();
-  cli::FarmPlan back = cli::FarmPlan::read((dir_ / "plan.json").string());
+  farm::FarmPlan back = farm::FarmPlan::read((dir_ / "plan.json").string());
   EXPECT_EQ(back.frames.frames, plan.frames.frames);
   EXPECT_EQ(back.output, plan.output);
   EXPECT_EQ(back.renderOptions, plan.renderOptions);
   std::ofstream(dir_ / "bad.json") << "{\"scene\": 1}";
-  EXPECT_THROW(cli::FarmPlan::read((dir_ / "bad.json").string()), std::runtime_error);
+  EXPECT_THROW(farm::FarmPlan::read((dir_ / "bad.json").string()), std::runtime_error);
 }
 
 }  // namespace

@@ -5,6 +5,7 @@
 #include "snell/snell.h"
 
 #include "bake/refraction_bake.h"
+#include "io/environment.h"
 #include "render/method.h"
 #include "render/pixel_aovs.h"
 #include "render/raster_pass.h"
@@ -95,6 +96,7 @@ vk::ContextDesc contextDesc(const DeviceOptions& options) {
   vk::ContextDesc desc;
   desc.applicationName = "snell (embedded)";
   desc.deviceOverride = options.device;
+  desc.environment = io::deviceEnvironment();  // SNELL_DEVICE, or the GPUs a launcher gave the process
   desc.validation = options.validation;
   desc.synchronizationValidation = options.synchronizationValidation;
   desc.driverRayTracing = options.driverRayTracing;
@@ -752,7 +754,7 @@ ShotSummary renderFrames(const std::string& devices, Scene& scene, const View& v
     if (!devices.empty()) {
       std::string why;
       workers.clear();
-      for (uint32_t index : vk::devicesForList(devices, why)) workers.push_back({std::to_string(index), why});
+      for (uint32_t index : vk::devicesForList(devices, io::deviceEnvironment(), why)) workers.push_back({std::to_string(index), why});
     }
     DeviceOptions shared = options;
     shared.device.clear();

@@ -8,6 +8,7 @@
 #include "cli/commands.h"
 #include "cli/render_shot.h"
 
+#include "io/environment.h"
 #include "io/image_file.h"
 #include "io/json.h"
 #include "scene/gltf_writer.h"
@@ -89,7 +90,7 @@ int runBench(Options& o) {
   if (o.folder.empty()) o.folder = (fs::temp_directory_path() / "snell-bench-shot").string();
   fs::create_directories(o.folder);
   std::string why;
-  std::vector<uint32_t> all = vk::devicesForList(o.devices, why);
+  std::vector<uint32_t> all = vk::devicesForList(o.devices, io::deviceEnvironment(), why);
   std::string allList;
   for (uint32_t d : all) allList += (allList.empty() ? "" : ",") + std::to_string(d);
 
@@ -129,7 +130,7 @@ int runBench(Options& o) {
   }
 
   if (!o.json.empty()) {
-    vk::DeviceReport survey = vk::surveyDevices(std::to_string(all.front()));
+    vk::DeviceReport survey = vk::surveyDevices(std::to_string(all.front()), io::deviceEnvironment());
     io::Json j = io::reportHead("bench-shot", &survey.devices[all.front()]);
     j["crowd"] = o.crowd;
     j["width"] = o.width;

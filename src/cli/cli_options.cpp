@@ -128,17 +128,6 @@ void parseOnly(CLI::App& app, const Args& args) {
   }
 }
 
-namespace {
-
-// lavapipe starts a thread per CPU of the node; a Slurm task that was given N
-// CPUs would take the others' from tasks sharing the node.
-void keepToTheTasksCpus() {
-  const char* cpus = std::getenv("SLURM_CPUS_PER_TASK");
-  if (cpus && *cpus && !std::getenv("LP_NUM_THREADS")) ::setenv("LP_NUM_THREADS", cpus, 0);
-}
-
-}  // namespace
-
 int runCommandLine(CLI::App& app, int argc, char** argv, const Runner& run) {
   const std::string program = programName(app);
   auto usage = [&](const std::string& message) {
@@ -159,7 +148,7 @@ int runCommandLine(CLI::App& app, int argc, char** argv, const Runner& run) {
     return kExitFailure;
   }
   if (!run) return usage("give a command");
-  keepToTheTasksCpus();
+  io::keepToTheTasksCpus();
   try {
     return run();
   } catch (const UsageError& e) {

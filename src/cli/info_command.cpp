@@ -2,6 +2,7 @@
 // text, and as JSON with --json.
 #include "cli/commands.h"
 
+#include "io/environment.h"
 #include "io/image_file.h"
 #include "io/json.h"
 #include "render/method.h"
@@ -68,7 +69,7 @@ io::Json deviceEntry(const vk::DeviceReport& report, size_t i) {
 int listDevices(const Options& o) {
   if (!o.json.empty() && o.json != "-") io::checkWritable(o.json);
   bool text = o.json != "-";
-  vk::DeviceReport report = vk::surveyDevices();
+  vk::DeviceReport report = vk::surveyDevices("", io::deviceEnvironment());
   const std::optional<uint32_t>& chosen = report.choice.chosen;
   if (text) {
     std::printf("Vulkan devices (%s):\n%s", report.why.c_str(), report.table().c_str());
@@ -181,7 +182,7 @@ void addScene(io::Json& j, const scene::Scene& scene) {
 // The device snell would run on, for the JSON's head; none when none qualifies.
 std::optional<vk::DeviceFacts> deviceSnellPicks() {
   try {
-    vk::DeviceReport report = vk::surveyDevices();
+    vk::DeviceReport report = vk::surveyDevices("", io::deviceEnvironment());
     if (report.choice.chosen) return report.devices[*report.choice.chosen];
   } catch (const vk::VulkanError&) {
     // No Vulkan here at all: the scene's facts need no GPU, so the head goes without one.

@@ -17,6 +17,7 @@
 #include <cstdio>
 #include <functional>
 #include <memory>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -30,6 +31,17 @@ using Args = std::vector<std::string>;
 struct UsageError {
   std::string message;
 };
+
+/// Runs `body`, turning a caller's mistake a lower layer found
+/// (std::invalid_argument: a frame list, a file pattern) into a UsageError.
+template <typename Body>
+auto usageErrors(Body&& body) -> decltype(body()) {
+  try {
+    return body();
+  } catch (const std::invalid_argument& e) {
+    throw UsageError{e.what()};
+  }
+}
 
 /// What runs a subcommand once its whole command line has parsed.
 using Runner = std::function<int()>;

@@ -4,8 +4,8 @@
 // with --reference), or with --viewport the viewer's composite.
 #include "cli/commands.h"
 #include "cli/exr_layers.h"
-#include "cli/frames.h"
 #include "cli/render_shot.h"
+#include "farm/frames.h"
 
 #include "io/environment.h"
 #include "render/method.h"
@@ -58,7 +58,7 @@ void addOptions(CLI::App& render, RenderOptions& o) {
       });
   o.shot.addTo(render);
   CLI::Option* frames = render.add_option_function<std::string>(
-      "--frames", [&o](const std::string& v) { o.frames = FrameList::parse("--frames", v); },
+      "--frames", [&o](const std::string& v) { o.frames = usageErrors([&] { return FrameList::parse("--frames", v); }); },
       "render these frames at --fps: 1-240, 1-240x4 (every 4th),\n"
       "1:240:4 (the same), 1,5,10-20; in increasing order, each once");
   frames->type_name("LIST")->excludes(o.shot.timeOption);
@@ -195,8 +195,8 @@ void check(RenderOptions& o) {
   // EXR coverage and AOVs come from the trace's own per-pixel data, which the driver's ray tracing has not.
   if (o.exr() || o.viewport || o.reference) o.autoMethod = false;
   size_t frames = o.frames ? o.frames->size() : 1;
-  checkFramePattern("-o", o.output, frames);
-  if (!o.statsJson.empty()) checkFramePattern("--stats-json", o.statsJson, frames);
+  usageErrors([&] { checkFramePattern("-o", o.output, frames); });
+  if (!o.statsJson.empty()) usageErrors([&] { checkFramePattern("--stats-json", o.statsJson, frames); });
 }
 
 

@@ -233,7 +233,7 @@ std::vector<render::ShotDevice> workerDevices(const RenderOptions& o) {
   if (o.devices.empty()) return {{"", ""}};
   std::string why;
   std::vector<render::ShotDevice> devices;
-  for (uint32_t index : vk::devicesForList(o.devices, why)) devices.push_back({std::to_string(index), why});
+  for (uint32_t index : vk::devicesForList(o.devices, io::deviceEnvironment(), why)) devices.push_back({std::to_string(index), why});
   return devices;
 }
 

@@ -5,8 +5,8 @@
 // under way.
 #pragma once
 
-#include "cli/frames.h"
 #include "cli/options.h"
+#include "farm/frames.h"
 #include "render/method.h"
 #include "render/raster_pass.h"
 #include "render/shot.h"
@@ -19,6 +19,10 @@
 #include <vector>
 
 namespace snell::cli {
+
+using farm::FrameList;
+using farm::checkFramePattern;
+using farm::framePath;
 
 /// The AOV layers --aov may name, in the order they are written.
 extern const std::vector<std::string> kAovNames;

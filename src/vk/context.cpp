@@ -35,37 +35,26 @@ bool hasInstanceExtension(const char* name) {
                      [&](const VkExtensionProperties& e) { return std::strcmp(e.extensionName, name) == 0; });
 }
 
-// The GPUs a launcher gave this process, as (variable, value); a null
-// variable where none did. Unset, empty, "-1" or Slurm's "NoDevFiles": the
-// launcher gave no GPU to keep to. Slurm's own lists come last: its GPU
-// plugin sets CUDA_VISIBLE_DEVICES beside them wherever it hands out GPUs.
-std::pair<const char*, const char*> launcherGpus() {
-  for (const char* variable : {"CUDA_VISIBLE_DEVICES", "GPU_DEVICE_ORDINAL", "SLURM_STEP_GPUS", "SLURM_JOB_GPUS"}) {
-    const char* value = std::getenv(variable);
-    if (!value || !*value || *value == '-' || std::strcmp(value, "NoDevFiles") == 0) continue;
-    return {variable, value};
-  }
-  return {nullptr, nullptr};
-}
-
 // The device override and where it came from: the caller's (--device),
 // SNELL_DEVICE, then a launcher's GPU list. Slurm and CUDA launchers set
 // CUDA_VISIBLE_DEVICES, GPU_DEVICE_ORDINAL and SLURM_STEP_GPUS, which no Vulkan driver reads:
 // without them every task of a node would pile onto its first GPU.
-std::string resolveOverride(const std::string& given, std::span<const DeviceFacts> facts, std::string& why) {
+std::string resolveOverride(const std::string& given, const DeviceEnvironment& environment,
+                            std::span<const DeviceFacts> facts, std::string& why) {
   if (!given.empty()) {
     why = "device=" + given;
     return given;
   }
-  if (const char* env = std::getenv("SNELL_DEVICE"); env && *env) {
-    why = std::string("SNELL_DEVICE=") + env;
-    return env;
+  if (!environment.device.empty()) {
+    why = "SNELL_DEVICE=" + environment.device;
+    return environment.device;
   }
-  if (auto [variable, value] = launcherGpus(); variable) return launcherOverride(facts, variable, value, why);
+  if (!environment.launcherVariable.empty()) {
+    return launcherOverride(facts, environment.launcherVariable, environment.launcherValue, why);
+  }
   why = "none named: the best in rank, discrete, integrated, virtual GPU, then CPU";
   return "";
 }
-
 
 struct InstanceRequest {
   std::string applicationName = "snell";
@@ -173,21 +162,19 @@ std::string DeviceReport::table() const {
   return out.str();
 }
 
-DeviceReport surveyDevices(const std::string& deviceOverride) {
+DeviceReport surveyDevices(const std::string& deviceOverride, const DeviceEnvironment& environment) {
   DeviceReport report;
   report.devices = readFactsOnce();
-  report.override = resolveOverride(deviceOverride, report.devices, report.why);
+  report.override = resolveOverride(deviceOverride, environment, report.devices, report.why);
   report.choice = chooseDevice(report.devices, report.override, report.why);
   return report;
 }
 
-std::vector<uint32_t> devicesForList(const std::string& list, std::string& why) {
+std::vector<uint32_t> devicesForList(const std::string& list, const DeviceEnvironment& environment, std::string& why) {
   std::vector<DeviceFacts> facts = readFactsOnce();
-  if (list == "all") {
-    if (auto [variable, value] = launcherGpus(); variable) {
-      why = std::string(variable) + "=" + value + ": every GPU the launcher gave";
-      return launcherDevices(facts, variable, value);
-    }
+  if (list == "all" && !environment.launcherVariable.empty()) {
+    why = environment.launcherVariable + "=" + environment.launcherValue + ": every GPU the launcher gave";
+    return launcherDevices(facts, environment.launcherVariable, environment.launcherValue);
   }
   why = list == "all" ? "--devices all: every device of the best kind that qualifies" : "--devices " + list;
   return chooseDeviceList(facts, list);
@@ -230,7 +217,7 @@ std::unique_ptr<Context> Context::create(const ContextDesc& desc) {
   std::vector<VkPhysicalDevice> handles;
   std::vector<DeviceFacts> facts = readAllFacts(c.instance_, handles);
   std::string why;
-  std::string override = resolveOverride(desc.deviceOverride, facts, why);
+  std::string override = resolveOverride(desc.deviceOverride, desc.environment, facts, why);
   DeviceChoice choice = chooseDevice(facts, override, why);
   if (!choice.chosen) {
     DeviceReport report{facts, choice, override, why};

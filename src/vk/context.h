@@ -26,16 +26,25 @@
 namespace snell::vk {
 
 /// How snell creates its own context.
+/// What the process environment says about the device, where no one names
+/// one: SNELL_DEVICE, else the GPUs a launcher gave the process (Slurm or a
+/// CUDA-style scheduler), which no Vulkan driver reads and launcherOverride
+/// maps onto Vulkan's devices. io::deviceEnvironment() fills it.
+struct DeviceEnvironment {
+  std::string device;  ///< SNELL_DEVICE's value ("": unset)
+  std::string launcherVariable, launcherValue;  ///< e.g. CUDA_VISIBLE_DEVICES and "2" ("": none)
+};
+
 struct ContextDesc {
   std::string applicationName = "snell";
   /// Turn on VK_LAYER_KHRONOS_validation; creation fails if the layer is missing.
   bool validation = false;
   /// With validation: also check synchronization (missing barriers, hazards).
   bool synchronizationValidation = false;
-  /// An index, a UUID or a name substring; empty means SNELL_DEVICE, then a
-  /// launcher's CUDA_VISIBLE_DEVICES, GPU_DEVICE_ORDINAL, SLURM_STEP_GPUS or SLURM_JOB_GPUS
-  /// (see launcherOverride).
+  /// An index, a UUID or a name substring; empty: what `environment` says.
   std::string deviceOverride;
+  /// The process environment's say on the device (io::deviceEnvironment reads it; vk reads none).
+  DeviceEnvironment environment;
   /// Ask the driver for per-pipeline statistics where it offers them.
   bool pipelineStatistics = false;
   /// Extra extensions a window needs (a surface on the instance, the swapchain
@@ -105,12 +114,12 @@ struct DeviceReport {
 };
 
 /// Surveys the Vulkan devices as Context::create would choose among them.
-DeviceReport surveyDevices(const std::string& deviceOverride = "");
+DeviceReport surveyDevices(const std::string& deviceOverride, const DeviceEnvironment& environment);
 
 /// The devices of a --devices list (chooseDeviceList), a worker each; "all"
-/// within a launcher's CUDA_VISIBLE_DEVICES is every GPU it lists. `why` says
-/// how they were found; throws VulkanError naming a bad entry.
-std::vector<uint32_t> devicesForList(const std::string& list, std::string& why);
+/// within a launcher's GPUs (`environment`) is every GPU it lists. `why`
+/// says how they were found; throws VulkanError naming a bad entry.
+std::vector<uint32_t> devicesForList(const std::string& list, const DeviceEnvironment& environment, std::string& why);
 
 /// Owns (or borrows) the Vulkan device everything else runs on, counts
 /// validation messages, and defers destruction of handles the GPU may still use.

@@ -18,6 +18,7 @@ LAYERS: list[tuple[str, tuple[str, ...]]] = [
     ("vk", ("src/vk",)),
     ("scene", ("src/scene",)),
     ("io", ("src/io",)),
+    ("farm", ("src/farm",)),
     ("peer", ("src/peer",)),
     ("ref", ("src/ref",)),
     ("render", ("src/render",)),

@@ -6,7 +6,7 @@
 #include <string>
 #include <vector>
 
-namespace snell::cli {
+namespace snell::farm {
 
 /// A list of frame numbers, increasing, each once. Written as
 ///   first:last[:step]  (snell's own)         1:240:4
@@ -14,7 +14,7 @@ namespace snell::cli {
 ///   first-last:step    (Open Job Description) 1-240:4
 ///   items separated by commas, each a frame or a range: 1,5,10-20
 /// A reversed range, a step of zero or below, a negative frame, or items
-/// that overlap are usage errors naming the option and the list.
+/// that overlap are std::invalid_argument naming the option and the list.
 struct FrameList {
   std::vector<long> frames;
   std::string text;  ///< as given
@@ -32,7 +32,7 @@ bool hasFrameSlot(const std::string& pattern);
 /// (shot.####.exr: shot.0042.exr), %d or %0Nd as printf writes it.
 std::string framePath(const std::string& pattern, long frame);
 /// Checks a name pattern against the frames asked for: several frames need a
-/// slot, a single one may have none. Throws UsageError naming the option.
+/// slot, a single one may have none. Throws std::invalid_argument naming the option.
 void checkFramePattern(const std::string& option, const std::string& pattern, size_t frames);
 
-}  // namespace snell::cli
+}  // namespace snell::farm

@@ -1,14 +1,13 @@
 // Frame lists and file-name patterns (see frames.h).
-#include "cli/frames.h"
-
-#include "cli/options.h"
+#include "farm/frames.h"
 
 #include <algorithm>
 #include <charconv>
 #include <cstdio>
 #include <iterator>
+#include <stdexcept>
 
-namespace snell::cli {
+namespace snell::farm {
 
 namespace {
 
@@ -16,9 +15,9 @@ long number(const std::string& option, const std::string& list, const std::strin
   long value = 0;
   auto [end, error] = std::from_chars(text.data(), text.data() + text.size(), value);
   if (text.empty() || error != std::errc() || end != text.data() + text.size()) {
-    throw UsageError{option + " " + list + ": '" + text + "' is not a whole number"};
+    throw std::invalid_argument(option + " " + list + ": '" + text + "' is not a whole number");
   }
-  if (value < 0) throw UsageError{option + " " + list + ": frame numbers are 0 or more, got " + text};
+  if (value < 0) throw std::invalid_argument(option + " " + list + ": frame numbers are 0 or more, got " + text);
   return value;
 }
 
@@ -46,10 +45,10 @@ std::vector<long> item(const std::string& option, const std::string& list, const
   } else {
     first = last = number(option, list, text);
   }
-  if (step <= 0) throw UsageError{option + " " + list + ": the step of '" + text + "' must be 1 or more"};
+  if (step <= 0) throw std::invalid_argument(option + " " + list + ": the step of '" + text + "' must be 1 or more");
   if (last < first) {
-    throw UsageError{option + " " + list + ": '" + text + "' runs backwards: it ends at " + std::to_string(last) +
-                     ", before it starts at " + std::to_string(first)};
+    throw std::invalid_argument(option + " " + list + ": '" + text + "' runs backwards: it ends at " + std::to_string(last) +
+                     ", before it starts at " + std::to_string(first));
   }
   std::vector<long> frames;
   for (long f = first; f <= last; f += step) frames.push_back(f);
@@ -62,18 +61,18 @@ FrameList FrameList::parse(const std::string& option, const std::string& text) {
   FrameList list;
   list.text = text;
   std::string quoted = "'" + text + "'";
-  if (text.empty()) throw UsageError{option + ": give frames, e.g. 1-240, 1:240:4 or 1,5,10-20"};
+  if (text.empty()) throw std::invalid_argument(option + ": give frames, e.g. 1-240, 1:240:4 or 1,5,10-20");
   std::vector<std::pair<long, long>> spans;  // each item's first and last, to name overlaps
   size_t start = 0;
   while (start <= text.size()) {
     size_t comma = text.find(',', start);
     std::string part = text.substr(start, comma == std::string::npos ? std::string::npos : comma - start);
-    if (part.empty()) throw UsageError{option + " " + quoted + ": an empty item between commas"};
+    if (part.empty()) throw std::invalid_argument(option + " " + quoted + ": an empty item between commas");
     std::vector<long> frames = item(option, quoted, part);
     for (const auto& [lo, hi] : spans) {
       if (frames.front() <= hi && frames.back() >= lo) {
-        throw UsageError{option + " " + quoted + ": '" + part + "' overlaps frames " + std::to_string(lo) + "-" +
-                         std::to_string(hi) + " listed before it"};
+        throw std::invalid_argument(option + " " + quoted + ": '" + part + "' overlaps frames " + std::to_string(lo) + "-" +
+                         std::to_string(hi) + " listed before it");
       }
     }
     spans.emplace_back(frames.front(), frames.back());
@@ -134,9 +133,9 @@ std::string framePath(const std::string& pattern, long frame) {
 
 void checkFramePattern(const std::string& option, const std::string& pattern, size_t frames) {
   if (frames > 1 && !hasFrameSlot(pattern)) {
-    throw UsageError{option + " " + pattern + ": " + std::to_string(frames) +
-                     " frames need a slot for the frame number in the name, '#'s or %04d (e.g. shot.####.exr)"};
+    throw std::invalid_argument(option + " " + pattern + ": " + std::to_string(frames) +
+                     " frames need a slot for the frame number in the name, '#'s or %04d (e.g. shot.####.exr)");
   }
 }
 
-}  // namespace snell::cli
+}  // namespace snell::farm

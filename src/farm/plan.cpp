@@ -1,7 +1,5 @@
-// A shot's chunks, its farm folder and its check (see farm_plan.h).
-#include "cli/farm_plan.h"
-
-#include "cli/options.h"
+// A shot's chunks, its farm folder and its check (see plan.h).
+#include "farm/plan.h"
 
 #include <algorithm>
 #include <cctype>
@@ -10,7 +8,7 @@
 #include <map>
 #include <stdexcept>
 
-namespace snell::cli {
+namespace snell::farm {
 
 namespace fs = std::filesystem;
 
@@ -57,7 +55,7 @@ int readStatus(const std::string& path) {
 
 FarmPlan FarmPlan::make(const std::string& scene, const std::string& output, FrameList frames, uint32_t chunk,
                         std::vector<std::string> renderOptions) {
-  if (chunk == 0) throw UsageError{"--chunk must be 1 or more frames"};
+  if (chunk == 0) throw std::invalid_argument("--chunk must be 1 or more frames");
   checkFramePattern("-o", output, frames.size());
   FarmPlan plan;
   plan.scene = fs::absolute(scene).lexically_normal().string();
@@ -139,8 +137,8 @@ FarmPlan FarmPlan::read(const std::string& path) {
     plan.renderOptions = j.at("render_options").get<std::vector<std::string>>();
     if (plan.chunk == 0) throw std::runtime_error("chunk is 0");
     return plan;
-  } catch (const UsageError& e) {
-    throw std::runtime_error(path + ": " + e.message);
+  } catch (const std::invalid_argument& e) {
+    throw std::runtime_error(path + ": " + e.what());
   } catch (const std::exception& e) {
     throw std::runtime_error(path + ": not a farm plan snell can read: " + e.what());
   }
@@ -219,4 +217,4 @@ std::string arrayList(const std::vector<size_t>& indices) {
   return out;
 }
 
-}  // namespace snell::cli
+}  // namespace snell::farm

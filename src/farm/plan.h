@@ -1,18 +1,18 @@
 // A shot as a farm runs it: the frames cut into chunks (one array task
 // each), the folder beside the images where the job's scripts, logs and
 // per-frame records live, and the check that says which frames are missing
-// and which tasks failed. The Slurm and Open Job Description commands
-// (farm_command.cpp) are written around it.
+// and which tasks failed. The Slurm and Open Job Description jobs
+// (slurm.h, openjd.h) are written around it.
 #pragma once
 
-#include "cli/frames.h"
+#include "farm/frames.h"
 #include "io/json.h"
 
 #include <cstdint>
 #include <string>
 #include <vector>
 
-namespace snell::cli {
+namespace snell::farm {
 
 struct FarmPlan {
   std::string scene;   ///< absolute
@@ -23,7 +23,7 @@ struct FarmPlan {
   std::vector<std::string> renderOptions;
 
   /// A plan for `frames` of `scene` into `output` (both made absolute).
-  /// Throws UsageError when several frames have no slot in the name, or `chunk` is 0.
+  /// Throws std::invalid_argument when several frames have no slot in the name, or `chunk` is 0.
   static FarmPlan make(const std::string& scene, const std::string& output, FrameList frames, uint32_t chunk,
                        std::vector<std::string> renderOptions);
 
@@ -79,4 +79,4 @@ FarmCheck checkFarm(const FarmPlan& plan, const std::string& job, const std::vec
 /// Indices as Slurm's --array takes them: "0-2,5".
 std::string arrayList(const std::vector<size_t>& indices);
 
-}  // namespace snell::cli
+}  // namespace snell::farm
