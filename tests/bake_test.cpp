@@ -72,7 +72,10 @@ io::ImageDifference glassError(const io::Rgb8Image& got, const io::Rgb8Image& wa
   return io::compareImages(got, want, &glass);
 }
 
-TEST_F(GpuTest, TheBakedEyeMarksItsGlassAndWhereItLandsOnTheIris) {
+// The GPU tests of baking the refraction map on the GPU.
+class RefractionBake : public GpuTest {};
+
+TEST_F(RefractionBake, TheBakedEyeMarksItsGlassAndWhereItLandsOnTheIris) {
   Baked b = bakeEye(context());
   size_t lands = b.bake.count(bake::Coverage::Lands), marked = b.bake.count(bake::Coverage::Marked);
   std::printf("%s\n", bake::describe(b.bake, b.scene).c_str());
@@ -94,7 +97,7 @@ TEST_F(GpuTest, TheBakedEyeMarksItsGlassAndWhereItLandsOnTheIris) {
 
 // At the pose and view it was baked at, the map redraws the trace: each
 // glass pixel is the shine plus the weight times the same texel.
-TEST_F(GpuTest, TheMapRedrawsTheTraceAtTheBakedPoseAndView) {
+TEST_F(RefractionBake, TheMapRedrawsTheTraceAtTheBakedPoseAndView) {
   Baked b = bakeEye(context());
   render::RefractionMapBuffer map = render::uploadRefractionMap(context(), b.bake);
   io::Rgb8Image drawn = drawWithMap(context(), b.scene, b.pose, b.settings, map);
@@ -109,7 +112,7 @@ TEST_F(GpuTest, TheMapRedrawsTheTraceAtTheBakedPoseAndView) {
 
 // The renderer keeps the map it baked: a refraction-map view that names no
 // map of its own draws with it, as it would with the same map handed over.
-TEST_F(GpuTest, ARendererDrawsWithTheRefractionMapItBakedLast) {
+TEST_F(RefractionBake, ARendererDrawsWithTheRefractionMapItBakedLast) {
   Baked b = bakeEye(context());
   render::Renderer renderer(context(), b.scene, b.pose);
   renderer.bakeRefractionMap(b.pose, b.settings);
@@ -123,7 +126,7 @@ TEST_F(GpuTest, ARendererDrawsWithTheRefractionMapItBakedLast) {
   EXPECT_EQ(kept.rgb, drawWithMap(context(), b.scene, b.pose, b.settings, map).rgb);
 }
 
-TEST_F(GpuTest, TheRefractionMapMethodWithoutABakedMapIsAnError) {
+TEST_F(RefractionBake, TheRefractionMapMethodWithoutABakedMapIsAnError) {
   Baked b = bakeEye(context());
   render::Renderer renderer(context(), b.scene, b.pose);
   render::FrameRequest request;
@@ -139,7 +142,7 @@ TEST_F(GpuTest, TheRefractionMapMethodWithoutABakedMapIsAnError) {
 
 // Baked at 0 s and drawn at later times, the eye has moved under the map:
 // the error grows with the drift, and the method does no trace.
-TEST_F(GpuTest, TheMapsErrorGrowsAsThePoseDriftsFromTheBakedOne) {
+TEST_F(RefractionBake, TheMapsErrorGrowsAsThePoseDriftsFromTheBakedOne) {
   Baked b = bakeEye(context());
   render::RefractionMapBuffer map = render::uploadRefractionMap(context(), b.bake);
   double duration = scene::animationDuration(b.scene);
@@ -159,7 +162,7 @@ TEST_F(GpuTest, TheMapsErrorGrowsAsThePoseDriftsFromTheBakedOne) {
 // The DCC route: the texture behind replaced by a UV gradient, rendered and
 // read back, gives the UVs the trace reports, within the gradient's texel
 // and the encoding's step; the tiled gradient (sky8's codes) is the finer.
-TEST_F(GpuTest, TheDccRouteAgreesWithTheDirectBake) {
+TEST_F(RefractionBake, TheDccRouteAgreesWithTheDirectBake) {
   Baked b = bakeEye(context());
   bake::DecodedMap direct = bake::storedMap(b.bake, b.scene);
   struct Route {
@@ -190,7 +193,7 @@ TEST_F(GpuTest, TheDccRouteAgreesWithTheDirectBake) {
 
 // Each file encoding written and read back holds the baked UVs within its
 // step, and the coverage exactly.
-TEST_F(GpuTest, EachMapFileRoundTripsTheBakedUvsWithinItsStep) {
+TEST_F(RefractionBake, EachMapFileRoundTripsTheBakedUvsWithinItsStep) {
   Baked b = bakeEye(context());
   bake::DecodedMap want = bake::storedMap(b.bake, b.scene);
   namespace fs = std::filesystem;

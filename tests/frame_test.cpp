@@ -70,7 +70,10 @@ scene::View lookFrom(const glm::dvec3& eye, const glm::dvec3& target = glm::dvec
   return scene::resolveView(scene::Scene{}, scene::Pose{}, request);
 }
 
-TEST_F(GpuTest, AStaticScenesSecondFrameRunsNoDeformRefitOrTopLevelWork) {
+// The GPU tests of what a frame runs, skips and reads back.
+class Frame : public GpuTest {};
+
+TEST_F(Frame, AStaticScenesSecondFrameRunsNoDeformRefitOrTopLevelWork) {
   scene::Scene s = smallEye();
   scene::Pose pose = scene::evaluate(s, 0.5);
   Renderer renderer(context(), s, pose);
@@ -88,7 +91,7 @@ TEST_F(GpuTest, AStaticScenesSecondFrameRunsNoDeformRefitOrTopLevelWork) {
   EXPECT_EQ(second.dispatches, 0u);
 }
 
-TEST_F(GpuTest, OrbitingTheCameraAloneRunsNoDeformOrRefit) {
+TEST_F(Frame, OrbitingTheCameraAloneRunsNoDeformOrRefit) {
   scene::Scene s = smallEye();
   scene::Pose pose = scene::evaluate(s, 0.5);
   Renderer renderer(context(), s, pose);
@@ -106,7 +109,7 @@ TEST_F(GpuTest, OrbitingTheCameraAloneRunsNoDeformOrRefit) {
   }
 }
 
-TEST_F(GpuTest, OneMovingCharacterOutOfTenRefitsOnlyItsOwnTrees) {
+TEST_F(Frame, OneMovingCharacterOutOfTenRefitsOnlyItsOwnTrees) {
   scene::EyeOptions options;
   options.resolution = 8;
   options.crowd = 10;
@@ -138,7 +141,7 @@ TEST_F(GpuTest, OneMovingCharacterOutOfTenRefitsOnlyItsOwnTrees) {
 }
 
 // The whole update is a fixed number of dispatches, however many shapes move.
-TEST_F(GpuTest, TheUpdateTakesAsManyDispatchesForTenCharactersAsForOne) {
+TEST_F(Frame, TheUpdateTakesAsManyDispatchesForTenCharactersAsForOne) {
   auto dispatches = [&](uint32_t crowd) {
     scene::EyeOptions options;
     options.resolution = 8;
@@ -159,7 +162,7 @@ TEST_F(GpuTest, TheUpdateTakesAsManyDispatchesForTenCharactersAsForOne) {
   EXPECT_EQ(one, ten);
 }
 
-TEST_F(GpuTest, AnEyeOffScreenGetsNoTraceDispatch) {
+TEST_F(Frame, AnEyeOffScreenGetsNoTraceDispatch) {
   scene::Scene s = smallEye();
   scene::Pose pose = scene::evaluate(s, 0.0);
   Renderer renderer(context(), s, pose);
@@ -172,7 +175,7 @@ TEST_F(GpuTest, AnEyeOffScreenGetsNoTraceDispatch) {
 
 // From behind, the cornea hides behind the sclera: the mask is empty and the
 // trace's indirect dispatch carries no workgroup.
-TEST_F(GpuTest, AnEyeTurnedAwayTracesNoPixel) {
+TEST_F(Frame, AnEyeTurnedAwayTracesNoPixel) {
   scene::Scene s = smallEye();
   scene::Pose pose = scene::evaluate(s, 0.0);
   Renderer renderer(context(), s, pose);
@@ -181,7 +184,7 @@ TEST_F(GpuTest, AnEyeTurnedAwayTracesNoPixel) {
   EXPECT_LE(stats.traceDispatches, 1u);
 }
 
-TEST_F(GpuTest, TheMaskedTraceCoversExactlyThePixelsWhoseVisibleFaceIsTransmissive) {
+TEST_F(Frame, TheMaskedTraceCoversExactlyThePixelsWhoseVisibleFaceIsTransmissive) {
   scene::Scene s = smallEye();
   scene::Pose pose = scene::evaluate(s, 0.0);
   Renderer renderer(context(), s, pose);
@@ -201,7 +204,7 @@ TEST_F(GpuTest, TheMaskedTraceCoversExactlyThePixelsWhoseVisibleFaceIsTransmissi
 
 // Tolerance: 1/255 on 99.9% of pixels. Measured on lavapipe: identical, as
 // each traced pixel's ray is the same whether its neighbours are traced or not.
-TEST_F(GpuTest, TheMaskedCompositeMatchesTheFullTraceComposite) {
+TEST_F(Frame, TheMaskedCompositeMatchesTheFullTraceComposite) {
   scene::Scene s = eyeWith(1.376f);
   scene::Pose pose = scene::evaluate(s, 0.0);
   scene::View view = scene::resolveView(s, pose, {});
@@ -219,7 +222,7 @@ TEST_F(GpuTest, TheMaskedCompositeMatchesTheFullTraceComposite) {
   EXPECT_GE(double(result.withinOne) / double(result.pixels), 0.999) << result.firstMismatches;
 }
 
-TEST_F(GpuTest, AViewportOfASceneWithoutTransmissiveFacesBuildsNoTrees) {
+TEST_F(Frame, AViewportOfASceneWithoutTransmissiveFacesBuildsNoTrees) {
   scene::Scene s = smallEye();
   for (scene::Material& m : s.materials) m.transmission = 0.0f;
   scene::Pose pose = scene::evaluate(s, 0.0);
@@ -232,7 +235,7 @@ TEST_F(GpuTest, AViewportOfASceneWithoutTransmissiveFacesBuildsNoTrees) {
   EXPECT_EQ(stats.traceDispatches, 0u);
 }
 
-TEST_F(GpuTest, RefractionOffRunsNoTreeWork) {
+TEST_F(Frame, RefractionOffRunsNoTreeWork) {
   scene::Scene s = smallEye();
   scene::Pose pose = scene::evaluate(s, 0.0);
   Renderer renderer(context(), s, pose);
@@ -248,7 +251,7 @@ TEST_F(GpuTest, RefractionOffRunsNoTreeWork) {
 
 // Frames in flight each keep their own instances, lights and joints: a frame
 // recorded while the one before is still queued draws its own pose.
-TEST_F(GpuTest, TwoFramesInFlightEachDrawTheirOwnPose) {
+TEST_F(Frame, TwoFramesInFlightEachDrawTheirOwnPose) {
   scene::Scene s = smallEye();
   scene::Pose a = scene::evaluate(s, 0.3), b = scene::evaluate(s, 2.2);
   scene::View view = scene::resolveView(s, a, {});
@@ -308,7 +311,7 @@ scene::Scene scatteringGrid(uint32_t n) {
   return s;
 }
 
-TEST_F(GpuTest, ARebuildTriggeredBySahGrowthRestoresTheSahRatio) {
+TEST_F(Frame, ARebuildTriggeredBySahGrowthRestoresTheSahRatio) {
   scene::Scene s = scatteringGrid(24);
   scene::Pose flat = scene::evaluate(s, 0.0);
   scene::Pose scattered = flat;

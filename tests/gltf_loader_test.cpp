@@ -255,6 +255,45 @@ constexpr const char* kTriangle = R"({"asset": {"version": "2.0"}, "buffers": [@
   "meshes": [{"primitives": [{"attributes": {"POSITION": 0}}]}],
   "nodes": [{"mesh": 0}], "scenes": [{"nodes": [0]}]})";
 
+TEST(GltfLoader, ALightOfAnUnknownTypeIsLeftOutWithANoteAndTheOthersKeepTheirNodes) {
+  auto dir = scratchDir("unknown-light");
+  std::string json = kTriangle;
+  json.replace(json.find(R"("nodes": [{"mesh": 0}], "scenes": [{"nodes": [0]}])"),
+               std::string(R"("nodes": [{"mesh": 0}], "scenes": [{"nodes": [0]}])").size(),
+               R"("extensionsUsed": ["KHR_lights_punctual"],
+                  "extensions": {"KHR_lights_punctual": {"lights": [{"type": "area", "name": "panel"},
+                                                                     {"type": "point", "intensity": 5}]}},
+                  "nodes": [{"mesh": 0}, {"extensions": {"KHR_lights_punctual": {"light": 0}}},
+                            {"extensions": {"KHR_lights_punctual": {"light": 1}}}],
+                  "scenes": [{"nodes": [0, 1, 2]}])");
+  Scene scene = loadGltf(writeGltf(dir / "lights.gltf", json, {0, 0, 0, 1, 0, 0, 0, 1, 0}));
+  ASSERT_EQ(scene.lights.size(), 1u) << "the area light is left out";
+  EXPECT_EQ(scene.lights[0].type, scene::LightType::Point);
+  EXPECT_EQ(scene.nodes[1].light, -1) << "its node carries no light";
+  EXPECT_EQ(scene.nodes[2].light, 0) << "the point light's node finds it";
+  EXPECT_TRUE(std::any_of(scene.warnings.begin(), scene.warnings.end(), [](const std::string& w) {
+    return w.find("light 0 'panel'") != std::string::npos && w.find("'area'") != std::string::npos;
+  }));
+}
+
+TEST(GltfLoader, ATextureOnAUvSetBeyondTheSecondReadsTheFirstWithANote) {
+  auto dir = scratchDir("third-uv-set");
+  std::string json = kTriangle;
+  json.replace(json.find(R"("meshes": [{"primitives": [{"attributes": {"POSITION": 0}}]}])"),
+               std::string(R"("meshes": [{"primitives": [{"attributes": {"POSITION": 0}}]}])").size(),
+               R"("meshes": [{"primitives": [{"attributes": {"POSITION": 0}, "material": 0}]}],
+                  "materials": [{"name": "painted", "pbrMetallicRoughness": {"baseColorTexture": {"index": 0, "texCoord": 2}}}],
+                  "textures": [{"source": 0}],
+                  "images": [{"uri": "data:image/png;base64,iVBORw0KGgoAAAANSUhEUgAAAAEAAAABCAYAAAAfFcSJAAAADUlEQVR42mP8z8BQDwAEhQGAhKmMIQAAAABJRU5ErkJggg=="}])");
+  Scene scene = loadGltf(writeGltf(dir / "uv2.gltf", json, {0, 0, 0, 1, 0, 0, 0, 1, 0}));
+  ASSERT_EQ(scene.materials.size(), 1u);
+  EXPECT_TRUE(scene.materials[0].baseColorTexture.present());
+  EXPECT_EQ(scene.materials[0].baseColorTexture.texCoord, 0);
+  EXPECT_TRUE(std::any_of(scene.warnings.begin(), scene.warnings.end(), [](const std::string& w) {
+    return w.find("TEXCOORD_2") != std::string::npos && w.find("reads set 0") != std::string::npos;
+  }));
+}
+
 TEST(GltfLoader, NanPositionIsAnErrorThatNamesTheAttribute) {
   auto dir = scratchDir("nan");
   std::string path = writeGltf(dir / "nan.gltf", kTriangle, {0, 0, 0, 1, 0, 0, std::nanf(""), 1, 0});

@@ -107,14 +107,17 @@ TEST(AutoMethod, TimesBothThenKeepsTheFasterWithoutCountingEachOnesFirstFrame) {
   }
 }
 
-TEST_F(GpuTest, TraceOnceIsTheFullTraceWhereRaysCrossOneInterface) {
+// The GPU tests of the methods' pictures against each other.
+class MethodImages : public GpuTest {};
+
+TEST_F(MethodImages, TraceOnceIsTheFullTraceWhereRaysCrossOneInterface) {
   scene::Scene eye = eyeWith(1.376f);
   Comparison c = compare(draw(context(), eye, Method::TraceOnce).image, draw(context(), eye, Method::Trace).image);
   EXPECT_EQ(c.withinOne, c.pixels) << c.firstMismatches;
 }
 
 // Through a prism a ray crosses two faces; bending at the first alone must show.
-TEST_F(GpuTest, TraceOnceDiffersFromTheFullTraceThroughAPrism) {
+TEST_F(MethodImages, TraceOnceDiffersFromTheFullTraceThroughAPrism) {
   scene::Scene prism = prismScene();
   scene::ViewRequest camera;  // the golden image's view: light reflected inside the prism
   camera.lookAt = scene::LookAt{{0.6, 0.3, -6.0}, {0.6, 0.0, 0.0}, {0.0, 1.0, 0.0}};
@@ -124,7 +127,7 @@ TEST_F(GpuTest, TraceOnceDiffersFromTheFullTraceThroughAPrism) {
             0.95);
 }
 
-TEST_F(GpuTest, ScreenSpaceMethodsBuildNoTreeAndDispatchNoTrace) {
+TEST_F(MethodImages, ScreenSpaceMethodsBuildNoTreeAndDispatchNoTrace) {
   scene::Scene eye = eyeWith(1.376f);
   for (Method m : {Method::IrisPlane, Method::NormalOffset}) {
     Shot shot = draw(context(), eye, m);
@@ -137,7 +140,7 @@ TEST_F(GpuTest, ScreenSpaceMethodsBuildNoTreeAndDispatchNoTrace) {
 
 // With no displacement the lookup behind the glass is the straight-through
 // view: exactly what `none` draws (the eye's glass is untinted).
-TEST_F(GpuTest, NormalOffsetOfStrengthZeroSeesStraightThrough) {
+TEST_F(MethodImages, NormalOffsetOfStrengthZeroSeesStraightThrough) {
   scene::Scene eye = eyeWith(1.376f);
   Comparison c = compare(draw(context(), eye, Method::NormalOffset, 0.0f).image, draw(context(), eye, Method::None).image);
   EXPECT_EQ(c.withinOne, c.pixels) << c.firstMismatches;
@@ -145,13 +148,13 @@ TEST_F(GpuTest, NormalOffsetOfStrengthZeroSeesStraightThrough) {
 
 // At IOR 1 the refracted ray is the view ray, so the point where it meets the
 // plane behind projects back onto the fragment's own pixel.
-TEST_F(GpuTest, IrisPlaneAtIorOneSeesStraightThrough) {
+TEST_F(MethodImages, IrisPlaneAtIorOneSeesStraightThrough) {
   scene::Scene eye = eyeWith(1.0f);
   EXPECT_GE(shareWithinOne(draw(context(), eye, Method::IrisPlane).image, draw(context(), eye, Method::None).image),
             0.999);
 }
 
-TEST_F(GpuTest, IrisPlaneBendsTheViewAtTheCorneasIor) {
+TEST_F(MethodImages, IrisPlaneBendsTheViewAtTheCorneasIor) {
   scene::Scene eye = eyeWith(1.376f);
   EXPECT_LT(shareWithinOne(draw(context(), eye, Method::IrisPlane).image, draw(context(), eye, Method::None).image),
             0.99);
@@ -234,7 +237,7 @@ TEST(BenchMethods, WritesJsonAndAChartWithOnePointPerMethodAndRefractionMatters)
   fs::remove_all(dir);
 }
 
-TEST_F(GpuTest, BenchMethodsPipelineStatsListTheTracePipelinesWhereTheDriverOffersThem) {
+TEST_F(MethodImages, BenchMethodsPipelineStatsListTheTracePipelinesWhereTheDriverOffersThem) {
   CommandRun run = runCommand(std::string(SNELL_BINARY) +
                               " bench methods --methods trace --size 32x24 --frames 2 --no-reference --pipeline-stats");
   ASSERT_EQ(run.exitCode, 0) << run.output;

@@ -138,7 +138,10 @@ TEST(RefractionMap, TheSeedDecoderDiffersFromTheExactOneOnlyWhereItsQuirksSay) {
   EXPECT_EQ(other, 0u);
 }
 
-TEST_F(GpuTest, TheSeedDecoderRunsBitForBitTheSameInGlslAndCpp) {
+// The GPU tests of what the trace tells the refraction map.
+class RefractionMapTrace : public GpuTest {};
+
+TEST_F(RefractionMapTrace, TheSeedDecoderRunsBitForBitTheSameInGlslAndCpp) {
   const uint32_t chunk = 1u << 22;
   vk::ComputeProgram program(context(), vk::ComputeProgramDesc{"sky8 decode", kSpvSky8Decode, {}, false});
   vk::Buffer decoded(context(), {VkDeviceSize(chunk) * 8, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT,
@@ -175,7 +178,7 @@ TEST_F(GpuTest, TheSeedDecoderRunsBitForBitTheSameInGlslAndCpp) {
 
 // What a refraction map is baked from: where each pixel's refracted ray
 // lands, in the texture space of the surface behind the glass.
-TEST_F(GpuTest, TheTraceReportsWhereRefractedRaysLandInTextureSpace) {
+TEST_F(RefractionMapTrace, TheTraceReportsWhereRefractedRaysLandInTextureSpace) {
   scene::Scene s = eyeWith(1.376f);
   scene::Pose pose = scene::evaluate(s, 0.0);
   scene::View view = scene::resolveView(s, pose, {});

@@ -54,7 +54,10 @@ std::string caseName(const ::testing::TestParamInfo<stress::Case>& info) {
 
 INSTANTIATE_TEST_SUITE_P(Grid, StressGrid, ::testing::ValuesIn(stress::grid(testGrid())), caseName);
 
-TEST_F(GpuTest, AnImageBeyondTheDeviceLimitIsAClearErrorNotACrash) {
+// The GPU tests of limits a renderer meets and survives.
+class StressLimits : public GpuTest {};
+
+TEST_F(StressLimits, AnImageBeyondTheDeviceLimitIsAClearErrorNotACrash) {
   stress::Case c = stress::grid(testGrid()).back();
   c.width = 1u << 20;
   c.height = 4;
@@ -65,7 +68,7 @@ TEST_F(GpuTest, AnImageBeyondTheDeviceLimitIsAClearErrorNotACrash) {
 // A tree whose boxes are NaN and whose children point back up (a cycle) must
 // still end every ray: the traversal's visit budget stops it, the frame
 // completes, and the device is not lost.
-TEST_F(GpuTest, ACorruptedBvhEndsEveryRayWithinTheVisitBudget) {
+TEST_F(StressLimits, ACorruptedBvhEndsEveryRayWithinTheVisitBudget) {
   scene::Scene s = stress::sphereScene(16, 1.5f);  // static: no refit repairs the boxes
   scene::Pose pose = scene::evaluate(s, 0.0);
   render::Renderer renderer(context(), s, pose);

@@ -184,7 +184,10 @@ scene::Scene seeThroughCard(scene::AlphaMode mode, float factorAlpha) {
   return s;
 }
 
-TEST_F(GpuTest, ANormalMapBendsTheViewThroughGlassAsTheReferenceDoes) {
+// The GPU tests of normal maps and alpha against the reference.
+class SurfaceMaps : public GpuTest {};
+
+TEST_F(SurfaceMaps, ANormalMapBendsTheViewThroughGlassAsTheReferenceDoes) {
   std::string mismatches;
   double share = agreement(context(), rippledGlass(true), mismatches);
   std::printf("rippled glass: %.2f%% of pixels within 1/255 of the reference\n", 100.0 * share);
@@ -194,7 +197,7 @@ TEST_F(GpuTest, ANormalMapBendsTheViewThroughGlassAsTheReferenceDoes) {
   EXPECT_GT(moved, 0.15) << "the normal map should bend what the glass shows";
 }
 
-TEST_F(GpuTest, ANormalMapShadesAnOpaqueFaceAsTheReferenceDoes) {
+TEST_F(SurfaceMaps, ANormalMapShadesAnOpaqueFaceAsTheReferenceDoes) {
   std::string mismatches;
   double share = agreement(context(), rippledCard(true), mismatches);
   std::printf("rippled card: %.2f%% of pixels within 1/255 of the reference\n", 100.0 * share);
@@ -203,7 +206,7 @@ TEST_F(GpuTest, ANormalMapShadesAnOpaqueFaceAsTheReferenceDoes) {
   EXPECT_GT(moved, 0.15) << "the normal map should change the card's light";
 }
 
-TEST_F(GpuTest, MaskedAlphaShowsWhatLiesBehindItsHolesAsTheReferenceDoes) {
+TEST_F(SurfaceMaps, MaskedAlphaShowsWhatLiesBehindItsHolesAsTheReferenceDoes) {
   std::string mismatches;
   double share = agreement(context(), seeThroughCard(scene::AlphaMode::Mask, 1.0f), mismatches);
   EXPECT_GE(share, 0.995) << mismatches;
@@ -227,7 +230,7 @@ TEST_F(GpuTest, MaskedAlphaShowsWhatLiesBehindItsHolesAsTheReferenceDoes) {
   EXPECT_GE(holesShowWall, 0.99 * holes) << "a hole should show the wall unchanged";
 }
 
-TEST_F(GpuTest, BlendedAlphaMixesTheFaceWithWhatLiesBehindAsTheReferenceDoes) {
+TEST_F(SurfaceMaps, BlendedAlphaMixesTheFaceWithWhatLiesBehindAsTheReferenceDoes) {
   std::string mismatches;
   double share = agreement(context(), seeThroughCard(scene::AlphaMode::Blend, 0.4f), mismatches);
   EXPECT_GE(share, 0.995) << mismatches;
@@ -236,7 +239,7 @@ TEST_F(GpuTest, BlendedAlphaMixesTheFaceWithWhatLiesBehindAsTheReferenceDoes) {
   EXPECT_GT(changed(blended, whole), 0.5) << "a blended card should let the wall through everywhere";
 }
 
-TEST_F(GpuTest, TheViewportCompositeDrawsAlphaAndNormalMapsAsTheTraceDoes) {
+TEST_F(SurfaceMaps, TheViewportCompositeDrawsAlphaAndNormalMapsAsTheTraceDoes) {
   for (const scene::Scene& s : {seeThroughCard(scene::AlphaMode::Mask, 1.0f), seeThroughCard(scene::AlphaMode::Blend, 0.4f),
                                 rippledCard(true)}) {
     scene::Pose pose = scene::evaluate(s, 0.0);

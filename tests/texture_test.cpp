@@ -65,7 +65,10 @@ scene::Scene texturedQuads(uint32_t count, uint32_t size) {
   return s;
 }
 
-TEST_F(GpuTest, TexturesLargerTogetherThanOneStorageBufferRenderAsTheReferenceDoes) {
+// The GPU tests of textures on the GPU against the reference.
+class Textures : public GpuTest {};
+
+TEST_F(Textures, TexturesLargerTogetherThanOneStorageBufferRenderAsTheReferenceDoes) {
   // Enough 2048^2 textures to pass the device's largest storage buffer (128 MiB on lavapipe).
   uint64_t limit = context().caps().maxStorageBufferRange;
   uint32_t count = uint32_t(limit / (2048ull * 2048 * 4)) + 2;
@@ -88,7 +91,7 @@ TEST_F(GpuTest, TexturesLargerTogetherThanOneStorageBufferRenderAsTheReferenceDo
   EXPECT_EQ(result.withinOne, result.pixels) << result.firstMismatches;
 }
 
-TEST_F(GpuTest, EachMipLevelIsTheMeanOfTheTwoByTwoTexelsAboveInLinearLight) {
+TEST_F(Textures, EachMipLevelIsTheMeanOfTheTwoByTwoTexelsAboveInLinearLight) {
   scene::Scene s = texturedQuads(1, 4);
   scene::Texture& t = s.textures[0];
   t.width = 7, t.height = 5;  // odd: the last column and row are clamped, level 1 is 3x2
@@ -122,7 +125,7 @@ TEST_F(GpuTest, EachMipLevelIsTheMeanOfTheTwoByTwoTexelsAboveInLinearLight) {
   EXPECT_LE(worst, 1);
 }
 
-TEST_F(GpuTest, TexturesNoMaterialDrawsTakeNoGpuMemory) {
+TEST_F(Textures, TexturesNoMaterialDrawsTakeNoGpuMemory) {
   scene::Scene s = texturedQuads(1, 256);
   s.textures.push_back(checker(1024, 7));  // read by no material: a normal map, say
   scene::Pose pose = scene::evaluate(s, 0.0);
@@ -131,7 +134,7 @@ TEST_F(GpuTest, TexturesNoMaterialDrawsTakeNoGpuMemory) {
   EXPECT_EQ(scene::textureChainBytes(s), gpu.textureBytes);
 }
 
-TEST_F(GpuTest, TexturesBeyondEveryPageAreAClearErrorNamingTheNumbers) {
+TEST_F(Textures, TexturesBeyondEveryPageAreAClearErrorNamingTheNumbers) {
   uint64_t limit = context().caps().maxStorageBufferRange;
   if (limit > (256ull << 20)) GTEST_SKIP() << "pages of " << (limit >> 20) << " MiB: too large to fill in a test";
   // One chain per page at most, and one more than there are pages.
@@ -233,7 +236,7 @@ double farFloorEnergy(const io::Rgb8Image& image) {
   return sum / double(count);
 }
 
-TEST_F(GpuTest, ACheckerboardFloorBehindGlassDoesNotShimmer) {
+TEST_F(Textures, ACheckerboardFloorBehindGlassDoesNotShimmer) {
   // The traced floor seen through the window, against the raster pass's
   // mipmapped floor with no window, and the same floor read at level 0.
   FloorShot behind = checkerFloor(true), open = checkerFloor(false);
@@ -274,7 +277,7 @@ TEST_F(GpuTest, ACheckerboardFloorBehindGlassDoesNotShimmer) {
 // KHR_texture_transform that offsets, rotates and scales it (the
 // TextureTransformTest sample's cases, built here), in front of the camera
 // or seen through a glass slab.
-TEST_F(GpuTest, TextureTransformsAndTheSecondUvSetReadAsTheReferenceReadsThem) {
+TEST_F(Textures, TextureTransformsAndTheSecondUvSetReadAsTheReferenceReadsThem) {
   for (bool throughGlass : {false, true}) {
     scene::Scene s = texturedQuads(1, 256);
     scene::Shape& quad = s.shapes[0];
@@ -311,7 +314,7 @@ TEST_F(GpuTest, TextureTransformsAndTheSecondUvSetReadAsTheReferenceReadsThem) {
 // Every sample model with textures, from its default view at 80x60: the
 // viewport composite (raster pass and trace) against the reference, mip
 // levels and texture transforms as the file gives them.
-TEST_F(GpuTest, EverySampleModelRendersItsTexturesAsTheReferenceDoes) {
+TEST_F(Textures, EverySampleModelRendersItsTexturesAsTheReferenceDoes) {
   int models = 0;
   for (const auto& folder : std::filesystem::directory_iterator(assetsDir() / "gltf")) {
     for (const auto& entry : std::filesystem::recursive_directory_iterator(folder.path())) {

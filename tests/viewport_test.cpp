@@ -133,9 +133,12 @@ TEST_P(ViewportComposite, OpaquePixelsMatchTheReferenceGolden) {
 INSTANTIATE_TEST_SUITE_P(Images, ViewportComposite, ::testing::ValuesIn(cases()),
                          [](const ::testing::TestParamInfo<ViewportCase>& info) { return info.param.name; });
 
+// The GPU tests of the viewport composite's own options.
+class Viewport : public GpuTest {};
+
 // Refraction off leaves the glass out of the raster: the eye must look as the
 // reference draws it with its transmissive faces removed.
-TEST_F(GpuTest, ViewportWithoutRefractionSeesStraightThroughTheCornea) {
+TEST_F(Viewport, ViewportWithoutRefractionSeesStraightThroughTheCornea) {
   ViewportCase c{"eye_no_refraction", "", 192, 144, {}, 0.0, [] { return eyeWith(1.376f); }, {}};
   render::RasterOptions options;
   options.refraction = false;
@@ -150,7 +153,7 @@ TEST_F(GpuTest, ViewportWithoutRefractionSeesStraightThroughTheCornea) {
   EXPECT_GE(share, 0.995) << result.firstMismatches;
 }
 
-TEST_F(GpuTest, ViewportWireframeDrawsEdgesOverTheShadedImage) {
+TEST_F(Viewport, ViewportWireframeDrawsEdgesOverTheShadedImage) {
   if (!context().caps().fillModeNonSolid) GTEST_SKIP() << "this device draws no wireframes";
   ViewportCase c{"eye", "", 192, 144, {}, 0.0, [] { return eyeWith(1.376f); }, {}};
   Composite plain(context(), c);
@@ -187,7 +190,7 @@ namespace {
 
 // The viewer's 2D pan and zoom move the picture on the film back, not the
 // camera: the trace and the raster must shift together, as the reference does.
-TEST_F(GpuTest, FilmBackPanAndZoomMoveTraceAndRasterTogether) {
+TEST_F(Viewport, FilmBackPanAndZoomMoveTraceAndRasterTogether) {
   scene::Scene s = eyeWith(1.376f);
   scene::Pose pose = scene::evaluate(s, 0.0);
   scene::View view = scene::resolveView(s, pose, {});

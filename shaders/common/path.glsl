@@ -1,9 +1,8 @@
 // What the trace pass and the driver's ray tracing pipeline share: the hit,
 // the surface at a hit, the refraction rules of shared/trace.h and the whole
-// path of one pixel. The including shader declares the buffers of trace.h's
-// bindings (instances, positions, normals, texcoords, indices, materials,
-// lights, environment, outImage, aovs, rays) and the texture binding macros
-// of common/shading.glsl, the push constant `pc`, and
+// path of one pixel. The scene binding set comes with common/scene.glsl; the
+// including shader declares the trace's own bindings of trace.h
+// (environment, outImage, aovs, rays) and the push constant `pc`, and
 // defines traceClosest() and firstTriangleOf() after this file.
 #ifndef SNELL_PATH_GLSL
 #define SNELL_PATH_GLSL

@@ -299,10 +299,6 @@ scene::Environment readEnvironment(const std::string& path) {
   return env;
 }
 
-void writePngRgba8(const std::string& path, uint32_t width, uint32_t height, const std::vector<uint8_t>& rgba) {
-  writeAtomically(path, [&](const std::string& temp) { writeBytes(path, temp, scene::encodePng(width, height, rgba)); });
-}
-
 void writeBytesFile(const std::string& path, const std::vector<uint8_t>& bytes) {
   writeAtomically(path, [&](const std::string& temp) { writeBytes(path, temp, bytes); });
 }

@@ -57,8 +57,6 @@ uint8_t linearToSrgb8(float linear);
 /// PNG ignores alpha (8-bit sRGB, opaque); EXR keeps it.
 void writeImage(const std::string& path, const LinearImage& image, const ImageExtras& extras = {});
 
-/// Writes RGBA bytes to a PNG as they are (no colour conversion).
-void writePngRgba8(const std::string& path, uint32_t width, uint32_t height, const std::vector<uint8_t>& rgba);
 /// Writes bytes already encoded (a PNG's, say): complete, or not at all.
 void writeBytesFile(const std::string& path, const std::vector<uint8_t>& bytes);
 /// Writes 4 float channels (R, G, B, A: data, not colour) to a zip-compressed

@@ -71,7 +71,6 @@ class PreparedScene {
   const ResolvedMaterial& material(int index) const {
     return index >= 0 && size_t(index) < materials_.size() ? materials_[size_t(index)] : defaultMaterial_;
   }
-  int materialCount() const { return int(materials_.size()); }
   const std::vector<ResolvedLight>& lights() const { return lights_; }
   double size() const { return size_; }
 

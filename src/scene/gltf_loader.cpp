@@ -78,7 +78,12 @@ TextureRef textureRef(const Reader& r, int index, int texCoord, const tinygltf::
   TextureRef ref;
   if (index < 0) return ref;
   r.at(r.model.textures, index, what, "texture");
-  if (texCoord < 0 || texCoord > 1) r.fail(what + " uses TEXCOORD_" + std::to_string(texCoord) + "; snell reads sets 0 and 1");
+  if (texCoord < 0) r.fail(what + " uses TEXCOORD_" + std::to_string(texCoord));
+  if (texCoord > 1) {
+    // As a glTF viewer does with a set it lacks: warn and go on with the first.
+    r.warn(what + " uses TEXCOORD_" + std::to_string(texCoord) + "; snell reads sets 0 and 1, so it reads set 0");
+    texCoord = 0;
+  }
   ref.texture = index;
   ref.texCoord = texCoord;
   ref.transform = textureTransform(extensions);
@@ -467,16 +472,26 @@ void loadCameras(const Reader& r) {
   }
 }
 
-void loadLights(const Reader& r) {
+// Returns, per light of the file, its index in the scene's lights (-1: skipped).
+std::vector<int> loadLights(const Reader& r) {
+  std::vector<int> indexOf;
   for (size_t l = 0; l < r.model.lights.size(); ++l) {
     const tinygltf::Light& source = r.model.lights[l];
     std::string what = label("light", l, source.name);
     Light light;
     light.name = source.name;
-    if (source.type == "directional") light.type = LightType::Directional;
-    else if (source.type == "point") light.type = LightType::Point;
-    else if (source.type == "spot") light.type = LightType::Spot;
-    else r.fail(what + " has unknown type '" + source.type + "'");
+    if (source.type == "directional") {
+      light.type = LightType::Directional;
+    } else if (source.type == "point") {
+      light.type = LightType::Point;
+    } else if (source.type == "spot") {
+      light.type = LightType::Spot;
+    } else {
+      // A type a later KHR_lights_punctual may add: as a glTF viewer does, say so and leave it out.
+      r.warn(what + " has type '" + source.type + "', which snell does not know; it is left out");
+      indexOf.push_back(-1);
+      continue;
+    }
     if (source.color.size() == 3) light.color = glm::vec3(source.color[0], source.color[1], source.color[2]);
     light.intensity = static_cast<float>(source.intensity);
     if (source.range > 0.0) light.range = static_cast<float>(source.range);
@@ -488,8 +503,10 @@ void loadLights(const Reader& r) {
         r.fail(what + ": spot angles must satisfy 0 <= innerConeAngle < outerConeAngle <= pi/2");
       }
     }
+    indexOf.push_back(int(r.scene.lights.size()));
     r.scene.lights.push_back(light);
   }
+  return indexOf;
 }
 
 void loadSkins(const Reader& r) {
@@ -554,7 +571,7 @@ std::vector<glm::mat4> instancing(const Reader& r, const tinygltf::Value& extens
   return matrices;
 }
 
-void loadNodes(const Reader& r) {
+void loadNodes(const Reader& r, const std::vector<int>& lightIndex) {
   const auto& nodes = r.model.nodes;
   r.scene.nodes.resize(nodes.size());
   for (size_t n = 0; n < nodes.size(); ++n) {
@@ -607,8 +624,8 @@ void loadNodes(const Reader& r) {
     }
     if (auto it = source.extensions.find("KHR_lights_punctual"); it != source.extensions.end()) {
       int light = static_cast<int>(number(it->second, "light", -1));
-      r.at(r.scene.lights, light, what, "light");
-      node.light = light;
+      r.at(r.model.lights, light, what, "light");
+      node.light = lightIndex[size_t(light)];
     }
     if (auto it = source.extensions.find("EXT_mesh_gpu_instancing"); it != source.extensions.end()) {
       node.instances = instancing(r, it->second, what + " EXT_mesh_gpu_instancing");
@@ -839,8 +856,6 @@ unsigned decodeImages(tinygltf::Model& model, EncodedImages& encoded) {
 
 }  // namespace
 
-const std::vector<std::string>& supportedExtensions() { return kSupported; }
-
 Scene loadGltf(const std::string& path, const LoadOptions& options) {
   std::vector<unsigned char> head = readHead(path, 4);
   if (head.empty()) throw SceneError(path + ": the file is empty");
@@ -897,9 +912,9 @@ Scene loadGltf(const std::string& path, const LoadOptions& options) {
   loadMaterials(r);
   loadMeshes(r);
   loadCameras(r);
-  loadLights(r);
+  const std::vector<int> lightIndex = loadLights(r);
   loadSkins(r);
-  loadNodes(r);
+  loadNodes(r, lightIndex);
   chooseScene(r, options);
   loadAnimations(r);
   if (options.textureBudget) {

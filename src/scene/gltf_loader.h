@@ -25,7 +25,4 @@ struct LoadOptions {
 /// Loads a .gltf or .glb file (told apart by content, not by name).
 Scene loadGltf(const std::string& path, const LoadOptions& options = {});
 
-/// The glTF extensions snell implements.
-const std::vector<std::string>& supportedExtensions();
-
 }  // namespace snell::scene

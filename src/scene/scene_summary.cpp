@@ -15,13 +15,14 @@ namespace {
 
 // What each element takes on the GPU, for a figure before anything is
 // uploaded; Renderer::memoryBytes() measures the real one once it is.
-constexpr uint64_t kRestBytesPerVertex = 24 + 8;     // position + normal, one UV set
+constexpr uint64_t kRestBytesPerVertex = 24 + 16;    // position + normal, two UV sets (one vec4)
 constexpr uint64_t kIndexBytesPerTriangle = 12;
 constexpr uint64_t kMorphBytesPerVertexTarget = 24;  // position + normal delta
 constexpr uint64_t kSkinBytesPerVertex = 32;         // 4 joints (u32) + 4 weights
 constexpr uint64_t kDeformedBytesPerVertex = 24;     // deformed position + normal
 constexpr uint64_t kBvhBytesPerTriangle = sizeof(gpu::BvhNode);  // n - 1 nodes; a leaf is a child reference
-constexpr uint64_t kTraceBytesPerPixel = 8 + 4 + 4;  // rgba16f trace, rgba8 viewport, depth
+// rgba16f trace and composite, depth, the transmissive mask, the masked trace's pixel list
+constexpr uint64_t kTraceBytesPerPixel = 8 + 8 + 4 + 4 + 4;
 
 /// Calls `visit(node, instanceCount)` for every node under the scene's roots.
 void forEachNode(const Scene& scene, const std::function<void(const Node&, size_t)>& visit) {

@@ -5,6 +5,7 @@
 #include "vk/error.h"
 
 #include <utility>
+#include <stdexcept>
 
 namespace snell::vk {
 
@@ -96,7 +97,7 @@ Buffer& Buffer::operator=(Buffer&& other) noexcept {
 }
 
 Buffer Buffer::borrow(Context& context, VkBuffer buffer, VkDeviceSize size, std::string name) {
-  if (!buffer) throw VulkanError("borrowing buffer '" + name + "': the handle is null");
+  if (!buffer) throw std::invalid_argument("borrowing buffer '" + name + "': the handle is null");
   Buffer b;
   b.context_ = &context;
   b.buffer_ = buffer;
@@ -233,7 +234,7 @@ uint32_t formatBytes(VkFormat format) {
 
 uint32_t Image::bytesPerPixel() const {
   uint32_t bytes = formatBytes(format_);
-  if (bytes == 0) throw VulkanError("image '" + name_ + "' has a format snell cannot size");
+  if (bytes == 0) throw std::invalid_argument("image '" + name_ + "' has a format snell cannot size");
   return bytes;
 }
 

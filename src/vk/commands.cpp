@@ -5,6 +5,7 @@
 
 #include <cstring>
 #include <limits>
+#include <stdexcept>
 
 namespace snell::vk {
 
@@ -59,7 +60,7 @@ Commands::~Commands() {
 
 void Commands::begin() {
   if (serial_) wait();
-  if (recording_) throw VulkanError("Commands '" + name_ + "': begin() while already recording");
+  if (recording_) throw std::logic_error("Commands '" + name_ + "': begin() while already recording");
   VkDevice device = context_->device();
   keptAlive_.clear();
   VK_CHECK(vkResetCommandPool(device, pool_, 0));
@@ -80,7 +81,7 @@ void Commands::begin() {
 void Commands::submit() { submit(VK_NULL_HANDLE, 0, VK_NULL_HANDLE); }
 
 void Commands::submit(VkSemaphore wait, VkPipelineStageFlags waitStage, VkSemaphore signal) {
-  if (!recording_) throw VulkanError("Commands '" + name_ + "': submit() without begin()");
+  if (!recording_) throw std::logic_error("Commands '" + name_ + "': submit() without begin()");
   if (passOpen_) endPass();
   VK_CHECK(vkEndCommandBuffer(buffer_));
   recording_ = false;
@@ -191,7 +192,7 @@ void Commands::copyBuffer(const Buffer& from, const Buffer& to, VkDeviceSize byt
                           VkDeviceSize toOffset) {
   if (bytes == 0) return;
   if (fromOffset + bytes > from.size() || toOffset + bytes > to.size()) {
-    throw VulkanError("copy of " + std::to_string(bytes) + " bytes from '" + from.name() + "' to '" + to.name() +
+    throw std::invalid_argument("copy of " + std::to_string(bytes) + " bytes from '" + from.name() + "' to '" + to.name() +
                       "' runs past the end of a buffer");
   }
   VkBufferCopy region{fromOffset, toOffset, bytes};
@@ -206,7 +207,7 @@ void Commands::fillBuffer(const Buffer& buffer, uint32_t word) {
 void Commands::updateBuffer(const Buffer& buffer, const void* data, VkDeviceSize bytes, VkDeviceSize offset) {
   if (bytes == 0) return;
   if (bytes > 65536 || bytes % 4 || offset % 4 || offset + bytes > buffer.size()) {
-    throw VulkanError("update of " + std::to_string(bytes) + " bytes at " + std::to_string(offset) + " of '" +
+    throw std::invalid_argument("update of " + std::to_string(bytes) + " bytes at " + std::to_string(offset) + " of '" +
                       buffer.name() + "' is too large, misaligned or runs past its end");
   }
   vkCmdUpdateBuffer(buffer_, buffer.handle(), offset, bytes, data);
@@ -215,7 +216,7 @@ void Commands::updateBuffer(const Buffer& buffer, const void* data, VkDeviceSize
 void Commands::copyImageToBuffer(const Image& image, const Buffer& buffer, VkDeviceSize offset) {
   VkDeviceSize bytes = VkDeviceSize(image.width()) * image.height() * image.bytesPerPixel();
   if (offset + bytes > buffer.size()) {
-    throw VulkanError("copy of image '" + image.name() + "' into '" + buffer.name() + "' runs past the buffer's end");
+    throw std::invalid_argument("copy of image '" + image.name() + "' into '" + buffer.name() + "' runs past the buffer's end");
   }
   VkBufferImageCopy region{};
   region.bufferOffset = offset;
@@ -234,7 +235,7 @@ void Commands::copyImageToBuffer(const Image& image, const Buffer& buffer, VkDev
 
 void Commands::blitToImage(const Image& image, const ImageTarget& target) {
   if (target.width != image.width() || target.height != image.height()) {
-    throw VulkanError("blit of image '" + image.name() + "' (" + std::to_string(image.width()) + "x" +
+    throw std::invalid_argument("blit of image '" + image.name() + "' (" + std::to_string(image.width()) + "x" +
                       std::to_string(image.height()) + ") onto a " + std::to_string(target.width) + "x" +
                       std::to_string(target.height) + " image");
   }
@@ -263,7 +264,7 @@ void Commands::blitToImage(const Image& image, const ImageTarget& target) {
 void Commands::fillBuffer(const Buffer& buffer, uint32_t word, VkDeviceSize offset, VkDeviceSize bytes) {
   if (bytes == 0) return;
   if (offset % 4 || bytes % 4 || offset + bytes > buffer.size()) {
-    throw VulkanError("fill of " + std::to_string(bytes) + " bytes at " + std::to_string(offset) + " of '" +
+    throw std::invalid_argument("fill of " + std::to_string(bytes) + " bytes at " + std::to_string(offset) + " of '" +
                       buffer.name() + "' is misaligned or runs past its end");
   }
   vkCmdFillBuffer(buffer_, buffer.handle(), offset, bytes, word);
@@ -336,7 +337,7 @@ VkDescriptorSet Commands::allocateSet(VkDescriptorSetLayout layout) {
 void upload(Context& context, const Buffer& destination, const void* data, VkDeviceSize bytes, VkDeviceSize offset) {
   if (bytes == 0) return;
   if (offset + bytes > destination.size()) {
-    throw VulkanError("upload of " + std::to_string(bytes) + " bytes runs past the end of '" + destination.name() + "'");
+    throw std::invalid_argument("upload of " + std::to_string(bytes) + " bytes runs past the end of '" + destination.name() + "'");
   }
   if (!destination.mapped().empty()) {
     std::memcpy(destination.mapped().data() + offset, data, bytes);
@@ -353,7 +354,7 @@ void upload(Context& context, const Buffer& destination, const void* data, VkDev
 void download(Context& context, const Buffer& source, void* data, VkDeviceSize bytes, VkDeviceSize offset) {
   if (bytes == 0) return;
   if (offset + bytes > source.size()) {
-    throw VulkanError("download of " + std::to_string(bytes) + " bytes runs past the end of '" + source.name() + "'");
+    throw std::invalid_argument("download of " + std::to_string(bytes) + " bytes runs past the end of '" + source.name() + "'");
   }
   Buffer readback(context, {bytes, VK_BUFFER_USAGE_TRANSFER_DST_BIT, MemoryDomain::Readback, source.name() + " readback"});
   Commands commands(context, "download " + source.name());

@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <cstring>
 #include <sstream>
+#include <stdexcept>
 
 #include "vk/error.h"
 
@@ -284,20 +285,20 @@ std::vector<uint32_t> chooseDeviceList(std::span<const DeviceFacts> devices, con
     return chosen;
   }
   for (const std::string& entry : commaList(list)) {
-    if (entry.empty()) throw VulkanError("--devices " + list + ": an empty entry between commas");
+    if (entry.empty()) throw std::invalid_argument("--devices " + list + ": an empty entry between commas");
     uint32_t index = 0;
     bool byIndex = isIndex(entry, index);
     if (!byIndex && !looksLikeUuid(entry)) {
-      throw VulkanError("--devices " + list + ": '" + entry + "' is neither a device index nor a UUID");
+      throw std::invalid_argument("--devices " + list + ": '" + entry + "' is neither a device index nor a UUID");
     }
     auto it = std::find_if(devices.begin(), devices.end(), [&](const DeviceFacts& d) {
       return byIndex ? d.index == index : !d.uuid.empty() && d.uuid.rfind(bareUuid(entry), 0) == 0;
     });
     if (it == devices.end()) {
-      throw VulkanError("--devices " + list + ": no device " + entry + " ('snell info --devices' lists " +
+      throw std::invalid_argument("--devices " + list + ": no device " + entry + " ('snell info --devices' lists " +
                         std::to_string(devices.size()) + ")");
     }
-    if (!it->unmet.empty()) throw VulkanError("--devices " + list + ": " + it->name + " does not qualify: " + it->unmet.front());
+    if (!it->unmet.empty()) throw std::invalid_argument("--devices " + list + ": " + it->name + " does not qualify: " + it->unmet.front());
     chosen.push_back(it->index);
   }
   return chosen;
