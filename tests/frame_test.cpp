@@ -54,6 +54,11 @@ const FrameResult& frame(Renderer& renderer, const scene::Pose& pose, std::vecto
   return renderer.wait(renderer.submit(request));
 }
 
+// One viewport composite of `s` at `pose` from the scene's own camera: what it did.
+FrameStats compositeStats(Renderer& renderer, const scene::Scene& s, const scene::Pose& pose) {
+  return frame(renderer, pose, {compositeView(scene::resolveView(s, pose, {}))}).stats;
+}
+
 // One view's frame with its pixels read back.
 const ViewPixels& readFrame(Renderer& renderer, const scene::Pose& pose, const ViewRequest& view) {
   FrameRequest request;
@@ -71,7 +76,11 @@ scene::View lookFrom(const glm::dvec3& eye, const glm::dvec3& target = glm::dvec
 }
 
 // The GPU tests of what a frame runs, skips and reads back.
-class Frame : public GpuTest {};
+class Frame : public GpuTest {
+ protected:
+  scene::Scene s = smallEye();  ///< the scene most tests draw, and its rest pose
+  scene::Pose pose = scene::evaluate(s, 0.0);
+};
 
 TEST_F(Frame, AStaticScenesSecondFrameRunsNoDeformRefitOrTopLevelWork) {
   scene::Scene s = smallEye();
@@ -163,8 +172,6 @@ TEST_F(Frame, TheUpdateTakesAsManyDispatchesForTenCharactersAsForOne) {
 }
 
 TEST_F(Frame, AnEyeOffScreenGetsNoTraceDispatch) {
-  scene::Scene s = smallEye();
-  scene::Pose pose = scene::evaluate(s, 0.0);
   Renderer renderer(context(), s, pose);
   scene::View away = lookFrom({0.0, 0.0, 0.1}, {0.0, 0.0, 1.0});  // looking away from the eye behind
   FrameStats stats = frame(renderer, pose, {compositeView(away)}).stats;
@@ -176,8 +183,6 @@ TEST_F(Frame, AnEyeOffScreenGetsNoTraceDispatch) {
 // From behind, the cornea hides behind the sclera: the mask is empty and the
 // trace's indirect dispatch carries no workgroup.
 TEST_F(Frame, AnEyeTurnedAwayTracesNoPixel) {
-  scene::Scene s = smallEye();
-  scene::Pose pose = scene::evaluate(s, 0.0);
   Renderer renderer(context(), s, pose);
   FrameStats stats = frame(renderer, pose, {compositeView(lookFrom({0.0, 0.0, -0.1}))}).stats;
   EXPECT_EQ(stats.pixelsTraced, 0u);
@@ -185,11 +190,8 @@ TEST_F(Frame, AnEyeTurnedAwayTracesNoPixel) {
 }
 
 TEST_F(Frame, TheMaskedTraceCoversExactlyThePixelsWhoseVisibleFaceIsTransmissive) {
-  scene::Scene s = smallEye();
-  scene::Pose pose = scene::evaluate(s, 0.0);
   Renderer renderer(context(), s, pose);
-  scene::View view = scene::resolveView(s, pose, {});
-  FrameStats stats = frame(renderer, pose, {compositeView(view)}).stats;
+  FrameStats stats = compositeStats(renderer, s, pose);
   std::vector<uint32_t> mask(size_t(kWidth) * kHeight);
   vk::downloadImage(context(), renderer.viewImages(0).mask, mask.data());
   uint64_t transmissive = 0;
@@ -227,7 +229,7 @@ TEST_F(Frame, AViewportOfASceneWithoutTransmissiveFacesBuildsNoTrees) {
   for (scene::Material& m : s.materials) m.transmission = 0.0f;
   scene::Pose pose = scene::evaluate(s, 0.0);
   Renderer renderer(context(), s, pose);
-  FrameStats stats = frame(renderer, pose, {compositeView(scene::resolveView(s, pose, {}))}).stats;
+  FrameStats stats = compositeStats(renderer, s, pose);
   EXPECT_FALSE(renderer.seeThrough());
   EXPECT_EQ(renderer.blas(), nullptr);
   EXPECT_EQ(renderer.builder(), nullptr) << "no tree builder and no trace pipeline were made";
@@ -236,8 +238,6 @@ TEST_F(Frame, AViewportOfASceneWithoutTransmissiveFacesBuildsNoTrees) {
 }
 
 TEST_F(Frame, RefractionOffRunsNoTreeWork) {
-  scene::Scene s = smallEye();
-  scene::Pose pose = scene::evaluate(s, 0.0);
   Renderer renderer(context(), s, pose);
   ViewRequest view = compositeView(scene::resolveView(s, pose, {}));
   view.raster.refraction = false;

@@ -94,11 +94,9 @@ class Golden : public GpuTest, public ::testing::WithParamInterface<Case> {};
 
 TEST_P(Golden, GpuTraceMatchesTheReferenceGolden) {
   const Case& c = GetParam();
-  Shot shot(c);
-  const scene::Scene& s = shot.scene;
-  const scene::Pose& pose = shot.pose;
-  const scene::View& view = shot.view;
-  fs::path goldenPath = goldenDir() / (c.name + ".png");
+  const Shot shot(c);
+  const auto& [s, pose, view] = std::tie(shot.scene, shot.pose, shot.view);
+  const fs::path goldenPath = goldenDir() / (c.name + ".png");
   const char* update = std::getenv("SNELL_UPDATE_GOLDEN");
   if (update && std::string(update) == "1") io::writeRgb8(goldenPath.string(), referenceImage(s, pose, view, c.width, c.height));
   ASSERT_TRUE(fs::exists(goldenPath)) << goldenPath << " is missing (SNELL_UPDATE_GOLDEN=1 makes it from the reference)";
@@ -130,13 +128,11 @@ TEST_P(Golden, GpuTraceMatchesTheReferenceGolden) {
 
 TEST_P(Golden, GoldenIsWhatTheReferenceRendersToday) {
   const Case& c = GetParam();
-  Shot shot(c);
-  const scene::Scene& s = shot.scene;
-  const scene::Pose& pose = shot.pose;
-  const scene::View& view = shot.view;
-  fs::path goldenPath = goldenDir() / (c.name + ".png");
+  const Shot shot(c);
+  const fs::path goldenPath = goldenDir() / (c.name + ".png");
   ASSERT_TRUE(fs::exists(goldenPath)) << goldenPath << " is missing";
-  Comparison result = compare(referenceImage(s, pose, view, c.width, c.height), io::readRgb8(goldenPath.string()));
+  Comparison result = compare(referenceImage(shot.scene, shot.pose, shot.view, c.width, c.height),
+                              io::readRgb8(goldenPath.string()));
   // Compilers may round the last bit differently; anything more means the golden is stale.
   EXPECT_LE(result.maxDifference, 1) << c.name << ": the committed golden is not what src/ref renders\n"
                                       << result.firstMismatches;

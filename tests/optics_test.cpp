@@ -146,11 +146,17 @@ TEST_F(Optics, TotalInternalReflectionKeepsAllTheLight) {
   EXPECT_NEAR(t.gpu[0].r, 1.0f, 1e-3f);
 }
 
-TEST_F(Optics, BeerLambertAttenuatesBySlabThickness) {
+// A slab of glass 2 units thick that keeps (0.5, 0.8, 0.9) of the light over `distance`.
+scene::Material tintedGlass(float distance) {
   scene::Material glass = glassOf(1.5f);
   glass.thickness = 2.0f;
   glass.attenuationColor = {0.5f, 0.8f, 0.9f};
-  glass.attenuationDistance = 1.0f;
+  glass.attenuationDistance = distance;
+  return glass;
+}
+
+TEST_F(Optics, BeerLambertAttenuatesBySlabThickness) {
+  const scene::Material glass = tintedGlass(1.0f);
   scene::Scene s = slabScene(glass);
   scene::Optics optics;
   optics.fresnel = false;  // the volume alone
@@ -163,10 +169,7 @@ TEST_F(Optics, BeerLambertAttenuatesBySlabThickness) {
 }
 
 TEST_F(Optics, BeerLambertAndFresnelMultiply) {
-  scene::Material glass = glassOf(1.5f);
-  glass.thickness = 2.0f;
-  glass.attenuationColor = {0.5f, 0.8f, 0.9f};
-  glass.attenuationDistance = 4.0f;
+  const scene::Material glass = tintedGlass(4.0f);
   scene::Scene s = slabScene(glass);
   scene::Optics optics;
   optics.environment = uniformEnvironment(glm::vec3(0.0f));  // the reflection sees black

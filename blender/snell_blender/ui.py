@@ -12,18 +12,23 @@ from .runtime import AREA_LIGHT_NOTE
 MAX_PROBLEM_LINES = 8
 
 
-class SNELL_PT_render(bpy.types.Panel):
-    """Render Properties > snell."""
+class SnellPropertiesPanel:
+    """What snell's panels in the Properties editor share: they show while snell is the render engine."""
 
-    bl_label = "snell"
     bl_space_type = "PROPERTIES"
     bl_region_type = "WINDOW"
-    bl_context = "render"
     COMPAT_ENGINES = {"SNELL"}
 
     @classmethod
     def poll(cls, context) -> bool:
         return context.engine in cls.COMPAT_ENGINES
+
+
+class SNELL_PT_render(SnellPropertiesPanel, bpy.types.Panel):
+    """Render Properties > snell."""
+
+    bl_label = "snell"
+    bl_context = "render"
 
     def draw(self, context) -> None:
         layout = self.layout
@@ -53,18 +58,11 @@ class SNELL_PT_render(bpy.types.Panel):
             layout.operator("snell.retry", icon="FILE_REFRESH")
 
 
-class SNELL_PT_passes(bpy.types.Panel):
+class SNELL_PT_passes(SnellPropertiesPanel, bpy.types.Panel):
     """View Layer Properties > snell Passes: the AOVs this view layer writes as render passes."""
 
     bl_label = "snell Passes"
-    bl_space_type = "PROPERTIES"
-    bl_region_type = "WINDOW"
     bl_context = "view_layer"
-    COMPAT_ENGINES = {"SNELL"}
-
-    @classmethod
-    def poll(cls, context) -> bool:
-        return context.engine in cls.COMPAT_ENGINES
 
     def draw(self, context) -> None:
         layout = self.layout

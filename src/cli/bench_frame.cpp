@@ -269,19 +269,12 @@ void addBenchFrame(CLI::App& bench, Runner& run) {
       "trace (with --viewport the trace covers only the pixels whose visible face is\n"
       "transmissive); the raster passes draw the viewport with or without it.");
   sub->footer(kHelpFooter);
-  sub->add_option("scene", o->file, "the glTF file instead of the procedural eye")->type_name("SCENE.glb");
-  addSize(*sub, "--size", o->width, o->height, "image size (default 1920x1080)");
+  addBenchScene(*sub, o->file, o->width, o->height, "1920x1080");
   CLI::Option* frames = sub->add_option("--frames", o->frames, "frames measured (default 30)")
                             ->type_name("N")
                             ->check(positiveCount());
   sub->add_option("--warmup", o->warmup, "frames rendered first and not measured (default 5)")->type_name("N");
-  // The procedural eye's own limits (scene::checkEyeOptions), named after these options.
-  sub->add_option("--eye-resolution", o->eye.resolution, "segments of the procedural eye, 8-2048 (default 64)")
-      ->type_name("N")
-      ->check(CLI::Range(8u, 2048u));
-  sub->add_option("--crowd", o->eye.crowd, "N characters' eye pairs instead of one eye (at most 10000)")
-      ->type_name("N")
-      ->check(CLI::Range(0u, 10000u));
+  addEyeOptions(*sub, o->eye);
   CLI::Option* viewport =
       sub->add_flag("--viewport", o->viewport, "the viewport composite: raster pass, transmissive pixels traced");
   sub->add_flag("--orbit", o->orbit,

@@ -636,8 +636,7 @@ void addBenchMethods(CLI::App& bench, Runner& run) {
       "where it applies), \"ior-texture\" (the scene's first texture as IOR, scale\n"
       "0.05); for the procedural eye \"aqueous\" (nested media), and \"all\" of them.");
   sub->footer(kHelpFooter);
-  sub->add_option("scene", o->file, "the glTF file instead of the procedural eye")->type_name("SCENE.glb");
-  addSize(*sub, "--size", o->width, o->height, "image size (default 320x240)");
+  addBenchScene(*sub, o->file, o->width, o->height, "320x240");
   sub->add_option("--frames", o->frames, "frames of the sequence (default 24)")
       ->type_name("N")
       ->check(positiveCount());
@@ -654,13 +653,7 @@ void addBenchMethods(CLI::App& bench, Runner& run) {
       ->type_name("N")
       ->check(CLI::Range(0u, 1024u));
   addOffsetStrength(*sub, o->offsetStrength);
-  // The procedural eye's own limits (scene::checkEyeOptions), named after these options.
-  sub->add_option("--eye-resolution", o->eye.resolution, "segments of the procedural eye, 8-2048 (default 64)")
-      ->type_name("N")
-      ->check(CLI::Range(8u, 2048u));
-  sub->add_option("--crowd", o->eye.crowd, "N characters' eye pairs instead of one eye (at most 10000)")
-      ->type_name("N")
-      ->check(CLI::Range(0u, 10000u));
+  addEyeOptions(*sub, o->eye);
   sub->add_flag("--optics", o->optics, "rows per optics feature (trace) instead of per method")->excludes(methods);
   sub->add_flag("--no-reference", o->noReference, "time only: no CPU reference, no errors (for scaling runs)");
   sub->add_flag("--pipeline-stats", o->pipelineStats,

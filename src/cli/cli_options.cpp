@@ -218,6 +218,20 @@ const CLI::Validator& positiveCount() {
   return validator;
 }
 
+void addEyeOptions(CLI::App& app, scene::EyeOptions& eye) {
+  app.add_option("--eye-resolution", eye.resolution, "segments of the procedural eye, 8-2048 (default 64)")
+      ->type_name("N")
+      ->check(CLI::Range(8u, 2048u));
+  app.add_option("--crowd", eye.crowd, "N characters' eye pairs instead of one eye (at most 10000)")
+      ->type_name("N")
+      ->check(CLI::Range(0u, 10000u));
+}
+
+void addBenchScene(CLI::App& app, std::string& file, uint32_t& width, uint32_t& height, const std::string& defaultSize) {
+  app.add_option("scene", file, "the glTF file instead of the procedural eye")->type_name("SCENE.glb");
+  addSize(app, "--size", width, height, "image size (default " + defaultSize + ")");
+}
+
 CLI::Option* addSize(CLI::App& app, const std::string& name, uint32_t& width, uint32_t& height,
                      const std::string& description) {
   std::string option = name.substr(name.rfind(',') == std::string::npos ? 0 : name.rfind(',') + 1);

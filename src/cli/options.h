@@ -5,6 +5,7 @@
 #pragma once
 
 #include "scene/gltf_loader.h"
+#include "scene/procedural_eye.h"
 #include "scene/scene.h"
 #include "scene/view.h"
 #include "shared/trace.h"
@@ -89,6 +90,11 @@ const CLI::Validator& positiveCount();
 
 /// Options whose values are parsed here, with errors naming the option.
 CLI::Option* addSize(CLI::App& app, const std::string& name, uint32_t& width, uint32_t& height, const std::string& description);
+/// The procedural eye's --eye-resolution and --crowd, in its own limits (scene::checkEyeOptions).
+void addEyeOptions(CLI::App& app, scene::EyeOptions& eye);
+/// A benchmark's SCENE (a glTF file instead of the procedural eye) and its
+/// --size, `defaultSize` ("1920x1080") said in the help.
+void addBenchScene(CLI::App& app, std::string& file, uint32_t& width, uint32_t& height, const std::string& defaultSize);
 CLI::Option* addTextureBudget(CLI::App& app, uint64_t& bytes);
 /// --offset-strength S (-10 to 10): normal-offset's displacement, its default the one `strength` holds.
 CLI::Option* addOffsetStrength(CLI::App& app, float& strength);

@@ -25,8 +25,8 @@ def read_png(path: Path) -> np.ndarray:
         raise ValueError(f"{path}: not a PNG file")
     at, idat, header = 8, b"", None
     while at < len(data):
-        length, kind = struct.unpack(">I4s", data[at : at + 8])
-        body = data[at + 8 : at + 8 + length]
+        length, kind = struct.unpack(">I4s", data[at:at + 8])
+        body = data[at + 8:at + 8 + length]
         if kind == b"IHDR":
             header = struct.unpack(">IIBBBBB", body)
         elif kind == b"IDAT":
@@ -218,7 +218,8 @@ class GltfWriter:
         mesh: dict = {"primitives": [primitive]}
         if morph is not None:
             dp, dn = morph
-            primitive["targets"] = [{"POSITION": self._accessor(dp, "VEC3", True), "NORMAL": self._accessor(dn, "VEC3")}]
+            primitive["targets"] = [{"POSITION": self._accessor(dp, "VEC3", True),
+                                     "NORMAL": self._accessor(dn, "VEC3")}]
             mesh["weights"] = list(weights or [0.0])
         self.doc["meshes"].append(mesh)
         return len(self.doc["meshes"]) - 1

@@ -39,14 +39,19 @@ def test_info_json_is_the_same_listing(eyes):
     assert [c["prim"] for c in listing["cameras"]] == ["/World/Camera"] and len(listing["lights"]) == 3
 
 
-def test_info_on_a_broken_stage_lists_the_error_and_exits_1(tmp_path):
-    stage = new_stage(tmp_path / "broken.usda")
+def broken_stage(folder) -> object:
+    """A card whose material's texture file is not there: broken.usda in `folder`."""
+    stage = new_stage(folder / "broken.usda")
     card = quad(stage, "/World/Card")
     material = preview_material(stage, "/World/M")
     texture(stage, material, "./gone.png")
     bind(card.GetPrim(), material)
     stage.GetRootLayer().Save()
-    done = snell_usd("info", tmp_path / "broken.usda")
+    return folder / "broken.usda"
+
+
+def test_info_on_a_broken_stage_lists_the_error_and_exits_1(tmp_path):
+    done = snell_usd("info", broken_stage(tmp_path))
     assert done.returncode == 1
     assert "  error: /World/M/Texture_diffuseColor: texture file ./gone.png not found" in done.stdout
 
@@ -83,15 +88,10 @@ def test_quiet_prints_nothing(eyes, tmp_path):
 
 
 def test_a_stage_with_a_missing_texture_exits_1_and_writes_nothing(tmp_path):
-    stage = new_stage(tmp_path / "broken.usda")
-    card = quad(stage, "/World/Card")
-    material = preview_material(stage, "/World/M")
-    texture(stage, material, "./gone.png")
-    bind(card.GetPrim(), material)
-    stage.GetRootLayer().Save()
+    broken = broken_stage(tmp_path)
     out = tmp_path / "out"
     out.mkdir()
-    done = snell_usd("render", tmp_path / "broken.usda", "-o", out / "f.####.exr", "--frames", "1-3", "--size", SIZE)
+    done = snell_usd("render", broken, "-o", out / "f.####.exr", "--frames", "1-3", "--size", SIZE)
     assert done.returncode == 1
     assert "/World/M/Texture_diffuseColor: texture file ./gone.png not found" in done.stderr
     assert os.listdir(out) == []

@@ -403,12 +403,18 @@ def test_textures_of_one_material_reading_other_primvars_read_the_first_ones_wit
             "primvars:st; snell's meshes carry one UV set: primvars:st is used") in messages(contents)
 
 
-def test_a_missing_texture_is_an_error_naming_the_file(tmp_path):
+def textured(path: str):
+    """A build of read_quad's that binds a preview material whose diffuse texture is `path`."""
     def build(stage, prim):
         material = preview_material(stage, "/World/T")
-        texture(stage, material, "./nowhere.png")
+        texture(stage, material, path)
         bind(prim, material)
 
+    return build
+
+
+def test_a_missing_texture_is_an_error_naming_the_file(tmp_path):
+    build = textured("./nowhere.png")
     contents = read_quad(tmp_path, build)
     errors = [str(w) for w in contents.problems.errors]
     assert errors == ["error: /World/T/Texture_diffuseColor: texture file ./nowhere.png not found "
@@ -418,12 +424,7 @@ def test_a_missing_texture_is_an_error_naming_the_file(tmp_path):
 
 
 def test_a_udim_texture_is_a_warning(tmp_path):
-    def build(stage, prim):
-        material = preview_material(stage, "/World/T")
-        texture(stage, material, "./skin.<UDIM>.png")
-        bind(prim, material)
-
-    contents = read_quad(tmp_path, build)
+    contents = read_quad(tmp_path, textured("./skin.<UDIM>.png"))
     assert "is a UDIM set" in messages(contents) and not contents.problems.errors
 
 

@@ -297,35 +297,31 @@ class MaterialTable:
         self._one_uv_set(record)
         return record
 
+    def _colour(self, record: MaterialRecord, shader: UsdShade.Shader, name: str, kind: str,
+                slot_name: str) -> tuple:
+        """A colour input: its constant, or (a texture) the record's slot `slot_name` and the slot."""
+        value, source = self._input(shader, name)
+        constant = tuple(PREVIEW_FALLBACKS[name] if value is None else value)
+        if source is None:
+            return constant, None
+        if not source.is_texture:
+            self._cannot_evaluate(shader.GetPath(), name, source, constant)
+            return constant, None
+        slot, seen = self._texture_slot(source, kind)
+        if slot is None:
+            return _channel_colour(seen, source.output), None
+        record.slots[slot_name] = slot
+        return constant, slot
+
     def _diffuse(self, record: MaterialRecord, shader: UsdShade.Shader) -> tuple[float, float, float]:
         """diffuseColor: the base colour factor; a texture goes into record's base colour slot (factor 1)."""
-        diffuse, source = self._input(shader, "diffuseColor")
-        colour = tuple(PREVIEW_FALLBACKS["diffuseColor"] if diffuse is None else diffuse)
-        if source is None:
-            return colour
-        if not source.is_texture:
-            self._cannot_evaluate(shader.GetPath(), "diffuseColor", source, colour)
-            return colour
-        slot, seen = self._texture_slot(source, "colour")
-        if slot is None:
-            return _channel_colour(seen, source.output)
-        record.slots["base_color"] = slot
-        return (1.0, 1.0, 1.0)
+        colour, slot = self._colour(record, shader, "diffuseColor", "colour", "base_color")
+        return (1.0, 1.0, 1.0) if slot is not None else colour
 
     def _emissive(self, record: MaterialRecord, shader: UsdShade.Shader) -> tuple[float, float, float]:
         """emissiveColor: the emissive factor; a texture goes into the emissive slot (factor set on reading)."""
-        emissive, source = self._input(shader, "emissiveColor")
-        constant = tuple(PREVIEW_FALLBACKS["emissiveColor"] if emissive is None else emissive)
-        if source is None:
-            return constant
-        if not source.is_texture:
-            self._cannot_evaluate(shader.GetPath(), "emissiveColor", source, constant)
-            return constant
-        slot, seen = self._texture_slot(source, "emission")
-        if slot is None:
-            return _channel_colour(seen, source.output)
-        record.slots["emissive"] = slot
-        return slot.factor
+        constant, slot = self._colour(record, shader, "emissiveColor", "emission", "emissive")
+        return slot.factor if slot is not None else constant
 
     def _normal(self, record: MaterialRecord, shader: UsdShade.Shader) -> float:
         """normal: a texture goes into the normal slot; returns snell's normal_scale for it."""
