@@ -26,6 +26,10 @@
 #   bench/run_frame_on_device.sh python  # the Python module, built there for its python3 against the carried
 #                                        # install (.carry/prefix), replaying the Blender feed in .carry/feed
 #                                        # (bench/record_blender_feed.py), beside bench frame of the rig's glTF
+#   bench/run_frame_on_device.sh usd     # snell.usd's feed (bench/usd_feed.py) of the eye pair and its dense
+#                                        # version (written here into .carry/usd-eyes and .carry/usd-dense by
+#                                        # tests/usd/eye_stage.py), usd-core from .whl, the module built there as
+#                                        # for python, beside bench frame of each stage's glTF twin
 # SNELL_BIN picks another carried binary for the first, trace, viewport,
 # build and shot1 steps (default .carry/snell), to measure two builds in one lease.
 # Results land in $OUT.
@@ -152,6 +156,26 @@ if [[ $step == python ]]; then
     echo "== snell bench frame of Blender's glTF export of the same rig, same size"
     .carry/snell bench frame .carry/feed/rig.glb --viewport --size 1920x1080 --warmup 200 --frames 48 --json "$OUT/frame-rig.json"
   } 2>&1 | tee "$OUT/python.log"
+fi
+if [[ $step == usd ]]; then
+  {
+    python3 -m pip install -q --no-index --no-deps --no-compile --no-cache-dir --upgrade --target /tmp/site .whl/*.whl
+    cmake -S python -B /tmp/pybuild -G Ninja -DCMAKE_BUILD_TYPE=Release -DPython_EXECUTABLE="$(command -v python3)" \
+      -Dsnell_DIR="$PWD/.carry/prefix/lib/cmake/snell" -Dpybind11_DIR="$(python3 -m pybind11 --cmakedir)" >/tmp/pybuild.log 2>&1 &&
+      cmake --build /tmp/pybuild >>/tmp/pybuild.log 2>&1 || { echo "the module did not build:"; tail -30 /tmp/pybuild.log; }
+    export PYTHONPATH=/tmp/pybuild/python:/tmp/site PYTHONUNBUFFERED=1
+    for stage in usd-eyes usd-dense; do
+      echo "== snell.usd's feed of .carry/$stage, 1920x1080, the trace"
+      python3 bench/usd_feed.py --stage ".carry/$stage/eyes.usda" --no-textures --size 1920x1080 --frames 48 \
+        --json "$OUT/usd-feed-$stage.json"
+      echo "== the same, the viewport composite"
+      python3 bench/usd_feed.py --stage ".carry/$stage/eyes.usda" --no-textures --size 1920x1080 --frames 48 --viewport \
+        --json "$OUT/usd-feed-$stage-viewport.json"
+      echo "== snell bench frame of its glTF twin, same size"
+      $snell bench frame ".carry/$stage/eyes.gltf" --size 1920x1080 --frames 48 --json "$OUT/frame-$stage.json"
+      $snell bench frame ".carry/$stage/eyes.gltf" --viewport --size 1920x1080 --frames 48 --json "$OUT/frame-$stage-viewport.json"
+    done
+  } 2>&1 | tee "$OUT/usd.log"
 fi
 if [[ $step == farm ]]; then
   echo "== GPUs as a launcher names them: CUDA_VISIBLE_DEVICES by index and by UUID, and one past the end"
