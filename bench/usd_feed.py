@@ -31,8 +31,14 @@ import tempfile
 import time
 from pathlib import Path
 
+from pxr import Usd  # noqa: F401  (before snell: see below)
+
 import snell
 import snell.usd
+
+# usd-core loads first: on the GPU machine (its own CPython 3.12, GCC 13 and
+# pybind11, snell's module built there) importing pxr after snell's module
+# crashes in pxr's import, and before it does not.
 
 HERE = Path(__file__).resolve().parent
 
