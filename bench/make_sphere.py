@@ -1,12 +1,19 @@
 """Writes the trace benchmark's sphere: a glass UV sphere of about N triangles over a checkered floor.
 
     python3 bench/make_sphere.py 1000000 sphere-1m.gltf
+    python3 bench/make_sphere.py 1000000 sphere-1m-wedges.gltf 10
 
 The sphere (IOR 1.5, transmission 1) fills most of a 16:9 frame from its
 camera, so nearly every pixel's ray crosses glass twice and lands on the
 floor or the sky behind: what `snell bench methods --methods trace,driver-rt`
 times the traversal on. Only numpy and the standard library are needed, so it
 runs on the GPU machine too.
+
+With WEDGES the same sphere is written as that many instances of one wedge
+(a slice between two meridians, rotated into place): the same triangles and
+the same picture from a bottom-level tree a WEDGES-th the size, with the top
+level above it. Beside the single mesh it tells what the tree's footprint in
+the caches costs the trace (issue 40, step 0).
 """
 
 from __future__ import annotations
@@ -20,12 +27,15 @@ from pathlib import Path
 import numpy as np
 
 
-def sphere(triangles: int):
-    """A unit UV sphere with rings x 2 rings quads: about `triangles` triangles."""
+def sphere(triangles: int, wedges: int = 1):
+    """A unit UV sphere with rings x 2 rings quads: about `triangles` triangles;
+    with wedges > 1 only the first of that many equal slices around the y axis."""
     rings = max(4, int(math.sqrt(triangles / 4)))
-    segments = 2 * rings
+    while (2 * rings) % wedges:
+        rings += 1
+    segments = 2 * rings // wedges
     theta = np.linspace(0.0, math.pi, rings + 1)
-    phi = np.linspace(0.0, 2.0 * math.pi, segments + 1)
+    phi = np.linspace(0.0, 2.0 * math.pi / wedges, segments + 1)
     t, p = np.meshgrid(theta, phi, indexing="ij")
     normals = np.stack([np.sin(t) * np.cos(p), np.cos(t), np.sin(t) * np.sin(p)], -1).reshape(-1, 3)
     a = (np.arange(rings)[:, None] * (segments + 1) + np.arange(segments)[None, :]).reshape(-1)
@@ -35,9 +45,10 @@ def sphere(triangles: int):
 
 
 def main(argv: list[str]) -> None:
-    if len(argv) != 2:
-        raise SystemExit("usage: make_sphere.py TRIANGLES OUT.gltf")
-    positions, normals, indices = sphere(int(argv[0]))
+    if len(argv) not in (2, 3):
+        raise SystemExit("usage: make_sphere.py TRIANGLES OUT.gltf [WEDGES]")
+    wedges = int(argv[2]) if len(argv) == 3 else 1
+    positions, normals, indices = sphere(int(argv[0]), wedges)
     floor = np.float32([[-8, -1.2, -8], [8, -1.2, -8], [8, -1.2, 8], [-8, -1.2, 8]])
     floor_normals = np.float32([[0, 1, 0]] * 4)
     floor_uv = np.float32([[0, 0], [8, 0], [8, 8], [0, 8]])
@@ -81,10 +92,13 @@ def main(argv: list[str]) -> None:
         "asset": {"version": "2.0", "generator": "snell bench/make_sphere.py"},
         "extensionsUsed": ["KHR_materials_transmission", "KHR_materials_ior"],
         "scene": 0,
-        "scenes": [{"nodes": [0, 1, 2, 3]}],
+        "scenes": [{"nodes": [0, 1, 2, 3] + list(range(4, 3 + wedges))}],
         "nodes": [{"mesh": 0}, {"mesh": 1}, {"camera": 0, "translation": [0.0, 0.3, 2.3], "rotation":
                                               [-0.0499792, 0.0, 0.0, 0.9987503]},
-                  {"extensions": {"KHR_lights_punctual": {"light": 0}}, "translation": [2.0, 4.0, 3.0]}],
+                  {"extensions": {"KHR_lights_punctual": {"light": 0}}, "translation": [2.0, 4.0, 3.0]}] +
+                 # Wedge k covers longitudes [k, k + 1) * 2 pi / wedges: a turn about y by -that much.
+                 [{"mesh": 0, "rotation": [0.0, -math.sin(math.pi * k / wedges), 0.0, math.cos(math.pi * k / wedges)]}
+                  for k in range(1, wedges)],
         "meshes": [{"primitives": [{"attributes": glass, "indices": add(indices.reshape(-1), "SCALAR"),
                                     "material": 0}]},
                    {"primitives": [{"attributes": ground, "indices": add(floor_indices.reshape(-1), "SCALAR"),
@@ -107,7 +121,8 @@ def main(argv: list[str]) -> None:
     (out.with_suffix(".bin")).write_bytes(bytes(blob))
     document["buffers"] = [{"byteLength": len(blob), "uri": out.with_suffix(".bin").name}]
     out.write_text(json.dumps(document))
-    print(f"{out}: a glass sphere of {len(indices)} triangles over a checkered floor")
+    what = f"{wedges} wedges of {len(indices)} triangles" if wedges > 1 else f"{len(indices)} triangles"
+    print(f"{out}: a glass sphere of {what} over a checkered floor")
 
 
 if __name__ == "__main__":

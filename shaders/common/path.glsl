@@ -16,6 +16,9 @@ bool opticsOn(uint bit) { return (kSpecOptics & pc.optics & bit) != 0u; }
 bool traceFlag(uint bit) { return (kSpecFlags & pc.flags & bit) != 0u; }
 
 uint visits;  // nodes visited by this pixel's whole path (the driver's pipeline cannot count them: 0)
+uint boxTests, triangleTests;  // child boxes and triangles tested over the path (trace.comp counts them)
+uint segments;  // closest-hit queries of the path so far
+uint tracedPixel;  // row-major index of the pixel being traced
 
 struct Hit {
   float t;
@@ -178,6 +181,7 @@ bool tracePath(vec3 origin, vec3 dir, float width, float spread, int channel, ou
   bool segmentZero = true;
   for (uint pass = 0u; pass < passes; ++pass) {
     Hit hit = traceClosest(origin, dir, skipInstance, skipPrim, tMin);
+    ++segments;
     Surface s;
     GpuMaterial m;
     bool opaque = false;
@@ -359,7 +363,8 @@ void tracePixel(uvec2 pixel) {
   }
   if (!opticsOn(kOpticsTextureLod)) width = spread = 0.0;
 
-  visits = 0u;
+  visits = boxTests = triangleTests = segments = 0u;
+  tracedPixel = pixel.y * pc.width + pixel.x;
   // One call site for the path (a compiler that inlines would copy it per
   // call): the first pass at the base IOR, then, where it met dispersion,
   // red, blue and green, each keeping its channel (the AOVs are green's).
@@ -387,7 +392,7 @@ void tracePixel(uvec2 pixel) {
     aovs[pixel.y * pc.width + pixel.x] = TraceAov(path.firstDistance, path.firstInstance, path.firstPrimitive,
                                                   path.interfaces, path.outcome, visits, path.landing.x, path.landing.y,
                                                   path.landingMaterial, path.landingLod, shine.r, shine.g, shine.b,
-                                                  weight.r, weight.g, weight.b);
+                                                  weight.r, weight.g, weight.b, segments, boxTests, triangleTests, 0u);
   }
 }
 

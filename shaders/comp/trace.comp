@@ -21,6 +21,7 @@ layout(std430, binding = kTraceBindingEnvironment) readonly buffer Environment {
 layout(binding = kTraceBindingImage, rgba16f) uniform writeonly image2D outImage;
 layout(std430, binding = kTraceBindingAov) writeonly buffer Aovs { TraceAov aovs[]; };
 layout(std430, binding = kTraceBindingRays) readonly buffer Rays { GpuRay rays[]; };
+layout(std430, binding = kTraceBindingHits) buffer HitRecords { TraceHitRecord hitRecords[]; };
 layout(std430, binding = kTraceBindingPixels) readonly buffer Pixels {
   TracePixelListHeader list;
   uint listed[];
@@ -137,6 +138,7 @@ void enterChildren(BvhNode node, ShearedRay r, float tMax, out float tNear, out 
 void testTriangle(ShearedRay r, uint instance, uint tri, uint skipPrim, uint first, uint end, float tMin,
                   inout Hit hit) {
   if (tri == skipPrim || tri < first || tri >= end) return;  // skipPrim: the face this ray leaves
+  ++triangleTests;
   vec3 bary;
   float t = intersectTriangle(r, tri, hit.t, bary);
   if (t < hit.t && t > tMin) hit = Hit(t, instance, tri, bary);
@@ -177,6 +179,7 @@ void traverseBlas(uint instance, vec3 origin, vec3 dir, uint skipPrim, float tMi
     if (ref < group.first || ref + 1u >= end) continue;
     float tNear, tFar;
     uint nearRef, farRef;
+    boxTests += 2u;
     enterChildren(blasNode(ref), r, hit.t, tNear, tFar, nearRef, farRef);
     if (tFar < kInf) {
       if ((farRef & kBvhLeafBit) != 0u) leaves[leafCount++] = farRef & ~kBvhLeafBit;
@@ -190,7 +193,7 @@ void traverseBlas(uint instance, vec3 origin, vec3 dir, uint skipPrim, float tMi
 }
 
 // tMin: hits this close to the origin are the surface the ray leaves.
-Hit traceClosest(vec3 origin, vec3 dir, uint skipInstance, uint skipPrim, float tMin) {
+Hit traverse(vec3 origin, vec3 dir, uint skipInstance, uint skipPrim, float tMin) {
   Hit hit = Hit(kInf, kNoHit, kNoHit, vec3(0.0));
   BvhGroup top = tlasGroups[0];
   if (top.root == kBvhNone) return hit;
@@ -214,10 +217,26 @@ Hit traceClosest(vec3 origin, vec3 dir, uint skipInstance, uint skipPrim, float 
     if (ref >= nodeEnd) continue;
     float tNear, tFar;
     uint nearRef, farRef;
+    boxTests += 2u;
     enterChildren(tlasNode(ref), r, hit.t, tNear, tFar, nearRef, farRef);
     // The nearer on top. A full stack drops them (only a corrupted tree is that deep): the ray still ends.
     if (tFar < kInf && sp < kStackSize) stack[sp++] = farRef;
     if (tNear < kInf && sp < kStackSize) stack[sp++] = nearRef;
+  }
+  return hit;
+}
+
+// The traversal, or, for the hit-replay ablation (shared/trace.h), its recorded answer.
+Hit traceClosest(vec3 origin, vec3 dir, uint skipInstance, uint skipPrim, float tMin) {
+  uint slot = tracedPixel * kTraceReplaySegments + segments;
+  bool recorded = segments < kTraceReplaySegments;
+  if (traceFlag(kTraceFlagReplayHits) && recorded) {
+    TraceHitRecord h = hitRecords[slot];
+    return Hit(h.t, h.instance, h.primitive, h.bary.xyz);
+  }
+  Hit hit = traverse(origin, dir, skipInstance, skipPrim, tMin);
+  if (traceFlag(kTraceFlagRecordHits) && recorded) {
+    hitRecords[slot] = TraceHitRecord(hit.t, hit.instance, hit.primitive, 0.0, vec4(hit.bary, 0.0));
   }
   return hit;
 }

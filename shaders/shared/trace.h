@@ -192,7 +192,7 @@ SNELL_CONST kOutcomeInterfaceLimit = 2;  // more refractive faces than maxInterf
 
 
 // Per-pixel outputs for tests and tools, written when TracePush::flags has kTraceFlagAov.
-// 64 bytes, total: 64 bytes
+// 80 bytes, total: 80 bytes
 struct TraceAov {
   float distance;   // 4: to the first hit along the unit primary ray; -1 on a miss
   uint instance;    // 4: draw item of the first hit, kNoHit on a miss
@@ -215,6 +215,13 @@ struct TraceAov {
   float weightR;    // 4: light times the glass's transmittance times the base colour factor
   float weightG;    // 4
   float weightB;    // 4
+  // What the path cost (bench cost): closest-hit queries (segments, reflected
+  // rays included), child boxes tested and triangles tested, over the whole
+  // path; the driver's pipeline counts only segments.
+  uint segments;        // 4
+  uint boxTests;        // 4
+  uint triangleTests;   // 4
+  uint pad0;            // 4
 };
 
 SNELL_CONST kNoHit = 0xffffffffu;
@@ -223,6 +230,12 @@ SNELL_CONST kTraceFlagAov = 1u;
 SNELL_CONST kTraceFlagOrthographic = 2u;
 SNELL_CONST kTraceFlagRayList = 4u;  // primary rays from kTraceBindingRays, not the camera
 SNELL_CONST kTraceFlagPixelList = 8u;  // only the pixels kTraceBindingPixels lists (the masked trace)
+// The hit-replay ablation (bench cost): record writes each segment's closest
+// hit to kTraceBindingHits; replay reads them back instead of traversing, so
+// its time is the path's work without the traversal. Benchmarks only.
+SNELL_CONST kTraceFlagRecordHits = 16u;
+SNELL_CONST kTraceFlagReplayHits = 32u;
+SNELL_CONST kTraceReplaySegments = 8;  // segments a pixel records; later ones are traced in both runs
 SNELL_CONST kTraceTile = 8;  // pixels per side of one workgroup's tile
 // Specialisation constants of the trace: the kOptics* and kTraceFlag* bits a
 // pipeline is made for. A bit off compiles its code out; TracePush's optics
@@ -245,12 +258,23 @@ SNELL_CONST kTraceBindingPixels = kSceneBindingCount + 7;         // TracePixelL
 SNELL_CONST kTraceBindingMask = kSceneBindingCount + 8;           // r32ui image: non-zero where a transmissive face is visible (compaction)
 SNELL_CONST kTraceBindingGeometryFirst = kSceneBindingCount + 9;  // uint[geometryCount]: first triangle (driver-rt pipeline only)
 SNELL_CONST kTraceBindingEnvironment = kSceneBindingCount + 10;   // vec4[]: (width, height, 0, 0), then width * height linear RGB texels, row 0 at +Y
+SNELL_CONST kTraceBindingHits = kSceneBindingCount + 11;          // TraceHitRecord[width * height * kTraceReplaySegments], record/replay only
 
 // A primary ray from a list, relative to the frame origin like everything the trace sees.
 // 32 bytes, total: 32 bytes
 struct GpuRay {
   vec4 origin;     // 16: xyz; w unused
   vec4 direction;  // 16: xyz, unit length; w unused
+};
+
+// One recorded closest hit (kTraceFlagRecordHits).
+// 32 bytes, total: 32 bytes
+struct TraceHitRecord {
+  float t;          // 4
+  uint instance;    // 4: kNoHit on a miss
+  uint primitive;   // 4
+  float pad0;       // 4
+  vec4 bary;        // 16: xyz
 };
 
 // The scene is rebased to a frame origin near the cameras (Renderer);

@@ -71,6 +71,8 @@ Mesh uvSphere(uint64_t triangles) {
 struct Row {
   uint64_t triangles = 0;
   double buildMs = 0, refitMs = 0, bytesPerTriangle = 0, scratchPerTriangle = 0, sahRatio = 0;
+  /// The build's steps, medians of runs that timed each (BvhBuilder::setStepTiming), in build order.
+  std::vector<std::pair<std::string, double>> stepMs;
   // The driver's, where it has them (0 otherwise).
   double driverFastBuildMs = 0, driverFastTraceMs = 0, driverUpdateMs = 0, driverBytesPerTriangle = 0;
 };
@@ -199,6 +201,26 @@ int runScale(const Options& o) {
       for (const vk::PassTime& p : commands.passTimes()) (p.name == "build" ? build : refit).push_back(p.milliseconds);
     }
     Row row;
+    // The breakdown: separate runs, since a timestamp between steps waits for
+    // the step before it and so costs the build some overlap.
+    {
+      builder.setStepTiming(true);
+      std::map<std::string, std::vector<double>> steps;
+      std::vector<std::string> order;
+      for (uint32_t run = 0; run <= runs; ++run) {
+        commands.begin();
+        arena.reset();
+        builder.recordBuild(commands, bvh, inputs, {}, arena, restructure);
+        commands.submitAndWait();
+        if (run == 0) continue;
+        for (const vk::PassTime& p : commands.passTimes()) {
+          if (!steps.count(p.name)) order.push_back(p.name);
+          steps[p.name].push_back(p.milliseconds);
+        }
+      }
+      builder.setStepTiming(false);
+      for (const std::string& name : order) row.stepMs.emplace_back(name, io::median(steps[name]));
+    }
     if (driver) {
       // The driver's structures over the same buffers, timed the same way.
       uint32_t vertices = static_cast<uint32_t>(mesh.positions.size() / 3);
@@ -253,6 +275,13 @@ int runScale(const Options& o) {
                 row.sahRatio > 0 ? std::to_string(row.sahRatio).substr(0, 5).c_str() : "-",
                 ms(row.driverFastBuildMs).c_str(), ms(row.driverFastTraceMs).c_str(), ms(row.driverUpdateMs).c_str(),
                 driver ? std::to_string(row.driverBytesPerTriangle).substr(0, 5).c_str() : "-");
+    std::printf("%10s build steps, ms:", "");
+    double stepSum = 0;
+    for (const auto& [name, ms] : row.stepMs) {
+      std::printf(" %s %.4f,", name.c_str() + 4, ms);  // less "bvh "
+      stepSum += ms;
+    }
+    std::printf(" sum %.4f\n", stepSum);
     std::fflush(stdout);
     builder.releaseScratch();
   }
@@ -292,7 +321,12 @@ int runScale(const Options& o) {
                                  {"driver_fast_build_ms", r.driverFastBuildMs},
                                  {"driver_fast_trace_build_ms", r.driverFastTraceMs},
                                  {"driver_update_ms", r.driverUpdateMs},
-                                 {"driver_bytes_per_triangle", r.driverBytesPerTriangle}});
+                                 {"driver_bytes_per_triangle", r.driverBytesPerTriangle},
+                                 {"build_steps_ms", [&] {
+                                    io::Json steps = io::Json::object();
+                                    for (const auto& [name, ms] : r.stepMs) steps[name] = ms;
+                                    return steps;
+                                  }()}});
     }
     j["spheres"] = std::move(spheres);
     j["crowd_viewport"] = io::Json{{"width", width}, {"height", height}, {"frames", frames}};

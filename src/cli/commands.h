@@ -25,6 +25,7 @@ void addExportWeb(CLI::App& parent, Runner& run);
 void addBenchSort(CLI::App& bench, Runner& run);
 void addBenchBvh(CLI::App& bench, Runner& run);
 void addBenchFrame(CLI::App& bench, Runner& run);
+void addBenchCost(CLI::App& bench, Runner& run);
 void addBenchStress(CLI::App& bench, Runner& run);
 void addBenchScale(CLI::App& bench, Runner& run);
 void addBenchMethods(CLI::App& bench, Runner& run);

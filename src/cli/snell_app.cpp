@@ -34,6 +34,7 @@ std::unique_ptr<CLI::App> makeSnellApp(Runner& run) {
   addBenchSort(*bench, run);
   addBenchBvh(*bench, run);
   addBenchFrame(*bench, run);
+  addBenchCost(*bench, run);
   addBenchStress(*bench, run);
   addBenchScale(*bench, run);
   addBenchMethods(*bench, run);

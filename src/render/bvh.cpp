@@ -1,6 +1,7 @@
 // Host side of the BVH passes (shaders/comp/bvh/*.comp).
 #include "render/bvh.h"
 
+#include "render/pass_names.h"
 #include "vk/error.h"
 
 #include "bvh_build_boxes.spv.h"
@@ -196,6 +197,7 @@ void BvhBuilder::recordBuild(vk::Commands& commands, Bvh& bvh, const BvhInputs& 
   uint32_t entryCount = static_cast<uint32_t>(entries.size());
   bool instances = bvh.leaves == BvhLeaves::Instances;
   gpu::BvhPush push{static_cast<uint32_t>(positions), entryCount, flags, bvh.primitiveCount};
+  if (stepTiming_) commands.beginPass(pass::kBvhBoxes);
   boxes_->dispatchThreads(commands,
                           {{gpu::kBvhBindingBuildEntries, &bvh.buildEntries},
                            {gpu::kBvhBindingPositions, instances ? &placeholder_ : inputs.positions},
@@ -206,6 +208,7 @@ void BvhBuilder::recordBuild(vk::Commands& commands, Bvh& bvh, const BvhInputs& 
                            {gpu::kBvhBindingDropped, &bvh.dropped}},
                           push, positions);
   commands.computeToCompute();
+  if (stepTiming_) commands.beginPass(pass::kBvhMorton);
   morton_->dispatchThreads(commands,
                            {{gpu::kBvhBindingBuildEntries, &bvh.buildEntries},
                             {gpu::kBvhBindingPrimBoxes, &s.primBoxes},
@@ -213,7 +216,9 @@ void BvhBuilder::recordBuild(vk::Commands& commands, Bvh& bvh, const BvhInputs& 
                             {gpu::kBvhBindingValues, &s.values}},
                            push, positions);
   commands.computeToCompute();
+  if (stepTiming_) commands.beginPass(pass::kBvhSort);
   sort.record(commands, s.keys, s.values, positions, sortScratch, keyBits);
+  if (stepTiming_) commands.beginPass(pass::kBvhHploc);
   hploc_->dispatchThreads(commands,
                           {{gpu::kBvhBindingBuildEntries, &bvh.buildEntries},
                            {gpu::kBvhBindingKeys, &s.keys},
@@ -228,6 +233,7 @@ void BvhBuilder::recordBuild(vk::Commands& commands, Bvh& bvh, const BvhInputs& 
   for (uint32_t round = 0; round < restructureRounds; ++round) {
     recordRestructure(commands, bvh, entryCount, static_cast<uint32_t>(positions));
   }
+  if (stepTiming_) commands.endPass();
   commands.computeToTransfer();
 }
 

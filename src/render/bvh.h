@@ -117,6 +117,10 @@ class BvhBuilder {
   void recordRefit(vk::Commands& commands, Bvh& bvh, const BvhInputs& inputs, std::span<const uint32_t> groups,
                    vk::UploadArena& arena);
 
+  /// Each build step opens its own timed pass (render/pass_names.h: kBvh*),
+  /// for a breakdown; off, a caller's own pass around the build times it whole.
+  void setStepTiming(bool on) { stepTiming_ = on; }
+
   /// Reads a forest back (waits for the GPU).
   BvhSnapshot download(const Bvh& bvh) const;
 
@@ -138,6 +142,7 @@ class BvhBuilder {
   std::shared_ptr<Scratch> scratch_;
   vk::Buffer placeholder_;
   std::unique_ptr<vk::ComputeProgram> boxes_, morton_, hploc_, refit_, restructure_;
+  bool stepTiming_ = false;
 };
 
 }  // namespace snell::render

@@ -13,6 +13,10 @@
 
 namespace snell::render {
 
+/// The hit-replay ablation (`snell bench cost`): record each segment's closest
+/// hit, then trace the same view again reading them instead of traversing.
+enum class HitReplay : uint8_t { Off, Record, Replay };
+
 struct FrameSettings {
   uint32_t width = 0, height = 0;
   scene::View view;
@@ -28,6 +32,8 @@ struct FrameSettings {
   scene::Optics optics;
   /// The composite's alpha where nothing is drawn (0: a host composites the image over its own).
   float backgroundAlpha = 1.0f;
+  /// Benchmarks only: a replay must follow a record of the same view and pose.
+  HitReplay hitReplay = HitReplay::Off;
   friend bool operator==(const FrameSettings&, const FrameSettings&) = default;
 };
 

@@ -15,6 +15,11 @@ inline constexpr const char* kTlas = "tlas";
 inline constexpr const char* kSortHistogram = "histogram";
 inline constexpr const char* kSortScan = "scan";
 inline constexpr const char* kSortScatter = "scatter";
+// The build's steps, with BvhBuilder::setStepTiming (bench scale's breakdown).
+inline constexpr const char* kBvhBoxes = "bvh boxes";
+inline constexpr const char* kBvhMorton = "bvh morton";
+inline constexpr const char* kBvhSort = "bvh sort";
+inline constexpr const char* kBvhHploc = "bvh hploc";
 inline constexpr const char* kTraceList = "trace list";
 inline constexpr const char* kTrace = "trace";
 inline constexpr const char* kRasterDepth = "raster depth";

@@ -46,6 +46,24 @@ uint32_t TracePass::opticsFor(const FrameSettings& settings) const {
   return asked & sceneOptics_;
 }
 
+uint32_t TracePass::replayFlags(const FrameSettings& settings) {
+  return settings.hitReplay == HitReplay::Record ? gpu::kTraceFlagRecordHits
+         : settings.hitReplay == HitReplay::Replay ? gpu::kTraceFlagReplayHits
+                                                   : 0u;
+}
+
+const vk::Buffer& TracePass::hitRecords(const FrameSettings& settings) {
+  if (settings.hitReplay == HitReplay::Off) return placeholder_;
+  VkDeviceSize bytes = VkDeviceSize(settings.width) * settings.height * gpu::kTraceReplaySegments *
+                       sizeof(gpu::TraceHitRecord);
+  if (hitRecords_.size() < bytes) {
+    if (settings.hitReplay == HitReplay::Replay) throw std::logic_error("trace: a hit replay before its record");
+    hitRecords_ = vk::Buffer(context_, {bytes, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, vk::MemoryDomain::Device,
+                                        "trace hit records"});
+  }
+  return hitRecords_;
+}
+
 const vk::ComputeProgram& TracePass::program(uint32_t optics, uint32_t flags) {
   uint64_t key = uint64_t(optics) << 32 | flags;
   auto found = programs_.find(key);
@@ -57,7 +75,8 @@ const vk::ComputeProgram& TracePass::program(uint32_t optics, uint32_t flags) {
 
 void TracePass::prefetch(const FrameSettings& settings, bool aov, bool masked) {
   uint32_t flags = (aov ? gpu::kTraceFlagAov : 0u) | (settings.view.orthographic ? gpu::kTraceFlagOrthographic : 0u) |
-                   (settings.rays.empty() ? 0u : gpu::kTraceFlagRayList) | (masked ? gpu::kTraceFlagPixelList : 0u);
+                   (settings.rays.empty() ? 0u : gpu::kTraceFlagRayList) | (masked ? gpu::kTraceFlagPixelList : 0u) |
+                   replayFlags(settings);
   program(opticsFor(settings), flags);
 }
 
@@ -109,7 +128,8 @@ gpu::TracePush TracePass::push(const TraceInputs& in, const FrameSettings& setti
   push.maxBends = settings.maxBends;
   push.lightCount = in.lightCount;
   push.flags = (target.aov ? gpu::kTraceFlagAov : 0u) | (v.orthographic ? gpu::kTraceFlagOrthographic : 0u) |
-               (target.rays ? gpu::kTraceFlagRayList : 0u) | (masked ? gpu::kTraceFlagPixelList : 0u);  // as prefetch()
+               (target.rays ? gpu::kTraceFlagRayList : 0u) | (masked ? gpu::kTraceFlagPixelList : 0u) |
+               replayFlags(settings);  // as prefetch()
   push.tilesX = (settings.width + gpu::kTraceTile - 1) / gpu::kTraceTile;
   push.shiftX = float(v.shift.x);
   push.shiftY = float(v.shift.y);
@@ -160,7 +180,8 @@ uint64_t TracePass::record(vk::Commands& commands, const TraceInputs& in, const 
                                    {gpu::kTraceBindingTlasGroups, &in.tlas->groups},
                                    {gpu::kTraceBindingBlasNodes, &in.blas->nodes},
                                    {gpu::kTraceBindingBlasGroups, &in.blas->groups},
-                                   {gpu::kTraceBindingPixels, masked ? target.pixels : &placeholder_}});
+                                   {gpu::kTraceBindingPixels, masked ? target.pixels : &placeholder_},
+                                   {gpu::kTraceBindingHits, &hitRecords(settings)}});
   if (masked) {
     trace.dispatchIndirect(commands, bindings, p, *target.pixels, gpu::kTracePixelListDispatchOffset);
   } else {

@@ -96,12 +96,16 @@ class TracePass {
   const vk::Buffer& environmentBuffer(const scene::Optics& optics) const;
   /// The trace pipeline specialised to `optics` and `flags` (gpu::kTraceFlag*), made on first use.
   const vk::ComputeProgram& program(uint32_t optics, uint32_t flags);
+  static uint32_t replayFlags(const FrameSettings& settings);
+  /// The hit records a record or replay binds (made by the first record), else the placeholder.
+  const vk::Buffer& hitRecords(const FrameSettings& settings);
 
   vk::Context& context_;
   uint32_t sceneOptics_ = 0;  ///< gpu::kOptics* bits the scene's materials can show
   std::map<uint64_t, std::unique_ptr<vk::ComputeProgram>> programs_;  ///< by optics << 32 | flags
   std::unique_ptr<vk::ComputeProgram> compact_;
   vk::Buffer placeholder_;
+  vk::Buffer hitRecords_;  ///< the hit-replay ablation's records (FrameSettings::hitReplay)
   /// Environments uploaded for views, by identity; each holds its own reference,
   /// so a buffer is never freed under a frame in flight that reads it.
   struct Environment {
