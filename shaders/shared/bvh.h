@@ -11,7 +11,10 @@
 // the node slot max(first sorted position in A, first in B) - 1: every binary
 // tree over a group's n leaves numbers its n - 1 nodes this way without
 // collision, so slots are deterministic, whatever order the GPU runs the
-// merges in, and a group owns exactly [first, first + count - 1).
+// merges in, and a group owns exactly [first, first + count - 1). H-PLOC
+// writes each node's links and its exact box (in the forest's exact boxes,
+// which refits use the same way); one pass then quantises every node's
+// children's boxes into it.
 #ifndef SNELL_BVH_H
 #define SNELL_BVH_H
 #include "shared_types.h"
@@ -59,7 +62,7 @@ SNELL_CONST kBvhBindingInstances = 15;    // GpuInstance[instanceCount]
 SNELL_CONST kBvhBindingBlasGroups = 16;   // BvhGroup[] of the bottom level
 SNELL_CONST kBvhBindingCounters = 17;     // uint[nodes]: arrivals of the restructuring pass
 SNELL_CONST kBvhBindingNodeStats = 18;    // uvec2[nodes]: subtree cost and leaf count (restructuring)
-SNELL_CONST kBvhBindingExactBoxes = 19;   // float[6 * nodes]: each node's exact box during a refit
+SNELL_CONST kBvhBindingExactBoxes = 19;   // float[6 * nodes]: each node's exact box during a build or a refit
 
 SNELL_CONST kBvhSpecWorkgroupSize = 0;
 SNELL_CONST kBvhSpecSlots = 1;  // H-PLOC: window slots per invocation, window / smallest subgroup

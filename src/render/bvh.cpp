@@ -7,6 +7,7 @@
 #include "bvh_build_boxes.spv.h"
 #include "bvh_hploc.spv.h"
 #include "bvh_morton.spv.h"
+#include "bvh_quantise.spv.h"
 #include "bvh_refit.spv.h"
 #include "bvh_restructure.spv.h"
 
@@ -77,6 +78,7 @@ BvhBuilder::BvhBuilder(vk::Context& context, BvhTuning tuning)
   refit_ = program("bvh refit", kSpvBvhRefit,
                    {{gpu::kBvhSpecWorkgroupSize, tuning.refitWorkgroup ? tuning.refitWorkgroup : handOffWorkgroup(context)}});
   restructure_ = program("bvh restructure", kSpvBvhRestructure, {{gpu::kBvhSpecWorkgroupSize, handOffWorkgroup(context)}});
+  quantise_ = program("bvh quantise", kSpvBvhQuantise, {{gpu::kBvhSpecWorkgroupSize, 64}});
   placeholder_ = deviceBuffer(context, 16, "bvh placeholder");
 }
 
@@ -105,6 +107,8 @@ Bvh BvhBuilder::makeBvh(const std::vector<uint32_t>& groupSizes, BvhLeaves leave
   bvh.dropped = deviceBuffer(context_, 4, name + " dropped triangles");
   bvh.buildEntries = deviceBuffer(context_, groupCount * sizeof(gpu::BvhBuildEntry), name + " build list");
   bvh.refitEntries = deviceBuffer(context_, groupCount * sizeof(gpu::BvhRefitEntry), name + " refit list");
+  // Every build and refit passes exact boxes up through them.
+  bvh.exactBoxes = deviceBuffer(context_, primitives * 24, name + " exact boxes");
 
   std::vector<gpu::BvhGroup> groups(groupCount);
   for (size_t g = 0; g < groups.size(); ++g) {
@@ -227,12 +231,21 @@ void BvhBuilder::recordBuild(vk::Commands& commands, Bvh& bvh, const BvhInputs& 
                            {gpu::kBvhBindingParentIds, &s.parentIds},
                            {gpu::kBvhBindingClusters, &s.clusters},
                            {gpu::kBvhBindingNodes, &bvh.nodes},
+                           {gpu::kBvhBindingExactBoxes, &bvh.exactBoxes},
                            {gpu::kBvhBindingGroups, &bvh.groups}},
                           push, positions);
   commands.computeToCompute();
   for (uint32_t round = 0; round < restructureRounds; ++round) {
     recordRestructure(commands, bvh, entryCount, static_cast<uint32_t>(positions));
   }
+  if (stepTiming_) commands.beginPass(pass::kBvhQuantise);
+  quantise_->dispatchThreads(commands,
+                             {{gpu::kBvhBindingBuildEntries, &bvh.buildEntries},
+                              {gpu::kBvhBindingPrimBoxes, &s.primBoxes},
+                              {gpu::kBvhBindingExactBoxes, &bvh.exactBoxes},
+                              {gpu::kBvhBindingNodes, &bvh.nodes}},
+                             push, positions);
+  commands.computeToCompute();
   if (stepTiming_) commands.endPass();
   commands.computeToTransfer();
 }
@@ -251,6 +264,8 @@ void BvhBuilder::recordRestructure(vk::Commands& commands, Bvh& bvh, uint32_t en
   restructure_->dispatchThreads(commands,
                                 {{gpu::kBvhBindingBuildEntries, &bvh.buildEntries},
                                  {gpu::kBvhBindingNodes, &bvh.nodes},
+                                 {gpu::kBvhBindingPrimBoxes, &s.primBoxes},
+                                 {gpu::kBvhBindingExactBoxes, &bvh.exactBoxes},
                                  {gpu::kBvhBindingCounters, &s.counters},
                                  {gpu::kBvhBindingNodeStats, &s.nodeStats}},
                                 push, primitives);
@@ -275,9 +290,6 @@ void BvhBuilder::recordRefit(vk::Commands& commands, Bvh& bvh, const BvhInputs& 
     threads += std::max(size - 1, 1u);  // one per node slot, or the lone leaf
   }
   if (entries.empty()) return;
-  if (!bvh.exactBoxes.handle()) {
-    bvh.exactBoxes = deviceBuffer(context_, uint64_t(bvh.primitiveCount) * 24, bvh.name + " refit boxes");
-  }
   arena.copy(commands, entries, bvh.refitEntries);
   commands.fillBuffer(bvh.stats, 0);
   commands.transferToCompute();

@@ -7,7 +7,8 @@
 //
 // build (any subset of groups): primitive boxes and centroid bounds ->
 // Morton keys -> radix sort -> H-PLOC (shaders/comp/bvh/bvh_hploc.comp), and
-// optionally rounds of treelet restructuring. refit (any subset): one
+// optionally rounds of treelet restructuring, on exact boxes; then the
+// nodes' quantisation (bvh_quantise.comp). refit (any subset): one
 // dispatch from the leaves up, which also prices each tree by the surface
 // area heuristic, so a caller can rebuild trees that deformation has spoiled.
 // Both are deterministic: the same input gives the same nodes in the same
@@ -49,12 +50,12 @@ struct Bvh {
   vk::Buffer stats;    ///< uvec4 per group: its last refit's SAH (BvhBuilder::sahCost reads it)
   vk::Buffer dropped;  ///< uint: non-finite triangles the box passes met since the caller last zeroed it
   vk::Buffer buildEntries, refitEntries;  ///< this forest's lists, copied in per build or refit
-  vk::Buffer exactBoxes;  ///< float[6] per node slot: a refit's exact boxes on their way up (made by the first refit)
+  vk::Buffer exactBoxes;  ///< float[6] per node slot: a build's or refit's exact boxes on their way up
 
   uint32_t groupCount() const { return static_cast<uint32_t>(groupSizes.size()); }
   /// Memory of the trees the trace reads: nodes and group records.
   uint64_t treeBytes() const;
-  /// Memory a refit works in besides the trees (exact boxes), and the per-group tables and lists.
+  /// Memory builds and refits work in besides the trees (exact boxes), and the per-group tables and lists.
   uint64_t workBytes() const;
 };
 
@@ -141,7 +142,7 @@ class BvhBuilder {
   RadixSort sort32_, sort64_;
   std::shared_ptr<Scratch> scratch_;
   vk::Buffer placeholder_;
-  std::unique_ptr<vk::ComputeProgram> boxes_, morton_, hploc_, refit_, restructure_;
+  std::unique_ptr<vk::ComputeProgram> boxes_, morton_, hploc_, refit_, restructure_, quantise_;
   bool stepTiming_ = false;
 };
 

@@ -8,8 +8,10 @@
 // (its team) loads the range's clusters (at most half a window from each
 // side) and merges them PLOC-style, mutual nearest neighbours by the surface
 // area of their union within a search radius, until half a window is left;
-// at a group's root it merges down to one. Each merge writes its node to the
-// slot max(first position of either cluster) - 1, so the tree and its memory
+// at a group's root it merges down to one. Each merge writes its node's
+// children and its exact box (bvh_quantise.comp quantises the children's
+// boxes once the tree stands, off the team's critical path) to the slot
+// max(first position of either cluster) - 1, so the tree and its memory
 // layout are the same on every run (shared/bvh.h). No invocation waits for
 // another outside its subgroup: a range is only continued by whoever arrives
 // second, so it is safe without forward-progress guarantees.
@@ -23,7 +25,6 @@
 #extension GL_KHR_shader_subgroup_basic : require
 #extension GL_KHR_shader_subgroup_ballot : require
 #include "bvh_common.glsl"
-#include "bvh_node.glsl"
 
 layout(constant_id = kBvhSpecSlots) const uint kSlots = 1u;
 layout(constant_id = kBvhSpecTeams) const uint kTeams = 1u;
@@ -35,6 +36,7 @@ layout(std430, binding = kBvhBindingPrimBoxes) readonly buffer PrimBoxes { float
 layout(std430, binding = kBvhBindingParentIds) coherent buffer ParentIds { uint parentIds[]; };
 layout(std430, binding = kBvhBindingClusters) coherent buffer Clusters { BvhCluster clusters[]; };
 layout(std430, binding = kBvhBindingNodes) coherent buffer Nodes { BvhNode nodes[]; };
+layout(std430, binding = kBvhBindingExactBoxes) writeonly buffer ExactBoxes { float exact[]; };
 layout(std430, binding = kBvhBindingGroups) buffer Groups { BvhGroup groups[]; };
 
 const uint kHalf = kBvhWindow / 2u;
@@ -216,18 +218,18 @@ void mergeRange(uint L, uint R, uint split, bool final, uint e) {
       hi[k] = sHi[w0 + i];
       if (mutual && i < j) {
         uint node = entry.first + (max(first[k], sFirst[w0 + j]) - entry.base) - 1u;
-        BvhNode n;
-        encodeNode(n, lo[k], hi[k], sLo[w0 + j], sHi[w0 + j]);
-        n.child[0] = ref[k];
-        n.child[1] = sRef[w0 + j];
-        n.parent = kBvhNone;
-        nodes[node] = n;
+        nodes[node].child = uint[2](ref[k], sRef[w0 + j]);
+        nodes[node].parent = kBvhNone;
         setParent(ref[k], node);
         setParent(sRef[w0 + j], node | kBvhParentRight);
         ref[k] = node;
         first[k] = min(first[k], sFirst[w0 + j]);
         lo[k] = min(lo[k], sLo[w0 + j]);
         hi[k] = max(hi[k], sHi[w0 + j]);
+        for (uint a = 0u; a < 3u; ++a) {
+          exact[6u * node + a] = lo[k][a];
+          exact[6u * node + 3u + a] = hi[k][a];
+        }
       }
       sKeep[w0 + i] = keep[k] ? 1u : 0u;
     }
@@ -235,12 +237,20 @@ void mergeRange(uint L, uint R, uint split, bool final, uint e) {
     uint kept = 0u;
     uint at[kSlots];
     for (uint k = 0u; k < kSlots; ++k) at[k] = 0u;
-    for (uint m = 0u; m < count; ++m) {
-      uint keepM = sKeep[w0 + m];
-      for (uint k = 0u; k < kSlots; ++k) {
-        if (m < lane + k * width) at[k] += keepM;
+    if (kSlots == 1u && width >= kBvhWindow) {
+      // One slot a lane: the kept clusters' new places are a ballot's prefix counts.
+      uvec4 ballot = subgroupBallot(keep[0]);
+      at[0] = subgroupBallotExclusiveBitCount(ballot);
+      kept = subgroupBallotBitCount(ballot);
+    } else {
+      // Narrower subgroups: every lane counts the flags below each of its slots.
+      for (uint m = 0u; m < count; ++m) {
+        uint keepM = sKeep[w0 + m];
+        for (uint k = 0u; k < kSlots; ++k) {
+          if (m < lane + k * width) at[k] += keepM;
+        }
+        kept += keepM;
       }
-      kept += keepM;
     }
     teamSync();
     for (uint k = 0u; k < kSlots; ++k) {

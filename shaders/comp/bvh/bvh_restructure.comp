@@ -14,14 +14,16 @@
 // src/ref/sah_bvh.h times the root's area): a leaf costs its box's area, an
 // internal node its area plus its children's costs. Boxes of the rewired
 // nodes are unions of the same leaf boxes the build used, so they stay exact.
+// It works on H-PLOC's links and exact boxes, before the quantisation.
 #version 460
 #extension GL_GOOGLE_include_directive : require
 #extension GL_KHR_memory_scope_semantics : require
 #include "bvh_common.glsl"
-#include "bvh_node.glsl"
 
 layout(std430, binding = kBvhBindingBuildEntries) readonly buffer Entries { BvhBuildEntry entries[]; };
 layout(std430, binding = kBvhBindingNodes) coherent buffer Nodes { BvhNode nodes[]; };
+layout(std430, binding = kBvhBindingPrimBoxes) readonly buffer PrimBoxes { float primBoxes[]; };
+layout(std430, binding = kBvhBindingExactBoxes) coherent buffer ExactBoxes { float exact[]; };
 layout(std430, binding = kBvhBindingCounters) coherent buffer Counters { uint counters[]; };
 // Per internal node: its subtree's cost (float bits) and leaf count.
 layout(std430, binding = kBvhBindingNodeStats) coherent buffer NodeStats { uvec2 nodeStats[]; };
@@ -36,9 +38,19 @@ const uint kTreeletInternal = kTreeletLeaves - 1u;
 // A treelet is only rebuilt when that saves more than rounding could fake.
 const float kMinGain = 1e-5;
 
-// A child's box as the node stores it (quantised: it holds the exact box).
+BvhBuildEntry entry;  // the group of the invocation's tree
+
+// A child's exact box: its primitive's, where the box pass put it, or the node's own.
 void slotBox(uint node, uint slot, out vec3 lo, out vec3 hi) {
-  decodeChild(nodes[node], slot, lo, hi);
+  uint ref = nodes[node].child[slot];
+  uint at = (ref & kBvhLeafBit) != 0u ? entry.base + ((ref & ~kBvhLeafBit) - entry.first) : ref;
+  if ((ref & kBvhLeafBit) != 0u) {
+    lo = vec3(primBoxes[6u * at], primBoxes[6u * at + 1u], primBoxes[6u * at + 2u]);
+    hi = vec3(primBoxes[6u * at + 3u], primBoxes[6u * at + 4u], primBoxes[6u * at + 5u]);
+  } else {
+    lo = vec3(exact[6u * at], exact[6u * at + 1u], exact[6u * at + 2u]);
+    hi = vec3(exact[6u * at + 3u], exact[6u * at + 4u], exact[6u * at + 5u]);
+  }
 }
 
 // The treelet under construction: its leaves (subtrees kept whole) and the
@@ -155,12 +167,11 @@ void rewire(uint leaves) {
       nodes[node].child[c] = ref;
       setParent(ref, node | (c == 1u ? kBvhParentRight : 0u));
     }
-    // Unions of boxes that hold their subtrees hold the new ones too.
-    BvhNode n = nodes[node];
-    encodeNode(n, subsetLo[sides[0]], subsetHi[sides[0]], subsetLo[sides[1]], subsetHi[sides[1]]);
-    nodes[node].origin = n.origin;
-    nodes[node].scale = n.scale;
-    nodes[node].quant = n.quant;
+    // A union of the subtrees' exact boxes: exact again.
+    for (uint a = 0u; a < 3u; ++a) {
+      exact[6u * node + a] = subsetLo[s][a];
+      exact[6u * node + 3u + a] = subsetHi[s][a];
+    }
     uint below = 0u;
     for (uint j = 0u; j < leaves; ++j) {
       if ((s & (1u << j)) != 0u) below += refLeaves(leafRef[j]);
@@ -212,7 +223,7 @@ bool arrive(uint node) {
 void main() {
   uint t = threadIndex();
   if (t >= pc.count) return;
-  BvhBuildEntry entry = entries[entryOf(t)];
+  entry = entries[entryOf(t)];
   uint local = t - entry.base;
   if (local + 1u >= entry.count) return;  // a group of n leaves has n - 1 nodes
   uint node = entry.first + local;

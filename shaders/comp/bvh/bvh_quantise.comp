@@ -1,0 +1,56 @@
+// Build step 5 (6 after a restructuring): each node of the groups just built
+// stores its children's boxes quantised within its own box (shared/bvh.h:
+// BvhNode), from the exact boxes of the build: a leaf's primitive box, an
+// inner child's box as H-PLOC (or the restructuring) left it in the exact
+// boxes. A pass of its own, one invocation per node: in H-PLOC each merge's
+// quantisation held up the whole team at its next barrier. The nodes are the
+// same, bit for bit, as a quantisation inside the merge made them: the same
+// exact boxes go in.
+#version 460
+#extension GL_GOOGLE_include_directive : require
+#include "bvh_common.glsl"
+#include "bvh_node.glsl"
+
+layout(std430, binding = kBvhBindingBuildEntries) readonly buffer Entries { BvhBuildEntry entries[]; };
+layout(std430, binding = kBvhBindingPrimBoxes) readonly buffer PrimBoxes { float primBoxes[]; };
+layout(std430, binding = kBvhBindingExactBoxes) readonly buffer ExactBoxes { float exact[]; };
+layout(std430, binding = kBvhBindingNodes) buffer Nodes { BvhNode nodes[]; };
+
+uint entryOf(uint t) {
+  uint lo = 0u, hi = pc.entryCount;
+  while (hi - lo > 1u) {
+    uint mid = (lo + hi) / 2u;
+    if (entries[mid].base <= t) lo = mid;
+    else hi = mid;
+  }
+  return lo;
+}
+
+// A child's exact box: its primitive's, where the box pass put it, or the node's own.
+void childBox(BvhBuildEntry entry, uint ref, out vec3 lo, out vec3 hi) {
+  uint at = (ref & kBvhLeafBit) != 0u ? entry.base + ((ref & ~kBvhLeafBit) - entry.first) : ref;
+  if ((ref & kBvhLeafBit) != 0u) {
+    lo = vec3(primBoxes[6u * at], primBoxes[6u * at + 1u], primBoxes[6u * at + 2u]);
+    hi = vec3(primBoxes[6u * at + 3u], primBoxes[6u * at + 4u], primBoxes[6u * at + 5u]);
+  } else {
+    lo = vec3(exact[6u * at], exact[6u * at + 1u], exact[6u * at + 2u]);
+    hi = vec3(exact[6u * at + 3u], exact[6u * at + 4u], exact[6u * at + 5u]);
+  }
+}
+
+void main() {
+  uint t = threadIndex();
+  if (t >= pc.count) return;
+  BvhBuildEntry entry = entries[entryOf(t)];
+  uint local = t - entry.base;
+  if (local + 1u >= entry.count) return;  // a group of n leaves has n - 1 nodes
+  uint node = entry.first + local;
+  BvhNode n = nodes[node];
+  vec3 lo0, hi0, lo1, hi1;
+  childBox(entry, n.child[0], lo0, hi0);
+  childBox(entry, n.child[1], lo1, hi1);
+  encodeNode(n, lo0, hi0, lo1, hi1);
+  nodes[node].origin = n.origin;
+  nodes[node].scale = n.scale;
+  nodes[node].quant = n.quant;
+}
