@@ -169,8 +169,11 @@ void traverseBlas(uint instance, vec3 origin, vec3 dir, uint skipPrim, float tMi
   for (;;) {
     for (uint k = 0u; k < leafCount; ++k) testTriangle(r, instance, leaves[k], skipPrim, group.first, end, tMin, hit);
     leafCount = 0u;
+    // The budget before anything else: a walk that always goes on to a nearer
+    // child (a corrupted tree's cycle) never pops, and must stop all the same.
+    if (budget == 0u) break;
     if (!haveNode) {
-      if (sp == base || budget == 0u) break;
+      if (sp == base) break;
       ref = stack[--sp];
     }
     haveNode = false;
