@@ -45,6 +45,20 @@ TEST(BenchFrame, OrbitTracesEveryFrameOfAStillScene) {
   EXPECT_EQ(std::stoul(m[1]), 0u) << "a still frame redraws nothing: " << still.output;
 }
 
+// The hit replay is only a fair measure of the non-traversal work if it draws
+// the same picture; bench cost checks that and counts each pixel's work.
+TEST(BenchCost, TheHitReplayDrawsTheTracedPictureAndEachPixelsWorkIsCounted) {
+  CommandRun run = snell("bench cost --size 64x36 --frames 1");
+  ASSERT_EQ(run.exitCode, 0) << run.output;
+  EXPECT_NE(run.output.find("the replay draws the traced picture: yes (0 pixels differ)"), std::string::npos)
+      << run.output;
+  std::smatch m;
+  ASSERT_TRUE(std::regex_search(run.output, m, std::regex("per pixel: ([0-9.]+) segments .* ([0-9.]+) node visits")))
+      << run.output;
+  EXPECT_GE(std::stod(m[1]), 1.0) << "every pixel traces at least its camera ray: " << run.output;
+  EXPECT_GT(std::stod(m[2]), 0.0) << run.output;
+}
+
 TEST(RenderCommand, TheDefaultMethodIsAutoAndSaysWhatItDrewWith) {
   fs::path out = fs::temp_directory_path() / "snell_render_auto.png";
   CommandRun run = snell("render --eye --size 32x24 -o " + shellQuoted(out.string()));

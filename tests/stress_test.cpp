@@ -118,7 +118,7 @@ TEST_F(StressLimits, ACorruptedBvhEndsEveryRayWithinTheVisitBudget) {
 // it (a budget checked only when popping wrapped below zero and let such a
 // walk run on for 2^32 visits: on an H100 the corrupted-tree test above ran
 // past 200 s).
-TEST_F(GpuTest, AWalkThatNeverPopsStillStopsAtTheVisitBudget) {
+TEST_F(StressLimits, AWalkThatNeverPopsStillStopsAtTheVisitBudget) {
   scene::Scene s = stress::sphereScene(16, 1.5f);  // static: no refit repairs the boxes
   scene::Pose pose = scene::evaluate(s, 0.0);
   render::Renderer renderer(context(), s, pose);

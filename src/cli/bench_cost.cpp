@@ -84,13 +84,13 @@ int runCost(const Options& o) {
     v.settings.hitReplay = replay;
     v.driverTrace = driverTrace;
     v.aov = aov;
-    v.readback.enabled = aov;
     return v;
   };
-  auto draw = [&](const render::ViewRequest& v) -> const render::FrameResult& {
+  auto draw = [&](const render::ViewRequest& v, bool readback) -> const render::FrameResult& {
     render::FrameRequest request;
     request.pose = &pose;
     request.views.push_back(v);
+    if (readback) request.readbacks.push_back({.view = 0});
     return renderer.wait(renderer.submit(request));
   };
   auto traceMs = [](const render::FrameResult& r) {
@@ -100,15 +100,13 @@ int runCost(const Options& o) {
   };
 
   // The counters, from one frame's AOVs; then the record the replays read.
-  render::ViewPixels pixels = draw(view(render::HitReplay::Off, false, true)).views.at(0);
+  render::ViewPixels pixels = draw(view(render::HitReplay::Off, false, true), true).views.at(0);
   CostCounters cost = countersOf(pixels.aov);
   CostCounters driverCost;
-  if (driver) driverCost = countersOf(draw(view(render::HitReplay::Off, true, true)).views.at(0).aov);
-  draw(view(render::HitReplay::Record, false, false));
+  if (driver) driverCost = countersOf(draw(view(render::HitReplay::Off, true, true), true).views.at(0).aov);
+  draw(view(render::HitReplay::Record, false, false), false);
   // The ablation is only fair if the replay does the path's whole work: it must draw the same picture.
-  render::ViewRequest replayCheck = view(render::HitReplay::Replay, false, false);
-  replayCheck.readback.enabled = true;
-  std::vector<glm::vec4> replayed = draw(replayCheck).views.at(0).trace;
+  std::vector<glm::vec4> replayed = draw(view(render::HitReplay::Replay, false, false), true).views.at(0).trace;
   size_t differing = 0;
   for (size_t i = 0; i < replayed.size() && i < pixels.trace.size(); ++i) differing += replayed[i] != pixels.trace[i];
 
@@ -119,7 +117,7 @@ int runCost(const Options& o) {
   for (uint32_t round = 0; round <= o.frames; ++round) {
     for (const std::string& row : rows) {
       render::HitReplay replay = row == "trace, hits replayed" ? render::HitReplay::Replay : render::HitReplay::Off;
-      double ms = traceMs(draw(view(replay, row == "driver-rt", false)));
+      double ms = traceMs(draw(view(replay, row == "driver-rt", false), false));
       if (round > 0) times[row].push_back(ms);  // the first round warms up
     }
   }
