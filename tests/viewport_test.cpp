@@ -11,12 +11,15 @@
 #include "render/raster_pass.h"
 #include "render/one_view.h"
 #include "render/renderer.h"
+#include "render/trace_pass.h"
+#include "scene/procedural_eye.h"
 #include "scene/evaluate.h"
 #include "scene/view.h"
 
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cstring>
 #include <functional>
 
@@ -180,6 +183,89 @@ TEST_F(Viewport, ViewportWireframeDrawsEdgesOverTheShadedImage) {
   }
   EXPECT_GT(changed, plain.frame.rgba.size() / 20) << "the wireframe drew almost nothing";
   EXPECT_EQ(stray, 0u) << "the wireframe drew over empty background";
+}
+
+// The masked viewport trace of two characters' eyes (few glass pixels, as
+// the viewport sees them): frames with a given number of lanes a pixel or
+// with the number left to the renderer, their composites and their stats.
+struct LanesFrame {
+  std::vector<glm::vec4> composite;  ///< its glass pixels are the trace's
+  render::FrameStats stats;
+};
+
+class MaskedLanes : public GpuTest {
+ protected:
+  MaskedLanes() : scene_(crowdOfTwo()), pose_(scene::evaluate(scene_, 0.0)) {}
+  static scene::Scene crowdOfTwo() {
+    scene::EyeOptions eye;
+    eye.crowd = 2;
+    return scene::makeEye(eye);
+  }
+  render::ViewRequest view() const {
+    render::ViewRequest v;
+    v.settings = {192, 144, scene::resolveView(scene_, pose_, {}), glm::vec3(scene::kDefaultBackground),
+                  gpu::kDefaultMaxInterfaces};
+    v.output = render::ViewOutput::Composite;
+    v.masked = true;
+    return v;
+  }
+  LanesFrame draw(render::Renderer& renderer) const {
+    render::FrameRequest request;
+    request.pose = &pose_;
+    request.views.push_back(view());
+    request.readbacks.push_back({.view = 0, .trace = false});
+    const render::FrameResult& r = renderer.wait(renderer.submit(request));
+    return {r.views.at(0).composite, r.stats};
+  }
+  LanesFrame drawWith(uint32_t lanes) {
+    render::RendererOptions options;
+    options.traceLanes = lanes;
+    render::Renderer renderer(context(), scene_, pose_, options);
+    return draw(renderer);
+  }
+  scene::Scene scene_;
+  scene::Pose pose_;
+};
+
+// Lanes that share a pixel walk both levels of the trees together and keep the
+// nearest hit of them all: the picture is one lane's, bit for bit.
+TEST_F(MaskedLanes, SeveralLanesAPixelDrawWhatOneLaneDraws) {
+  LanesFrame one = drawWith(1);
+  ASSERT_GT(one.stats.pixelsTraced, 0u);
+  EXPECT_EQ(one.stats.traceLanes, 1u);
+  for (uint32_t lanes : {2u, 4u, 8u}) {
+    if (lanes > context().facts().minSubgroupSize) continue;  // a pixel's lanes share a subgroup
+    LanesFrame several = drawWith(lanes);
+    EXPECT_EQ(several.stats.traceLanes, lanes);
+    EXPECT_EQ(several.stats.pixelsTraced, one.stats.pixelsTraced);
+    EXPECT_TRUE(several.composite == one.composite) << lanes << " lanes a pixel composited another picture";
+  }
+}
+
+// With the lanes left to the renderer, the first frame knows no count and
+// traces a lane a pixel; once it has counted a few glass pixels, and the wider
+// pipeline has compiled beside the frames, each pixel gets several.
+TEST_F(MaskedLanes, AFewGlassPixelsGetSeveralLanesOnceTheyAreCounted) {
+  if (context().facts().minSubgroupSize < 2) GTEST_SKIP() << "subgroups of one lane";
+  render::Renderer renderer(context(), scene_, pose_);
+  LanesFrame first = draw(renderer);
+  EXPECT_EQ(first.stats.traceLanes, 1u);
+  ASSERT_GT(first.stats.pixelsTraced, 0u);
+  ASSERT_LT(first.stats.pixelsTraced * 8, render::TracePass::kMaskedLaneInvocations);
+  LanesFrame later = first;
+  auto until = std::chrono::steady_clock::now() + std::chrono::seconds(120);
+  while (later.stats.traceLanes == 1 && std::chrono::steady_clock::now() < until) {
+    renderer.invalidateViews();
+    later = draw(renderer);
+  }
+  EXPECT_EQ(later.stats.traceLanes, std::min(8u, context().facts().minSubgroupSize));
+  EXPECT_TRUE(later.composite == first.composite);
+}
+
+TEST_F(MaskedLanes, LanesOtherThanAPowerOfTwoUpToEightAreRefused) {
+  render::RendererOptions options;
+  options.traceLanes = 3;
+  EXPECT_THROW(render::Renderer(context(), scene_, pose_, options), std::invalid_argument);
 }
 
 }  // namespace

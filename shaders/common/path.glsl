@@ -3,9 +3,13 @@
 // path of one pixel. The scene binding set comes with common/scene.glsl; the
 // including shader declares the trace's own bindings of trace.h
 // (environment, outImage, aovs, rays) and the push constant `pc`, and
-// defines traceClosest() and firstTriangleOf() after this file.
+// defines traceClosest() and firstTriangleOf() after this file. An includer
+// whose lanes share pixels defines SNELL_PIXEL_WRITER: the one lane that writes.
 #ifndef SNELL_PATH_GLSL
 #define SNELL_PATH_GLSL
+#ifndef SNELL_PIXEL_WRITER
+#define SNELL_PIXEL_WRITER true
+#endif
 
 const float kInf = 1.0 / 0.0;  // folded to +infinity at compile time
 
@@ -384,6 +388,7 @@ void tracePixel(uvec2 pixel) {
   }
   path.colour = colour;
 
+  if (!(SNELL_PIXEL_WRITER)) return;
   imageStore(outImage, ivec2(pixel), vec4(path.colour, 1.0));
   if (traceFlag(kTraceFlagAov)) {
     // The colour less its landing's textured part is the shine (every channel's path, so dispersion too).

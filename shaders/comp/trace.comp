@@ -5,12 +5,16 @@
 // is written out in shaders/shared/trace.h; src/ref is its double twin.
 #version 460
 #extension GL_GOOGLE_include_directive : require
+#extension GL_KHR_shader_subgroup_basic : require
+#extension GL_KHR_shader_subgroup_ballot : require
+#extension GL_KHR_shader_subgroup_shuffle : require
 #include "../shared/bvh.h"
 #include "../shared/trace.h"
 #include "bvh/bvh_node.glsl"
 
 layout(local_size_x = 64) in;  // one kTraceTile x kTraceTile tile of pixels
 layout(push_constant) uniform Push { TracePush pc; };
+layout(constant_id = kTraceSpecLanes) const uint kLanes = 1u;
 
 // Nodes are 40 bytes: read as five 8-byte words rather than ten 4-byte ones.
 layout(std430, binding = kTraceBindingTlasNodes) readonly buffer TlasNodes { uvec2 tlasWords[]; };
@@ -29,7 +33,10 @@ layout(std430, binding = kTraceBindingPixels) readonly buffer Pixels {
 
 // Hit, the surface at a hit, shading and the path of one pixel, shared with
 // the driver's ray tracing pipeline (src/peer/driver_tracer.h); this shader
-// brings traceClosest, its own traversal.
+// brings traceClosest, its own traversal. Lanes that share a pixel all run
+// its path (their hits are the same), and the first of them writes it.
+uint clusterLane() { return gl_SubgroupInvocationID & (kLanes - 1u); }
+#define SNELL_PIXEL_WRITER (clusterLane() == 0u)
 #include "../common/path.glsl"
 
 const uint kStackSize = 64u;
@@ -134,14 +141,25 @@ void enterChildren(BvhNode node, ShearedRay r, float tMax, out float tNear, out 
   farRef = swapOrder ? node.child[0] : node.child[1];
 }
 
+// The ray in an instance's object space.
+ShearedRay objectRay(uint instance, vec3 origin, vec3 dir) {
+  GpuInstance inst = instances[instance];
+  vec3 o = vec3(dot(inst.worldToObject[0], vec4(origin, 1.0)), dot(inst.worldToObject[1], vec4(origin, 1.0)),
+                dot(inst.worldToObject[2], vec4(origin, 1.0)));
+  vec3 d = vec3(dot(inst.worldToObject[0].xyz, dir), dot(inst.worldToObject[1].xyz, dir),
+                dot(inst.worldToObject[2].xyz, dir));
+  return shearRay(o, d);
+}
+
 // A triangle of the instance's tree: the closest hit so far if nearer.
-void testTriangle(ShearedRay r, uint instance, uint tri, uint skipPrim, uint first, uint end, float tMin,
+// tMax: hit.t, or less where another lane of the pixel has a nearer hit.
+void testTriangle(ShearedRay r, uint instance, uint tri, uint skipPrim, uint first, uint end, float tMin, float tMax,
                   inout Hit hit) {
   if (tri == skipPrim || tri < first || tri >= end) return;  // skipPrim: the face this ray leaves
   ++triangleTests;
   vec3 bary;
-  float t = intersectTriangle(r, tri, hit.t, bary);
-  if (t < hit.t && t > tMin) hit = Hit(t, instance, tri, bary);
+  float t = intersectTriangle(r, tri, tMax, bary);
+  if (t < tMax && t > tMin) hit = Hit(t, instance, tri, bary);
 }
 
 // One instance's tree, with the ray in its object space (t is shared: the
@@ -152,22 +170,19 @@ void testTriangle(ShearedRay r, uint instance, uint tri, uint skipPrim, uint fir
 // References outside the group's own nodes and triangles (only a corrupted
 // tree has them) are skipped, so a bad tree costs visits, never a wild read.
 void traverseBlas(uint instance, vec3 origin, vec3 dir, uint skipPrim, float tMin, uint base, inout Hit hit) {
-  GpuInstance inst = instances[instance];
-  BvhGroup group = blasGroups[inst.geometry];
+  BvhGroup group = blasGroups[instances[instance].geometry];
   if (group.root == kBvhNone) return;
   uint end = group.first + group.count;
-  vec3 o = vec3(dot(inst.worldToObject[0], vec4(origin, 1.0)), dot(inst.worldToObject[1], vec4(origin, 1.0)),
-                dot(inst.worldToObject[2], vec4(origin, 1.0)));
-  vec3 d = vec3(dot(inst.worldToObject[0].xyz, dir), dot(inst.worldToObject[1].xyz, dir),
-                dot(inst.worldToObject[2].xyz, dir));
-  ShearedRay r = shearRay(o, d);
+  ShearedRay r = objectRay(instance, origin, dir);
   uint sp = base;
   uint ref = group.root;
   bool haveNode = (ref & kBvhLeafBit) == 0u;
   uint leaves[2] = uint[2](ref & ~kBvhLeafBit, 0u);
   uint leafCount = haveNode ? 0u : 1u;
   for (;;) {
-    for (uint k = 0u; k < leafCount; ++k) testTriangle(r, instance, leaves[k], skipPrim, group.first, end, tMin, hit);
+    for (uint k = 0u; k < leafCount; ++k) {
+      testTriangle(r, instance, leaves[k], skipPrim, group.first, end, tMin, hit.t, hit);
+    }
     leafCount = 0u;
     // The budget before anything else: a walk that always goes on to a nearer
     // child (a corrupted tree's cycle) never pops, and must stop all the same.
@@ -229,6 +244,147 @@ Hit traverse(vec3 origin, vec3 dir, uint skipInstance, uint skipPrim, float tMin
   return hit;
 }
 
+// ------------------------------------------------- several lanes, one ray
+
+// The masked viewport traces few rays, and then a ray's chain of dependent
+// node visits, not the GPU's throughput, sets the time. With kLanes > 1 that
+// many neighbouring lanes of a subgroup trace one ray: each walks its own
+// part of both levels, nearer child first; a lane that runs out of nodes
+// takes the farther child another lane just found, and every step the lanes
+// cull with the nearest hit any of them has. They end together, and all take
+// the nearest hit (the lowest lane's where two are equally near).
+
+uint stackInstance[kStackSize];  // the instance of each stacked bottom-level node; kNoHit: top level
+
+uint clusterBits(bool b) {  // one bit per lane of this ray, its first lane lowest
+  uvec4 ballot = subgroupBallot(b);
+  uint first = gl_SubgroupInvocationID - clusterLane();
+  return (ballot[first >> 5u] >> (first & 31u)) & ((1u << kLanes) - 1u);
+}
+
+float clusterMin(float v) {
+  for (uint m = 1u; m < kLanes; m <<= 1u) v = min(v, subgroupShuffleXor(v, m));
+  return v;
+}
+
+uint clusterSum(uint v) {
+  for (uint m = 1u; m < kLanes; m <<= 1u) v += subgroupShuffleXor(v, m);
+  return v;
+}
+
+uint nthBit(uint mask, uint rank) {  // the lane of `mask` with `rank` set bits below it
+  for (uint i = 0u; i < rank; ++i) mask &= mask - 1u;
+  return findLSB(mask);
+}
+
+Hit traverseLanes(vec3 origin, vec3 dir, uint skipInstance, uint skipPrim, float tMin) {
+  Hit hit = Hit(kInf, kNoHit, kNoHit, vec3(0.0));
+  BvhGroup top = tlasGroups[0];
+  if (top.root == kBvhNone) return hit;
+  uint visitsBefore = visits, boxesBefore = boxTests, trianglesBefore = triangleTests;
+  uint nodeEnd = top.count - 1u;
+  ShearedRay world = shearRay(origin, dir);
+  ShearedRay r = world;
+  uint rInstance = kNoHit;  // the space r is in
+  uint sp = 0u;
+  // The node in hand and its instance (kNoHit: a top-level node); the first lane starts at the root.
+  uint ref = clusterLane() == 0u ? top.root : kNoHit, inst = kNoHit;
+  float nearest = kInf;  // the nearest hit of any lane, as of the last step
+  budget = kTraceMaxVisits;  // each lane's own: a corrupted tree costs kLanes budgets at most
+  for (;;) {
+    if (ref == kNoHit && sp > 0u) {
+      --sp;
+      ref = stack[sp];
+      inst = stackInstance[sp];
+    }
+    uint farRefGiven = kNoHit, farInst = kNoHit;
+    if (ref != kNoHit && budget > 0u) {
+      --budget;
+      ++visits;
+      uint node = ref, nodeInst = inst;
+      ref = kNoHit;
+      float tMax = min(hit.t, nearest);
+      float tNear, tFar;
+      uint nearRef, farRef;
+      if (nodeInst == kNoHit) {
+        if ((node & kBvhLeafBit) != 0u) {  // an instance: on into its tree
+          uint instance = node & ~kBvhLeafBit;
+          uint root = instance < top.count ? blasGroups[instances[instance].geometry].root : kBvhNone;
+          if (root != kBvhNone) ref = root, inst = instance;
+        } else if (node < nodeEnd) {
+          boxTests += 2u;
+          enterChildren(tlasNode(node), world, tMax, tNear, tFar, nearRef, farRef);
+          if (tNear < kInf) ref = nearRef;
+          if (tFar < kInf) farRefGiven = farRef;
+        }
+      } else {
+        BvhGroup group = blasGroups[instances[nodeInst].geometry];
+        uint end = group.first + group.count;
+        uint skip = nodeInst == skipInstance ? skipPrim : kNoHit;
+        if (rInstance != nodeInst) {
+          r = objectRay(nodeInst, origin, dir);
+          rInstance = nodeInst;
+        }
+        uint leaves[2] = uint[2](0u, 0u);
+        uint leafCount = 0u;
+        if ((node & kBvhLeafBit) != 0u) {  // a tree of one triangle
+          leaves[leafCount++] = node & ~kBvhLeafBit;
+        } else if (node >= group.first && node + 1u < end) {
+          boxTests += 2u;
+          enterChildren(blasNode(node), r, tMax, tNear, tFar, nearRef, farRef);
+          if (tNear < kInf) {
+            if ((nearRef & kBvhLeafBit) != 0u) leaves[leafCount++] = nearRef & ~kBvhLeafBit;
+            else ref = nearRef, inst = nodeInst;
+          }
+          if (tFar < kInf) {
+            if ((farRef & kBvhLeafBit) != 0u) leaves[leafCount++] = farRef & ~kBvhLeafBit;
+            else farRefGiven = farRef, farInst = nodeInst;
+          }
+        }
+        for (uint k = 0u; k < leafCount; ++k) {
+          testTriangle(r, nodeInst, leaves[k], skip, group.first, end, tMin, min(hit.t, nearest), hit);
+        }
+      }
+    }
+    if (budget == 0u) ref = farRefGiven = kNoHit, sp = 0u;
+    if (ref == kNoHit && farRefGiven != kNoHit) {  // nothing nearer in hand: the farther child goes on here
+      ref = farRefGiven;
+      inst = farInst;
+      farRefGiven = kNoHit;
+    }
+    // Lanes left with nothing take the farther children the others found, in rank order.
+    bool idle = ref == kNoHit && sp == 0u;
+    uint idleLanes = clusterBits(idle), givingLanes = clusterBits(farRefGiven != kNoHit);
+    uint below = (1u << clusterLane()) - 1u;
+    uint from = clusterLane();
+    if (idle && bitCount(idleLanes & below) < bitCount(givingLanes)) {
+      from = nthBit(givingLanes, bitCount(idleLanes & below));
+    }
+    uint first = gl_SubgroupInvocationID - clusterLane();
+    uint takenRef = subgroupShuffle(farRefGiven, first + from);
+    uint takenInst = subgroupShuffle(farInst, first + from);
+    if (from != clusterLane()) ref = takenRef, inst = takenInst;
+    if (farRefGiven != kNoHit && bitCount(givingLanes & below) >= bitCount(idleLanes) && sp < kStackSize) {
+      stack[sp] = farRefGiven;  // no lane free to take it (a full stack drops it: only a corrupted tree is that deep)
+      stackInstance[sp] = farInst;
+      ++sp;
+    }
+    nearest = clusterMin(hit.t);
+    if (clusterBits(ref != kNoHit || sp > 0u) == 0u) break;
+  }
+  // Every lane takes the nearest hit, from the lowest lane that has it.
+  uint holders = clusterBits(hit.instance != kNoHit && hit.t == nearest);
+  uint from = gl_SubgroupInvocationID - clusterLane() + (holders == 0u ? 0u : findLSB(holders));
+  Hit taken = Hit(subgroupShuffle(hit.t, from), subgroupShuffle(hit.instance, from),
+                  subgroupShuffle(hit.primitive, from),
+                  vec3(subgroupShuffle(hit.bary.x, from), subgroupShuffle(hit.bary.y, from),
+                       subgroupShuffle(hit.bary.z, from)));
+  visits = visitsBefore + clusterSum(visits - visitsBefore);
+  boxTests = boxesBefore + clusterSum(boxTests - boxesBefore);
+  triangleTests = trianglesBefore + clusterSum(triangleTests - trianglesBefore);
+  return holders == 0u ? Hit(kInf, kNoHit, kNoHit, vec3(0.0)) : taken;
+}
+
 // The traversal, or, for the hit-replay ablation (shared/trace.h), its recorded answer.
 Hit traceClosest(vec3 origin, vec3 dir, uint skipInstance, uint skipPrim, float tMin) {
   uint slot = tracedPixel * kTraceReplaySegments + segments;
@@ -237,8 +393,9 @@ Hit traceClosest(vec3 origin, vec3 dir, uint skipInstance, uint skipPrim, float 
     TraceHitRecord h = hitRecords[slot];
     return Hit(h.t, h.instance, h.primitive, h.bary.xyz);
   }
-  Hit hit = traverse(origin, dir, skipInstance, skipPrim, tMin);
-  if (traceFlag(kTraceFlagRecordHits) && recorded) {
+  Hit hit = kLanes > 1u ? traverseLanes(origin, dir, skipInstance, skipPrim, tMin)
+                        : traverse(origin, dir, skipInstance, skipPrim, tMin);
+  if (traceFlag(kTraceFlagRecordHits) && recorded && SNELL_PIXEL_WRITER) {
     hitRecords[slot] = TraceHitRecord(hit.t, hit.instance, hit.primitive, 0.0, vec4(hit.bary, 0.0));
   }
   return hit;
@@ -253,7 +410,11 @@ void main() {
     // The masked trace: one listed pixel per invocation (listed tile by tile,
     // so neighbours stay together). One call of tracePixel, outside any loop:
     // lavapipe's compiler took three times as long over it inside one.
-    uint i = group * gl_WorkGroupSize.x + gl_LocalInvocationID.x;
+    // With several lanes a pixel, they are neighbours in one subgroup (the
+    // pipeline asks for full subgroups): all of a pixel's lanes go on or return.
+    uint i = kLanes == 1u ? group * gl_WorkGroupSize.x + gl_LocalInvocationID.x
+                          : (group * gl_WorkGroupSize.x + gl_SubgroupID * gl_SubgroupSize + gl_SubgroupInvocationID) /
+                                kLanes;
     if (i >= list.count) return;
     pixel = uvec2(listed[i] & 0xffffu, listed[i] >> 16);
   } else {

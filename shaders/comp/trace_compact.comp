@@ -33,7 +33,8 @@ void main() {
     uint base = 0u;
     if (subgroupElect()) {
       base = atomicAdd(list.count, n);
-      uint groups = (base + n + gl_WorkGroupSize.x - 1u) / gl_WorkGroupSize.x;  // the trace's, 64 invocations each
+      // The trace's workgroups, 64 invocations each, lanesPerPixel of them a pixel.
+      uint groups = ((base + n) * pc.lanesPerPixel + gl_WorkGroupSize.x - 1u) / gl_WorkGroupSize.x;
       atomicMax(list.dispatchY, (groups + kTraceListGroupsX - 1u) / kTraceListGroupsX);
     }
     base = subgroupBroadcastFirst(base);

@@ -243,6 +243,9 @@ SNELL_CONST kTraceTile = 8;  // pixels per side of one workgroup's tile
 // the driver-rt peer's, follows the push constant alone).
 SNELL_CONST kTraceSpecOptics = 0;
 SNELL_CONST kTraceSpecFlags = 1;
+// Lanes that trace one listed pixel together (the masked trace only): 1, or
+// a power of two no larger than the subgroup (trace.comp's traverseLanes).
+SNELL_CONST kTraceSpecLanes = 2;
 // Nodes one ray segment may visit before it gives up: a corrupted tree ends here.
 SNELL_CONST kTraceMaxVisits = 1u << 20;
 
@@ -328,7 +331,7 @@ struct TraceCompactPush {
   uint width;           // 4
   uint height;          // 4
   uint tilesX;          // 4: kTraceTile-wide tiles per row
-  uint pad0;            // 4
+  uint lanesPerPixel;   // 4: the trace's invocations per listed pixel (kTraceSpecLanes)
 };
 
 SNELL_GPU_END

@@ -32,6 +32,7 @@ struct Options {
   scene::EyeOptions eye;
   bool viewport = false, noMask = false, noRefraction = false;
   bool orbit = false;  ///< the camera swings about the scene, 30 degrees either way over 240 frames
+  uint32_t traceLanes = 0;  ///< RendererOptions::traceLanes (0: chosen per frame)
   std::string json;
   double soak = 0;  ///< seconds; 0: measure --frames instead
 };
@@ -146,13 +147,15 @@ int runFrame(const Options& o) {
   glm::dvec3 lo, hi;
   scene::approximateBounds(scene, firstPose, lo, hi);
   const glm::dvec3 centre = lo.x <= hi.x ? 0.5 * (lo + hi) : glm::dvec3(0.0);
-  render::Renderer renderer(*context, scene, firstPose);
+  render::RendererOptions rendererOptions;
+  rendererOptions.traceLanes = o.traceLanes;
+  render::Renderer renderer(*context, scene, firstPose, rendererOptions);
   std::map<std::string, std::vector<double>> times;
   std::vector<std::string> order;
   std::vector<double> totals, refractionTotals, walls;
   std::map<std::string, std::vector<double>> counters;
   std::vector<std::string> counterOrder = {"items deformed", "trees refit", "trees rebuilt", "triangles refit",
-                                           "pixels traced", "dispatches", "draws"};
+                                           "pixels traced", "trace lanes", "dispatches", "draws"};
   // One animated frame, rendered and waited for; its wall time in `wall`.
   auto renderFrame = [&](uint64_t f, double& wall) -> const render::FrameResult& {
     double t = std::fmod(double(f) / 24.0, duration);
@@ -204,6 +207,7 @@ int runFrame(const Options& o) {
     counters["trees rebuilt"].push_back(s.treesBuilt);
     counters["triangles refit"].push_back(double(s.trianglesRefit));
     counters["pixels traced"].push_back(double(s.pixelsTraced));
+    counters["trace lanes"].push_back(s.traceLanes);
     counters["dispatches"].push_back(s.dispatches);
     counters["draws"].push_back(s.draws);
   }
@@ -283,6 +287,12 @@ void addBenchFrame(CLI::App& bench, Runner& run) {
   sub->add_flag("--no-refraction", o->noRefraction, "with --viewport: glass left out, nothing traced")
       ->needs(viewport)
       ->excludes(noMask);
+  sub->add_option("--trace-lanes", o->traceLanes,
+                  "with --viewport: lanes that trace each glass pixel, 1, 2, 4 or 8 (default: chosen each frame "
+                  "from the last frame's count)")
+      ->check(CLI::IsMember({1, 2, 4, 8}))
+      ->needs(viewport)
+      ->type_name("N");
   sub->add_option("--json", o->json, "write the results as JSON too")->type_name("FILE");
   sub->add_option("--soak", o->soak,
                   "render for SECONDS instead, and every twentieth of it\n"

@@ -75,6 +75,7 @@ void printStats(long frameNumber, const render::FrameStats& s, const std::vector
               static_cast<unsigned long long>(s.trianglesBuilt), static_cast<unsigned long long>(s.trianglesRefit),
               s.topLevelBuilt, s.topLevelRefit, s.topLevelSkipped, s.traceDispatches,
               static_cast<unsigned long long>(s.pixelsTraced), s.dispatches, s.draws);
+  if (s.traceLanes > 1) std::printf("; lanes a traced pixel %u", s.traceLanes);
   if (s.droppedTriangles) std::printf("; non-finite triangles dropped %u", s.droppedTriangles);
   std::printf("\n  GPU ms:");
   double total = 0;

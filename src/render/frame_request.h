@@ -63,6 +63,7 @@ struct FrameStats {
   uint32_t viewsRendered = 0, viewsSkipped = 0;
   uint32_t traceDispatches = 0;  ///< trace dispatches recorded (a masked one may find no pixel)
   uint64_t pixelsTraced = 0;     ///< counted on the GPU
+  uint32_t traceLanes = 0;       ///< the most lanes a masked trace gave each pixel (0: no masked trace)
   uint32_t dispatches = 0, draws = 0;
   uint32_t droppedTriangles = 0;  ///< non-finite triangles left out of this frame's trees
   bool rebased = false;           ///< the frame origin moved this frame

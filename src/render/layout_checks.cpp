@@ -58,7 +58,7 @@ static_assert(sizeof(TraceAov) == 80 && offsetof(TraceAov, segments) == 64 && of
 static_assert(sizeof(TraceHitRecord) == 32 && offsetof(TraceHitRecord, bary) == 16);
 static_assert(sizeof(GpuRay) == 32 && offsetof(GpuRay, direction) == 16);
 static_assert(sizeof(TracePixelListHeader) == 32 && offsetof(TracePixelListHeader, dispatchX) == kTracePixelListDispatchOffset);
-static_assert(sizeof(TraceCompactPush) == 16 && offsetof(TraceCompactPush, pad0) == 12);
+static_assert(sizeof(TraceCompactPush) == 16 && offsetof(TraceCompactPush, lanesPerPixel) == 12);
 static_assert(sizeof(RasterPush) == 112 && offsetof(RasterPush, offsetStrength) == 96 && offsetof(RasterPush, flags) == 80 && offsetof(RasterPush, lightCount) == 84);
 static_assert(sizeof(RasterPush) == 112 && offsetof(RasterPush, mapWidth) == 100);
 static_assert(sizeof(RefractionTexel) == 48 && offsetof(RefractionTexel, weight) == 16 && offsetof(RefractionTexel, material) == 40);

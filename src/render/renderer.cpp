@@ -40,6 +40,7 @@ struct Renderer::ViewState {
   bool rendered = false;
   uint64_t version = 0;
   ViewRequest last;
+  uint64_t listed = 0;  ///< glass pixels its last collected masked trace listed
 };
 
 // The host's plan for a frame's update of the scene.
@@ -89,6 +90,10 @@ Renderer::Renderer(vk::Context& context, const scene::Scene& scene, const scene:
              options.rebuildBudget),
       targets_(context), bounds_(scene) {
   if (options_.framesInFlight == 0) throw std::invalid_argument("renderer: framesInFlight must be at least 1");
+  if (options_.traceLanes & (options_.traceLanes - 1) || options_.traceLanes > 8) {
+    throw std::invalid_argument("renderer: traceLanes must be 0 (chosen per frame), 1, 2, 4 or 8, not " +
+                                std::to_string(options_.traceLanes));
+  }
   if (options_.keepVertices && options_.host.positions) {
     throw std::invalid_argument("renderer: kept vertices are for scenes without host buffers");
   }
@@ -344,7 +349,13 @@ void Renderer::recordTrace(vk::Commands& commands, size_t index, const ViewReque
   if (plan.driver) {
     stats.pixelsTraced += trace_->recordDriver(commands, in, request.settings, target);
   } else {
-    stats.pixelsTraced += trace_->record(commands, in, request.settings, target, plan.masked);
+    uint32_t lanes = 1;
+    if (plan.masked) {
+      uint64_t listed = options_.independentFrames ? 0 : views_[index].listed;
+      lanes = trace_->maskedLanes(request.settings, request.aov, listed, options_.traceLanes);
+      stats.traceLanes = std::max(stats.traceLanes, lanes);
+    }
+    stats.pixelsTraced += trace_->record(commands, in, request.settings, target, plan.masked, lanes);
   }
   ++stats.traceDispatches;
 }
@@ -390,6 +401,7 @@ void Renderer::collect(Slot& slot) {
     uint32_t count;
     std::memcpy(&count, data + slot.pixelCountsAt + 4 * k, 4);
     result.stats.pixelsTraced += count;
+    if (slot.maskedViews[k] < views_.size()) views_[slot.maskedViews[k]].listed = count;
   }
   result.views.clear();
   for (PendingReadback& r : slot.readbacks) result.views.push_back(targets_.finishReadback(std::move(r)));

@@ -62,6 +62,11 @@ struct RendererOptions {
   /// every tree built afresh. Its pixels then depend on nothing drawn before
   /// it, so a farm's chunks and retries agree bit for bit, for a build a frame.
   bool independentFrames = false;
+  /// Lanes that trace each pixel of a masked trace: 0 chooses from the
+  /// view's last count of glass pixels (TracePass::maskedLanes); 1, 2, 4 or 8
+  /// (no wider than the device's smallest subgroup) fixes it, for benchmarks
+  /// and tests. Independent frames, which know no last count, use one.
+  uint32_t traceLanes = 0;
 };
 
 class Renderer {

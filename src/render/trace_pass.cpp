@@ -4,6 +4,7 @@
 #include "trace.spv.h"
 #include "trace_compact.spv.h"
 
+#include <algorithm>
 #include <cstdio>
 #include <stdexcept>
 #include <string>
@@ -64,20 +65,42 @@ const vk::Buffer& TracePass::hitRecords(const FrameSettings& settings) {
   return hitRecords_;
 }
 
-const vk::ComputeProgram& TracePass::program(uint32_t optics, uint32_t flags) {
-  uint64_t key = uint64_t(optics) << 32 | flags;
+const vk::ComputeProgram& TracePass::program(uint32_t optics, uint32_t flags, uint32_t lanes) {
+  uint64_t key = uint64_t(optics) << 32 | uint64_t(lanes) << 16 | flags;
   auto found = programs_.find(key);
   if (found != programs_.end()) return *found->second;
-  vk::ComputeProgramDesc desc{"trace", kSpvTrace, {{gpu::kTraceSpecOptics, optics}, {gpu::kTraceSpecFlags, flags}},
-                              false};
+  // Several lanes a pixel must share a subgroup: full subgroups keep them together.
+  vk::ComputeProgramDesc desc{"trace",
+                              kSpvTrace,
+                              {{gpu::kTraceSpecOptics, optics},
+                               {gpu::kTraceSpecFlags, flags},
+                               {gpu::kTraceSpecLanes, lanes}},
+                              lanes > 1};
   return *programs_.emplace(key, std::make_unique<vk::ComputeProgram>(context_, desc)).first->second;
 }
 
+uint32_t TracePass::flagsFor(const FrameSettings& settings, bool aov, bool masked) const {
+  return (aov ? gpu::kTraceFlagAov : 0u) | (settings.view.orthographic ? gpu::kTraceFlagOrthographic : 0u) |
+         (settings.rays.empty() ? 0u : gpu::kTraceFlagRayList) | (masked ? gpu::kTraceFlagPixelList : 0u) |
+         replayFlags(settings);
+}
+
 void TracePass::prefetch(const FrameSettings& settings, bool aov, bool masked) {
-  uint32_t flags = (aov ? gpu::kTraceFlagAov : 0u) | (settings.view.orthographic ? gpu::kTraceFlagOrthographic : 0u) |
-                   (settings.rays.empty() ? 0u : gpu::kTraceFlagRayList) | (masked ? gpu::kTraceFlagPixelList : 0u) |
-                   replayFlags(settings);
-  program(opticsFor(settings), flags);
+  program(opticsFor(settings), flagsFor(settings, aov, masked), 1);
+}
+
+uint32_t TracePass::maskedLanes(const FrameSettings& settings, bool aov, uint64_t listedBefore, uint32_t forced) {
+  // Lanes of a pixel share a subgroup; the shader's masks hold at most 32 of them.
+  const uint32_t widest = std::min(8u, context_.facts().minSubgroupSize);
+  uint32_t lanes = 1;
+  if (forced) {
+    while (lanes * 2 <= std::min(forced, widest)) lanes *= 2;
+    return lanes;
+  }
+  if (listedBefore == 0) return 1;
+  while (lanes * 2 <= widest && listedBefore * lanes * 2 <= kMaskedLaneInvocations) lanes *= 2;
+  if (lanes > 1 && !program(opticsFor(settings), flagsFor(settings, aov, true), lanes).ready()) return 1;
+  return lanes;
 }
 
 void TracePass::prepare(const FrameSettings& settings) {
@@ -150,8 +173,9 @@ std::vector<vk::BufferBinding> TracePass::pathBindings(const TraceInputs& in, co
 }
 
 uint64_t TracePass::record(vk::Commands& commands, const TraceInputs& in, const FrameSettings& settings,
-                           const TraceTarget& target, bool masked) {
+                           const TraceTarget& target, bool masked, uint32_t lanes) {
   gpu::TracePush p = push(in, settings, target, masked);
+  if (!masked) lanes = 1;
   uint32_t tilesY = (settings.height + gpu::kTraceTile - 1) / gpu::kTraceTile;
   uint64_t traced = 0;
   if (masked) {
@@ -161,7 +185,7 @@ uint64_t TracePass::record(vk::Commands& commands, const TraceInputs& in, const 
     const gpu::TracePixelListHeader header{0, 0, gpu::kTraceListGroupsX, 0, 1, 0, 0, 0};
     commands.updateBuffer(*target.pixels, &header, sizeof(header));
     commands.transferToCompute();
-    gpu::TraceCompactPush compact{settings.width, settings.height, p.tilesX, 0};
+    gpu::TraceCompactPush compact{settings.width, settings.height, p.tilesX, lanes};
     uint64_t tiles = uint64_t(p.tilesX) * tilesY;
     commands.beginPass(pass::kTraceList);
     compact_->dispatchGroups(commands,
@@ -173,7 +197,7 @@ uint64_t TracePass::record(vk::Commands& commands, const TraceInputs& in, const 
     commands.computeToCompute();
     traced = uint64_t(settings.width) * settings.height;
   }
-  const vk::ComputeProgram& trace = program(p.optics, p.flags);
+  const vk::ComputeProgram& trace = program(p.optics, p.flags, lanes);
   commands.beginPass(pass::kTrace);
   std::vector<vk::BufferBinding> bindings = pathBindings(in, settings, target);
   bindings.insert(bindings.end(), {{gpu::kTraceBindingTlasNodes, &in.tlas->nodes},
@@ -223,7 +247,8 @@ std::vector<std::string> TracePass::statistics() const {
   std::vector<std::string> lines;
   for (const auto& [key, program] : programs_) {
     char variant[64];
-    std::snprintf(variant, sizeof variant, "trace (optics 0x%x, flags 0x%x): ", unsigned(key >> 32), unsigned(key));
+    std::snprintf(variant, sizeof variant, "trace (optics 0x%x, flags 0x%x, %u lanes a pixel): ", unsigned(key >> 32),
+                  unsigned(key & 0xffffu), unsigned(key >> 16 & 0xffffu));
     for (const std::string& line : program->statistics()) lines.push_back(variant + line);
   }
   return lines;

@@ -66,7 +66,18 @@ class TracePass {
   /// marks, compacted first into the pixel list. Returns the pixels traced
   /// when the host knows them (unmasked), else 0 (the GPU counts them).
   uint64_t record(vk::Commands& commands, const TraceInputs& in, const FrameSettings& settings,
-                  const TraceTarget& target, bool masked);
+                  const TraceTarget& target, bool masked, uint32_t lanes = 1);
+  /// The lanes that trace each listed pixel of a masked trace: 1, 2, 4 or 8,
+  /// no wider than the device's smallest subgroup. `forced` (non-zero) wins.
+  /// Otherwise the pixels the view's last masked trace listed choose (0: not
+  /// known, one lane): as many lanes as keep pixels x lanes within
+  /// kMaskedLaneInvocations, since a few rays leave the GPU waiting on each
+  /// ray's chain of node visits. A choice whose pipeline is still compiling
+  /// starts it and draws this frame with one lane.
+  uint32_t maskedLanes(const FrameSettings& settings, bool aov, uint64_t listedBefore, uint32_t forced);
+  /// Measured on an H100 (bench/results/trace-1.5x.md, step 4): 5.4k pixels
+  /// traced fastest with 8 lanes, 43k with 2, 136k with 1.
+  static constexpr uint64_t kMaskedLaneInvocations = 96 * 1024;
 
   /// The driver-rt peer. The renderer says which geometries deformed and
   /// whether instances moved since the driver's structures last saw them;
@@ -95,14 +106,15 @@ class TracePass {
                                               const TraceTarget& target) const;
   const vk::Buffer& environmentBuffer(const scene::Optics& optics) const;
   /// The trace pipeline specialised to `optics` and `flags` (gpu::kTraceFlag*), made on first use.
-  const vk::ComputeProgram& program(uint32_t optics, uint32_t flags);
+  const vk::ComputeProgram& program(uint32_t optics, uint32_t flags, uint32_t lanes);
+  uint32_t flagsFor(const FrameSettings& settings, bool aov, bool masked) const;
   static uint32_t replayFlags(const FrameSettings& settings);
   /// The hit records a record or replay binds (made by the first record), else the placeholder.
   const vk::Buffer& hitRecords(const FrameSettings& settings);
 
   vk::Context& context_;
   uint32_t sceneOptics_ = 0;  ///< gpu::kOptics* bits the scene's materials can show
-  std::map<uint64_t, std::unique_ptr<vk::ComputeProgram>> programs_;  ///< by optics << 32 | flags
+  std::map<uint64_t, std::unique_ptr<vk::ComputeProgram>> programs_;  ///< by optics << 32 | lanes << 16 | flags
   std::unique_ptr<vk::ComputeProgram> compact_;
   vk::Buffer placeholder_;
   vk::Buffer hitRecords_;  ///< the hit-replay ablation's records (FrameSettings::hitReplay)

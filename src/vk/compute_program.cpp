@@ -4,6 +4,7 @@
 #include "vk/error.h"
 
 #include <algorithm>
+#include <chrono>
 
 
 namespace snell::vk {
@@ -50,6 +51,10 @@ ComputeProgram::ComputeProgram(Context& context, const ComputeProgramDesc& desc)
     pipelineInfo.layout = layout;
     return vkCreateComputePipelines(context.device(), context.pipelineCache(), 1, &pipelineInfo, nullptr, pipeline);
   });
+}
+
+bool ComputeProgram::ready() const {
+  return pipeline_ || pending_.wait_for(std::chrono::seconds(0)) == std::future_status::ready;
 }
 
 VkPipeline ComputeProgram::pipeline() const {

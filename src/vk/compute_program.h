@@ -44,6 +44,8 @@ class ComputeProgram {
   /// "name = value" lines the driver reports for this pipeline (registers,
   /// spills, ...); empty unless the context captures pipeline statistics.
   std::vector<std::string> statistics() const;
+  /// Its compile has finished (so a dispatch does not wait for it).
+  bool ready() const;
 
   /// Dispatches enough workgroups to cover `threads` invocations along x.
   template <typename Push>

@@ -154,10 +154,10 @@ DeviceFacts readDeviceFacts(VkPhysicalDevice device, uint32_t index) {
   if (!(props11.subgroupSupportedStages & VK_SHADER_STAGE_COMPUTE_BIT)) {
     facts.unmet.push_back("subgroup operations are not supported in compute shaders");
   }
-  const VkSubgroupFeatureFlags needed =
-      VK_SUBGROUP_FEATURE_BASIC_BIT | VK_SUBGROUP_FEATURE_BALLOT_BIT | VK_SUBGROUP_FEATURE_ARITHMETIC_BIT;
+  const VkSubgroupFeatureFlags needed = VK_SUBGROUP_FEATURE_BASIC_BIT | VK_SUBGROUP_FEATURE_BALLOT_BIT |
+                                        VK_SUBGROUP_FEATURE_ARITHMETIC_BIT | VK_SUBGROUP_FEATURE_SHUFFLE_BIT;
   if ((props11.subgroupSupportedOperations & needed) != needed) {
-    facts.unmet.push_back("subgroup basic, ballot and arithmetic operations are not all supported");
+    facts.unmet.push_back("subgroup basic, ballot, arithmetic and shuffle operations are not all supported");
   }
   if (!features13.subgroupSizeControl) facts.unmet.push_back("feature subgroupSizeControl is missing");
   if (!features13.computeFullSubgroups) facts.unmet.push_back("feature computeFullSubgroups is missing");

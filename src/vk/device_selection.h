@@ -39,7 +39,7 @@ struct DeviceFacts {
 };
 
 /// Reads the facts of one physical device and checks snell's requirements:
-/// Vulkan 1.3, a compute queue, subgroup basic/ballot/arithmetic in compute
+/// Vulkan 1.3, a compute queue, subgroup basic/ballot/arithmetic/shuffle in compute
 /// shaders, subgroupSizeControl, computeFullSubgroups and maintenance4.
 DeviceFacts readDeviceFacts(VkPhysicalDevice device, uint32_t index);
 
