@@ -483,4 +483,8 @@ uint64_t Renderer::memoryBytes() const {
 
 std::vector<std::string> Renderer::pipelineStatistics() const { return trace_->statistics(); }
 
+void Renderer::finishCompiles() const {
+  if (trace_) trace_->finishCompiles();
+}
+
 }  // namespace snell::render

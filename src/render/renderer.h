@@ -128,6 +128,10 @@ class Renderer {
   uint64_t memoryBytes() const;
   /// The driver's statistics of the trace pipelines made so far (vk::ContextDesc::pipelineStatistics).
   std::vector<std::string> pipelineStatistics() const;
+  /// Waits for the trace pipelines still compiling beside the frames (a
+  /// wider masked trace's among them), so that the next frames draw as a
+  /// long session's do: for benchmarks, after their warm-up.
+  void finishCompiles() const;
   /// Bytes of tree memory (both levels) per bottom-level triangle, build scratch apart.
   double treeBytesPerTriangle() const { return trees_.treeBytesPerTriangle(); }
 

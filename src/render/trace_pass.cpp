@@ -254,6 +254,10 @@ std::vector<std::string> TracePass::statistics() const {
   return lines;
 }
 
+void TracePass::finishCompiles() const {
+  for (const auto& entry : programs_) entry.second->finishCompile();
+}
+
 uint64_t TracePass::bytes() const { return driver_ ? driver_->bytes() : 0; }
 
 }  // namespace snell::render

@@ -94,6 +94,8 @@ class TracePass {
   /// The driver's statistics of each trace pipeline made so far (registers,
   /// spills, ...), one line each, where the context captures them.
   std::vector<std::string> statistics() const;
+  /// Waits for every trace pipeline made so far, lane choices' included.
+  void finishCompiles() const;
   /// GPU memory of the driver's structures (the environments are the views' own).
   uint64_t bytes() const;
   /// A small buffer bound where a view has no AOV, ray list or pixel list.

@@ -46,6 +46,8 @@ class ComputeProgram {
   std::vector<std::string> statistics() const;
   /// Its compile has finished (so a dispatch does not wait for it).
   bool ready() const;
+  /// Waits for its compile (and throws what the compile threw).
+  void finishCompile() const { pipeline(); }
 
   /// Dispatches enough workgroups to cover `threads` invocations along x.
   template <typename Push>
