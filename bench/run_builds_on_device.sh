@@ -15,15 +15,7 @@
 # A build name may carry a leaf size, for bench/experiments/wide-bvh8.patch:
 # wide@1 runs .carry/snell-wide with SNELL_BVH_LEAF_MAX=1.
 set -uo pipefail
-for f in .gl/*.deb; do dpkg -x "$f" /; done
-ldconfig
-icd=/usr/local/nvidia/share/vulkan/icd.d/nvidia_icd.json
-[[ -f $icd ]] && export VK_DRIVER_FILES=$icd
-export LD_LIBRARY_PATH=$PWD/.carry/lib:$PWD/.carry VK_ADD_LAYER_PATH=$PWD/.carry/layer XDG_RUNTIME_DIR=/tmp
-export SNELL_ASSETS_DIR=/tmp/assets SNELL_GOLDEN_DIR=$PWD/golden
-mkdir -p "$SNELL_ASSETS_DIR/gltf" "$SNELL_ASSETS_DIR/gltf-invalid"
-OUT=${OUT:-/tmp/out}
-mkdir -p "$OUT"
+source "$(dirname "$0")/device_env.sh"
 nvidia-smi --query-gpu=name,driver_version,clocks.sm,clocks.mem --format=csv,noheader
 read -r -a builds <<<"${BUILDS:-base step1 wide}"
 step=${1:-trace}

@@ -34,15 +34,7 @@
 # build and shot1 steps (default .carry/snell), to measure two builds in one lease.
 # Results land in $OUT.
 set -uo pipefail
-for f in .gl/*.deb; do dpkg -x "$f" /; done
-ldconfig
-icd=/usr/local/nvidia/share/vulkan/icd.d/nvidia_icd.json
-[[ -f $icd ]] && export VK_DRIVER_FILES=$icd
-export LD_LIBRARY_PATH=$PWD/.carry/lib:$PWD/.carry VK_ADD_LAYER_PATH=$PWD/.carry/layer XDG_RUNTIME_DIR=/tmp
-export SNELL_ASSETS_DIR=$PWD/.assets SNELL_GOLDEN_DIR=$PWD/golden
-mkdir -p "$SNELL_ASSETS_DIR/gltf" "$SNELL_ASSETS_DIR/gltf-invalid"  # the asset-driven tests instantiate over what is carried
-OUT=${OUT:-/tmp/out}
-mkdir -p "$OUT"
+source "$(dirname "$0")/device_env.sh"
 nvidia-smi --query-gpu=name,driver_version,clocks.sm,clocks.mem --format=csv
 step=${1:-all}
 snell=${SNELL_BIN:-.carry/snell}

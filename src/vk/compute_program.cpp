@@ -4,7 +4,6 @@
 #include "vk/error.h"
 
 #include <algorithm>
-#include <chrono>
 
 
 namespace snell::vk {
@@ -35,8 +34,8 @@ ComputeProgram::ComputeProgram(Context& context, const ComputeProgramDesc& desc)
       desc.requireFullSubgroups ? VK_PIPELINE_SHADER_STAGE_CREATE_REQUIRE_FULL_SUBGROUPS_BIT : 0;
   VkPipelineCreateFlags pipelineFlags = caps.pipelineStatistics ? VK_PIPELINE_CREATE_CAPTURE_STATISTICS_BIT_KHR : 0;
   // The compile runs on its own thread; what it reads is copied into it or lives as long as this program.
-  pending_ = context.compileAsync(name_, [&context, module = layout_.module(0), layout = layout_.pipelineLayout(), entries,
-                                         values, stageFlags, pipelineFlags](VkPipeline* pipeline) {
+  pipeline_.emplace(context, name_, [&context, module = layout_.module(0), layout = layout_.pipelineLayout(), entries,
+                                      values, stageFlags, pipelineFlags](VkPipeline* pipeline) {
     VkSpecializationInfo specInfo{static_cast<uint32_t>(entries.size()), entries.data(),
                                   values.size() * sizeof(uint32_t), values.data()};
     VkPipelineShaderStageCreateInfo stage{VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO};
@@ -53,25 +52,8 @@ ComputeProgram::ComputeProgram(Context& context, const ComputeProgramDesc& desc)
   });
 }
 
-bool ComputeProgram::ready() const {
-  return pipeline_ || pending_.wait_for(std::chrono::seconds(0)) == std::future_status::ready;
-}
-
-VkPipeline ComputeProgram::pipeline() const {
-  if (!pipeline_) pipeline_ = pending_.get();
-  return pipeline_;
-}
-
-ComputeProgram::~ComputeProgram() {
-  VkPipeline handle = VK_NULL_HANDLE;
-  try {
-    handle = pipeline();  // a compile still running finishes first: it reads the module and layout
-  } catch (...) {
-    // The compile failed: its first use reported it, or nothing used it; there is no pipeline to destroy.
-  }
-  // The pipeline goes first; the layout member retires the module and layouts after it.
-  if (handle) context_->retire([device = context_->device(), handle] { vkDestroyPipeline(device, handle, nullptr); });
-}
+// The pipeline goes first (a compile still running finishes); the layout member retires the module and layouts after it.
+ComputeProgram::~ComputeProgram() = default;
 
 std::vector<std::string> ComputeProgram::statistics() const {
   std::vector<std::string> lines;
@@ -83,12 +65,12 @@ std::vector<std::string> ComputeProgram::statistics() const {
       vkGetDeviceProcAddr(device, "vkGetPipelineExecutableStatisticsKHR"));
   if (!getProperties || !getStatistics) return lines;
   VkPipelineInfoKHR pipelineInfo{VK_STRUCTURE_TYPE_PIPELINE_INFO_KHR};
-  pipelineInfo.pipeline = pipeline();
+  pipelineInfo.pipeline = pipeline_->get();
   uint32_t executables = 0;
   VK_CHECK(getProperties(device, &pipelineInfo, &executables, nullptr));
   for (uint32_t e = 0; e < executables; ++e) {
     VkPipelineExecutableInfoKHR executable{VK_STRUCTURE_TYPE_PIPELINE_EXECUTABLE_INFO_KHR};
-    executable.pipeline = pipeline();
+    executable.pipeline = pipeline_->get();
     executable.executableIndex = e;
     uint32_t count = 0;
     VK_CHECK(getStatistics(device, &executable, &count, nullptr));
@@ -114,7 +96,7 @@ void ComputeProgram::record(Commands& commands, std::span<const BufferBinding> b
                             VkDeviceSize indirectOffset) const {
   layout_.checkPush(push, pushBytes);
   if (groups == 0 && !indirect) return;
-  layout_.bind(commands, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline(), buffers);
+  layout_.bind(commands, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline_->get(), buffers);
   layout_.push(commands, push);
   VkCommandBuffer cmd = commands.handle();
   commands.noteDispatch();

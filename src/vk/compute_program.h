@@ -3,6 +3,7 @@
 // sites give thread counts and buffers, never group counts or binding tables.
 #pragma once
 
+#include "vk/async_pipeline.h"
 #include "vk/buffer.h"
 #include "vk/commands.h"
 #include "vk/context.h"
@@ -13,9 +14,9 @@
 #include <vulkan/vulkan.h>
 
 #include <array>
-#include <future>
 #include <cstdint>
 #include <initializer_list>
+#include <optional>
 #include <span>
 #include <string>
 #include <vector>
@@ -45,9 +46,9 @@ class ComputeProgram {
   /// spills, ...); empty unless the context captures pipeline statistics.
   std::vector<std::string> statistics() const;
   /// Its compile has finished (so a dispatch does not wait for it).
-  bool ready() const;
+  bool ready() const { return pipeline_->ready(); }
   /// Waits for its compile (and throws what the compile threw).
-  void finishCompile() const { pipeline(); }
+  void finishCompile() const { pipeline_->get(); }
 
   /// Dispatches enough workgroups to cover `threads` invocations along x.
   template <typename Push>
@@ -89,10 +90,7 @@ class ComputeProgram {
   std::string name_;
   ShaderReflection reflection_;
   ProgramLayout layout_;
-  /// Compiled on a thread of its own (Context::compileAsync); the first use waits for it.
-  VkPipeline pipeline() const;
-  std::shared_future<VkPipeline> pending_;
-  mutable VkPipeline pipeline_ = VK_NULL_HANDLE;
+  std::optional<AsyncPipeline> pipeline_;  ///< after layout_: it goes first, then the modules it reads
 };
 
 }  // namespace snell::vk

@@ -46,8 +46,8 @@ GraphicsProgram::GraphicsProgram(Context& context, const GraphicsProgramDesc& de
   }
 
   // The compile runs on its own thread (Context::compileAsync): the state is built there from copies.
-  pending_ = context.compileAsync(name_, [&context, desc, vertex = layout_.module(0), fragment = layout_.module(1),
-                                         layout = layout_.pipelineLayout()](VkPipeline* pipeline) {
+  pipeline_.emplace(context, name_, [&context, desc, vertex = layout_.module(0), fragment = layout_.module(1),
+                                      layout = layout_.pipelineLayout()](VkPipeline* pipeline) {
     VkPipelineShaderStageCreateInfo shaderStages[2] = {
         {VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO, nullptr, 0, VK_SHADER_STAGE_VERTEX_BIT, vertex, "main"},
         {VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO, nullptr, 0, VK_SHADER_STAGE_FRAGMENT_BIT, fragment, "main"}};
@@ -112,24 +112,11 @@ GraphicsProgram::GraphicsProgram(Context& context, const GraphicsProgramDesc& de
   });
 }
 
-VkPipeline GraphicsProgram::pipeline() const {
-  if (!pipeline_) pipeline_ = pending_.get();
-  return pipeline_;
-}
-
-GraphicsProgram::~GraphicsProgram() {
-  VkPipeline handle = VK_NULL_HANDLE;
-  try {
-    handle = pipeline();  // a compile still running finishes first: it reads the modules and layout
-  } catch (...) {
-    // The compile failed: its first use reported it; there is no pipeline to destroy.
-  }
-  // The pipeline goes first; the layout member retires the modules and layouts after it.
-  if (handle) context_->retire([device = context_->device(), handle] { vkDestroyPipeline(device, handle, nullptr); });
-}
+// The pipeline goes first (a compile still running finishes); the layout member retires the modules and layouts after it.
+GraphicsProgram::~GraphicsProgram() = default;
 
 void GraphicsProgram::bind(Commands& commands, std::span<const BufferBinding> resources, VkRect2D area) const {
-  layout_.bind(commands, VK_PIPELINE_BIND_POINT_GRAPHICS, pipeline(), resources);
+  layout_.bind(commands, VK_PIPELINE_BIND_POINT_GRAPHICS, pipeline_->get(), resources);
   VkViewport viewport{float(area.offset.x), float(area.offset.y), float(area.extent.width), float(area.extent.height),
                       0.0f, 1.0f};
   vkCmdSetViewport(commands.handle(), 0, 1, &viewport);

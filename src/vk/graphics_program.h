@@ -4,6 +4,7 @@
 // has no vertex input state at all.
 #pragma once
 
+#include "vk/async_pipeline.h"
 #include "vk/buffer.h"
 #include "vk/commands.h"
 #include "vk/context.h"
@@ -14,6 +15,7 @@
 #include <vulkan/vulkan.h>
 
 #include <cstdint>
+#include <optional>
 #include <span>
 #include <string>
 
@@ -63,10 +65,7 @@ class GraphicsProgram {
   Context* context_;
   std::string name_;
   ProgramLayout layout_;
-  /// Compiled on a thread of its own (Context::compileAsync); the first use waits for it.
-  VkPipeline pipeline() const;
-  std::shared_future<VkPipeline> pending_;
-  mutable VkPipeline pipeline_ = VK_NULL_HANDLE;
+  std::optional<AsyncPipeline> pipeline_;  ///< after layout_: it goes first, then the modules it reads
 };
 
 /// A rendering scope (dynamic rendering) on one colour image and an optional

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import os
 import subprocess
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -16,15 +17,8 @@ import pytest
 import snell
 from support import GltfWriter, checker, quad, uv_sphere
 
-VALIDATION = os.environ.get("SNELL_VALIDATION") == "1"
-
-
-@pytest.fixture(scope="session")
-def device():
-    """A device with validation on where CI asks for it; a validation message fails the test."""
-    with snell.Device(validation=VALIDATION) as d:
-        yield d
-        assert d.validation_messages == 0, "the Khronos validation layer reported messages (see standard error)"
+sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
+from snell_session import VALIDATION, device  # noqa: E402,F401 (device: a fixture, found by its name)
 
 
 @pytest.fixture(scope="session")
