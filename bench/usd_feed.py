@@ -62,7 +62,7 @@ def main() -> int:
         if args.stage:
             stage_path, about = Path(args.stage), {"stage": args.stage}
         else:
-            sys.path.insert(0, str(HERE.parent / "tests" / "usd"))
+            sys.path[:0] = [str(HERE.parent / "tests" / "usd"), str(HERE.parent / "tests")]
             from eye_stage import eye_arrays, write_eye_stage
 
             written = write_eye_stage(Path(folder), eye_arrays(args.rings, args.segments))

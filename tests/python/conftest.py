@@ -15,9 +15,10 @@ import numpy as np
 import pytest
 
 import snell
-from support import GltfWriter, checker, quad, uv_sphere
+from support import checker, primitive, quad, uv_sphere
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
+from gltf_writer import GltfWriter  # noqa: E402 (tests/, shared with tests/usd)
 from snell_session import VALIDATION, device  # noqa: E402,F401 (device: a fixture, found by its name)
 
 
@@ -63,10 +64,10 @@ def lens_gltf(tmp_path_factory) -> Path:
     g = GltfWriter()
     wall = g.material(texture=checker())
     glass = g.material(base_color=(0.95, 1.0, 0.97, 1.0), transmission=1.0, ior=1.45)
-    g.node(mesh=g.mesh(*WALL, material=wall))
-    sphere = g.node(mesh=g.mesh(*SPHERE[:3], material=glass, morph=squash_target(), weights=[0.0]))
-    g.weights_animation(sphere, [0.0, 1.0], [0.0, 1.0])
-    g.camera(YFOV, (0.0, 0.0, CAMERA_Z))
+    g.node(mesh=g.mesh([primitive(*WALL, material=wall)]))
+    sphere = g.node(mesh=g.mesh([primitive(*SPHERE[:3], material=glass, targets=[squash_target()])], weights=[0.0]))
+    g.animate(sphere, "weights", [0.0, 1.0], [0.0, 1.0])
+    g.camera(YFOV, None, (0.0, 0.0, CAMERA_Z), znear=0.01)
     return g.write(tmp_path_factory.mktemp("lens") / "lens.gltf")
 
 

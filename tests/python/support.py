@@ -1,9 +1,8 @@
-"""Helpers for the module's tests: scenes written as glTF, PNG files read back, sRGB."""
+"""Helpers for the module's tests: meshes and textures of test scenes (tests/gltf_writer.py writes them as glTF),
+PNG files read back, sRGB."""
 
 from __future__ import annotations
 
-import base64
-import json
 import struct
 import zlib
 from pathlib import Path
@@ -129,134 +128,6 @@ def checker(size: int = 64, squares: int = 8) -> np.ndarray:
     return rgba
 
 
-class GltfWriter:
-    """A minimal glTF 2.0 writer (one .gltf with its buffer inline) for test scenes."""
-
-    def __init__(self) -> None:
-        self.doc: dict = {"asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": []}], "nodes": [],
-                          "meshes": [], "accessors": [], "bufferViews": [], "materials": []}
-        self.blob = bytearray()
-
-    def _accessor(self, array: np.ndarray, kind: str, minmax: bool = False) -> int:
-        component = {np.dtype(np.float32): 5126, np.dtype(np.uint32): 5125}[array.dtype]
-        while len(self.blob) % 4:
-            self.blob.append(0)
-        view = {"buffer": 0, "byteOffset": len(self.blob), "byteLength": array.nbytes}
-        self.blob += np.ascontiguousarray(array).tobytes()
-        self.doc["bufferViews"].append(view)
-        accessor = {"bufferView": len(self.doc["bufferViews"]) - 1, "componentType": component,
-                    "count": int(array.shape[0]) if kind != "SCALAR" or array.ndim == 1 else int(array.size),
-                    "type": kind}
-        if minmax:
-            accessor["min"] = array.min(axis=0).tolist()
-            accessor["max"] = array.max(axis=0).tolist()
-        self.doc["accessors"].append(accessor)
-        return len(self.doc["accessors"]) - 1
-
-    def texture(self, rgba: np.ndarray, wrap: str = "repeat", nearest: bool = False) -> int:
-        """An embedded PNG texture with its sampler; returns the texture's index."""
-        png = _png_bytes(rgba)
-        self.doc.setdefault("images", []).append({"uri": "data:image/png;base64," + base64.b64encode(png).decode()})
-        codes = {"repeat": 10497, "clamp": 33071, "mirror": 33648}
-        sampler = {"wrapS": codes[wrap], "wrapT": codes[wrap]}
-        if nearest:
-            sampler["magFilter"] = sampler["minFilter"] = 9728
-        self.doc.setdefault("samplers", []).append(sampler)
-        self.doc.setdefault("textures", []).append({"source": len(self.doc["images"]) - 1,
-                                                    "sampler": len(self.doc["samplers"]) - 1})
-        return len(self.doc["textures"]) - 1
-
-    def _uses(self, extension: str) -> None:
-        used = self.doc.setdefault("extensionsUsed", [])
-        if extension not in used:
-            used.append(extension)
-
-    def texture_info(self, index: int, transform: dict | None = None, **fields) -> dict:
-        """A material's reference to texture `index`, with a KHR_texture_transform."""
-        info = {"index": index, **fields}
-        if transform:
-            info["extensions"] = {"KHR_texture_transform": transform}
-            self._uses("KHR_texture_transform")
-        return info
-
-    def material(self, base_color=(1, 1, 1, 1), transmission=0.0, ior=1.5, texture: np.ndarray | None = None,
-                 base_info: dict | None = None, emissive=(0.0, 0.0, 0.0), emissive_info: dict | None = None,
-                 normal_info: dict | None = None, alpha_mode: str | None = None,
-                 alpha_cutoff: float | None = None) -> int:
-        """A material; *_info are texture_info() references (texture: the base colour's, repeating)."""
-        m: dict = {"pbrMetallicRoughness": {"baseColorFactor": list(base_color), "metallicFactor": 0.0}}
-        if transmission > 0:
-            m["extensions"] = {"KHR_materials_transmission": {"transmissionFactor": transmission},
-                               "KHR_materials_ior": {"ior": ior}}
-            self._uses("KHR_materials_transmission")
-            self._uses("KHR_materials_ior")
-        if texture is not None:
-            base_info = {"index": self.texture(texture)}
-        if base_info is not None:
-            m["pbrMetallicRoughness"]["baseColorTexture"] = base_info
-        if any(emissive):
-            m["emissiveFactor"] = list(emissive)
-        if emissive_info is not None:
-            m["emissiveTexture"] = emissive_info
-        if normal_info is not None:
-            m["normalTexture"] = normal_info
-        if alpha_mode is not None:
-            m["alphaMode"] = alpha_mode
-        if alpha_cutoff is not None:
-            m["alphaCutoff"] = alpha_cutoff
-        self.doc["materials"].append(m)
-        return len(self.doc["materials"]) - 1
-
-    def mesh(self, positions, normals, indices, uvs=None, material=None, morph=None, weights=None) -> int:
-        """A mesh of one primitive; morph: (position deltas, normal deltas) of one target."""
-        attributes = {"POSITION": self._accessor(positions, "VEC3", True), "NORMAL": self._accessor(normals, "VEC3")}
-        if uvs is not None:
-            attributes["TEXCOORD_0"] = self._accessor(uvs, "VEC2")
-        primitive: dict = {"attributes": attributes, "indices": self._accessor(indices.reshape(-1), "SCALAR")}
-        if material is not None:
-            primitive["material"] = material
-        mesh: dict = {"primitives": [primitive]}
-        if morph is not None:
-            dp, dn = morph
-            primitive["targets"] = [{"POSITION": self._accessor(dp, "VEC3", True),
-                                     "NORMAL": self._accessor(dn, "VEC3")}]
-            mesh["weights"] = list(weights or [0.0])
-        self.doc["meshes"].append(mesh)
-        return len(self.doc["meshes"]) - 1
-
-    def node(self, **fields) -> int:
-        self.doc["nodes"].append(fields)
-        self.doc["scenes"][0]["nodes"].append(len(self.doc["nodes"]) - 1)
-        return len(self.doc["nodes"]) - 1
-
-    def camera(self, yfov: float, translation, aspect: float | None = None) -> int:
-        perspective = {"yfov": yfov, "znear": 0.01}
-        if aspect:
-            perspective["aspectRatio"] = aspect
-        self.doc.setdefault("cameras", []).append({"type": "perspective", "perspective": perspective})
-        return self.node(camera=len(self.doc["cameras"]) - 1, translation=list(translation))
-
-    def weights_animation(self, node: int, times, weights) -> None:
-        """Linear keys of a one-target mesh's weight."""
-        t = self._accessor(np.array(times, np.float32), "SCALAR", True)
-        w = self._accessor(np.array(weights, np.float32), "SCALAR")
-        self.doc["animations"] = [{"samplers": [{"input": t, "output": w, "interpolation": "LINEAR"}],
-                                   "channels": [{"sampler": 0, "target": {"node": node, "path": "weights"}}]}]
-
-    def write(self, path: Path) -> Path:
-        self.doc["buffers"] = [{"byteLength": len(self.blob),
-                                "uri": "data:application/octet-stream;base64," + base64.b64encode(self.blob).decode()}]
-        Path(path).write_text(json.dumps(self.doc))
-        return Path(path)
-
-
-def _png_bytes(rgba: np.ndarray) -> bytes:
-    """An RGBA8 PNG of the array (no filtering), for textures inside test glTF files."""
-    height, width, _ = rgba.shape
-    raw = b"".join(b"\x00" + rgba[y].tobytes() for y in range(height))
-
-    def chunk(kind: bytes, body: bytes) -> bytes:
-        return struct.pack(">I", len(body)) + kind + body + struct.pack(">I", zlib.crc32(kind + body) & 0xFFFFFFFF)
-
-    header = struct.pack(">IIBBBBB", width, height, 8, 6, 0, 0, 0)
-    return b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", header) + chunk(b"IDAT", zlib.compress(raw)) + chunk(b"IEND", b"")
+def primitive(positions, normals, indices, uvs=None, **fields) -> dict:
+    """A mesh primitive for gltf_writer.GltfWriter.mesh from the arrays uv_sphere and quad return."""
+    return {"positions": positions, "normals": normals, "indices": indices, "uvs": uvs, **fields}

@@ -7,7 +7,8 @@ import pytest
 
 import snell
 from conftest import CAMERA_Z, YFOV
-from support import GltfWriter, checker, holes, quad, ripples, srgb8, uv_sphere
+from gltf_writer import GltfWriter
+from support import checker, holes, primitive, quad, ripples, srgb8, uv_sphere
 
 WIDTH, HEIGHT = 160, 120
 SPHERE = uv_sphere(0.5, 24, 32)
@@ -27,18 +28,19 @@ def every_feature_gltf(path) -> None:
     normal-mapped glass sphere and a blended card, as glTF."""
     g = GltfWriter()
     wall = g.material(base_color=(0, 0, 0, 1), emissive=(1, 1, 1),
-                      emissive_info=g.texture_info(g.texture(checker(), wrap="clamp", nearest=True), WALL_TRANSFORM))
+                      emissive_info=g.texture_info(g.texture(checker(), "clamp", nearest=True),
+                                                   transform=WALL_TRANSFORM))
     card = g.material(base_color=(0.9, 0.5, 0.3, 1), base_info=g.texture_info(g.texture(holes(), nearest=True)),
                       normal_info=g.texture_info(g.texture(ripples(64, 1.0)), scale=0.8), alpha_mode="MASK",
                       alpha_cutoff=0.4)
     glass = g.material(base_color=(0.95, 1.0, 0.97, 1.0), transmission=1.0, ior=1.45,
-                       normal_info=g.texture_info(g.texture(ripples(64, 0.5), wrap="mirror")))
+                       normal_info=g.texture_info(g.texture(ripples(64, 0.5), "mirror")))
     blended = g.material(base_color=(0.2, 0.8, 0.3, 0.35), alpha_mode="BLEND")
-    g.node(mesh=g.mesh(*WALL, material=wall))
-    g.node(mesh=g.mesh(*CARD, material=card), translation=list(PLACES["card"]))
-    g.node(mesh=g.mesh(*SPHERE, material=glass), translation=list(PLACES["sphere"]))
-    g.node(mesh=g.mesh(*SMALL_CARD, material=blended), translation=list(PLACES["small card"]))
-    g.camera(YFOV, (0.0, 0.0, CAMERA_Z))
+    g.node(mesh=g.mesh([primitive(*WALL, material=wall)]))
+    g.node(mesh=g.mesh([primitive(*CARD, material=card)]), translation=list(PLACES["card"]))
+    g.node(mesh=g.mesh([primitive(*SPHERE, material=glass)]), translation=list(PLACES["sphere"]))
+    g.node(mesh=g.mesh([primitive(*SMALL_CARD, material=blended)]), translation=list(PLACES["small card"]))
+    g.camera(YFOV, None, (0.0, 0.0, CAMERA_Z), znear=0.01)
     g.write(path)
 
 

@@ -15,9 +15,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from eye_stage import EyeStage, write_eye_stage
-
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
+from eye_stage import EyeStage, write_eye_stage  # noqa: E402 (its glTF twin's writer is in tests/)
 from snell_session import VALIDATION, device  # noqa: E402,F401 (device: a fixture, found by its name)
 
 

@@ -432,7 +432,7 @@ def _write_gltf(path: Path, a: EyeArrays, texture: Path) -> Path:
     g = GltfWriter()
     sclera = g.material(base_color=(*SCLERA, 1.0), roughness=0.5)
     cornea = g.material(base_color=(1, 1, 1, 1), roughness=CORNEA_ROUGHNESS, transmission=1.0, ior=CORNEA_IOR)
-    iris = g.material(roughness=IRIS_ROUGHNESS, texture_uri=texture.name)
+    iris = g.material(roughness=IRIS_ROUGHNESS, texture=texture.name)
     rig = g.node(name="Rig", translation=[0.0, 0.05, 0.0])
     head = g.node(name="Head", parent=rig)
     eye_nodes = {side: g.node(name=f"Eye{side}", parent=head, translation=[x, 0.0, 0.0])

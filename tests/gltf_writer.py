@@ -1,16 +1,20 @@
-"""A small glTF 2.0 writer for test scenes: one .gltf (JSON) and one binary buffer (.bin) beside it.
+"""A small glTF 2.0 writer for the test scenes of tests/python and tests/usd.
 
-It writes what the USD tests compare against: meshes of several primitives
-with skins, morph targets and two UV sets, node animations, metallic-roughness
-materials with KHR_materials_transmission and KHR_materials_ior, base colour,
-emissive and normal textures by URI (each with its sampler's wraps, its UV set
-and a KHR_texture_transform), alphaMode and alphaCutoff, a perspective camera
-and KHR_lights_punctual lights.
+One .gltf (JSON) and one binary buffer (.bin) beside it: meshes of several
+primitives with skins, morph targets (positions, and normals where given) and
+two UV sets, node animations, metallic-roughness materials with
+KHR_materials_transmission and KHR_materials_ior, base colour, emissive and
+normal textures by URI or embedded from an array (each with its sampler's
+wraps and filter, its UV set and a KHR_texture_transform), alphaMode and
+alphaCutoff, a perspective camera and KHR_lights_punctual lights.
 """
 
 from __future__ import annotations
 
+import base64
 import json
+import struct
+import zlib
 from pathlib import Path
 
 import numpy as np
@@ -24,7 +28,7 @@ class GltfWriter:
     """Builds a glTF document; write() saves it with its buffer."""
 
     def __init__(self) -> None:
-        self.doc: dict = {"asset": {"version": "2.0", "generator": "snell tests/usd"}, "scene": 0,
+        self.doc: dict = {"asset": {"version": "2.0", "generator": "snell tests"}, "scene": 0,
                           "scenes": [{"nodes": []}], "nodes": [], "meshes": [], "accessors": [],
                           "bufferViews": [], "materials": []}
         self.blob = bytearray()
@@ -54,10 +58,15 @@ class GltfWriter:
         self.doc["accessors"].append(accessor)
         return len(self.doc["accessors"]) - 1
 
-    def texture(self, uri: str, wrap_s: str = "repeat", wrap_t: str = "repeat") -> int:
-        """An image by URI with a trilinear sampler of these wraps (repeat, clamp, mirror); the texture's index."""
-        self.doc.setdefault("images", []).append({"uri": uri})
-        sampler = {"magFilter": 9729, "minFilter": 9987, "wrapS": _WRAPS[wrap_s], "wrapT": _WRAPS[wrap_t]}
+    def texture(self, image: str | np.ndarray, wrap_s: str = "repeat", wrap_t: str | None = None,
+                nearest: bool = False) -> int:
+        """An image, by URI or an RGBA8 array embedded as PNG, with a sampler of these wraps (repeat, clamp,
+        mirror; wrap_t: wrap_s's unless given), trilinear or nearest; the texture's index."""
+        if not isinstance(image, str):
+            image = "data:image/png;base64," + base64.b64encode(_png_bytes(image)).decode()
+        self.doc.setdefault("images", []).append({"uri": image})
+        sampler = {"magFilter": 9728 if nearest else 9729, "minFilter": 9728 if nearest else 9987,
+                   "wrapS": _WRAPS[wrap_s], "wrapT": _WRAPS[wrap_t or wrap_s]}
         samplers = self.doc.setdefault("samplers", [])
         if sampler not in samplers:
             samplers.append(sampler)
@@ -77,10 +86,10 @@ class GltfWriter:
         return info
 
     def material(self, base_color=(1, 1, 1, 1), roughness: float = 1.0, transmission: float = 0.0, ior: float = 1.5,
-                 texture_uri: str | None = None, emissive=(0, 0, 0), base_info: dict | None = None,
+                 texture: str | np.ndarray | None = None, emissive=(0, 0, 0), base_info: dict | None = None,
                  emissive_info: dict | None = None, normal_info: dict | None = None, alpha_mode: str | None = None,
                  alpha_cutoff: float | None = None) -> int:
-        """A material; *_info are texture_info() references (texture_uri: a repeating base colour texture)."""
+        """A material; *_info are texture_info() references (texture: a repeating base colour texture)."""
         pbr: dict = {"baseColorFactor": list(base_color), "metallicFactor": 0.0, "roughnessFactor": roughness}
         m: dict = {"pbrMetallicRoughness": pbr}
         if any(emissive):
@@ -90,8 +99,8 @@ class GltfWriter:
                                "KHR_materials_ior": {"ior": ior}}
             self._extension("KHR_materials_transmission")
             self._extension("KHR_materials_ior")
-        if texture_uri is not None:
-            base_info = {"index": self.texture(texture_uri)}
+        if texture is not None:
+            base_info = {"index": self.texture(texture)}
         for key, info in (("emissiveTexture", emissive_info), ("normalTexture", normal_info)):
             if info is not None:
                 m[key] = info
@@ -106,7 +115,8 @@ class GltfWriter:
 
     def mesh(self, primitives: list[dict], weights: list[float] | None = None, name: str = "") -> int:
         """primitives: dicts of positions, normals, indices ((T, 3) uint32), and optional uvs, uvs1, material,
-        joints ((n, 4) uint16), weights ((n, 4) float32) and targets (position deltas, one array per target)."""
+        joints ((n, 4) uint16), weights ((n, 4) float32) and targets (one per target: its position deltas, or
+        its position and normal deltas as a pair)."""
         out = []
         for p in primitives:
             attributes = {"POSITION": self.accessor(np.float32(p["positions"]), minmax=True, target=34962),
@@ -123,7 +133,7 @@ class GltfWriter:
             if p.get("material") is not None:
                 primitive["material"] = p["material"]
             if p.get("targets"):
-                primitive["targets"] = [{"POSITION": self.accessor(np.float32(d), minmax=True)} for d in p["targets"]]
+                primitive["targets"] = [self._target(t) for t in p["targets"]]
             out.append(primitive)
         mesh: dict = {"primitives": out}
         if name:
@@ -132,6 +142,13 @@ class GltfWriter:
             mesh["weights"] = list(weights)
         self.doc["meshes"].append(mesh)
         return len(self.doc["meshes"]) - 1
+
+    def _target(self, deltas) -> dict:
+        if isinstance(deltas, tuple):
+            positions, normals = deltas
+            return {"POSITION": self.accessor(np.float32(positions), minmax=True),
+                    "NORMAL": self.accessor(np.float32(normals))}
+        return {"POSITION": self.accessor(np.float32(deltas), minmax=True)}
 
     def node(self, parent: int | None = None, matrix: np.ndarray | None = None, **fields) -> int:
         """A node under `parent` (None: a root of the scene); matrix: 4x4 with column vectors."""
@@ -163,9 +180,12 @@ class GltfWriter:
         sampler = len(animation["samplers"]) - 1
         animation["channels"].append({"sampler": sampler, "target": {"node": node, "path": path}})
 
-    def camera(self, yfov: float, aspect: float, position, name: str = "", znear: float = 0.1) -> int:
-        self.doc.setdefault("cameras", []).append(
-            {"type": "perspective", "perspective": {"yfov": yfov, "aspectRatio": aspect, "znear": znear}})
+    def camera(self, yfov: float, aspect: float | None, position, name: str = "", znear: float = 0.1) -> int:
+        """A perspective camera at `position` looking down -Z (aspect None: the image's)."""
+        perspective = {"yfov": yfov, "znear": znear}
+        if aspect:
+            perspective["aspectRatio"] = aspect
+        self.doc.setdefault("cameras", []).append({"type": "perspective", "perspective": perspective})
         return self.node(name=name or None, camera=len(self.doc["cameras"]) - 1,
                          translation=[float(c) for c in position])
 
@@ -189,3 +209,15 @@ class GltfWriter:
         self.doc["buffers"] = [{"byteLength": len(self.blob), "uri": binary.name}]
         path.write_text(json.dumps(self.doc, indent=1))
         return path
+
+
+def _png_bytes(rgba: np.ndarray) -> bytes:
+    """An RGBA8 PNG of the array (no filtering), for textures inside test glTF files."""
+    height, width, _ = rgba.shape
+    raw = b"".join(b"\x00" + rgba[y].tobytes() for y in range(height))
+
+    def chunk(kind: bytes, body: bytes) -> bytes:
+        return struct.pack(">I", len(body)) + kind + body + struct.pack(">I", zlib.crc32(kind + body) & 0xFFFFFFFF)
+
+    header = struct.pack(">IIBBBBB", width, height, 8, 6, 0, 0, 0)
+    return b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", header) + chunk(b"IDAT", zlib.compress(raw)) + chunk(b"IEND", b"")
