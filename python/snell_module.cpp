@@ -795,7 +795,9 @@ PYBIND11_MODULE(_snell, m) {
       .def("__exit__", [](PyRenderer& r, const py::args&) { r.state.reset(); });
 
   py::class_<snell::ShotFrame>(m, "ShotFrame",
-                               "One frame of a shot (render_frames): a time, and what the host changes at it.")
+                               "One frame of a shot (render_frames): a time, and what the host changes at it.\n\n"
+                               "Each device keeps the vertices the frames it drew gave: a mesh one frame rewrites\n"
+                               "should come in every frame, or a frame's pixels would depend on its device.")
       .def(py::init([](long number, double seconds, const py::object& viewMatrix, const py::object& projection,
                        const py::dict& transforms, const py::dict& vertices) {
              snell::ShotFrame f;

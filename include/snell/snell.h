@@ -463,6 +463,9 @@ struct ShotFrame {
   /// Instances placed at this frame (mesh space to world), as Renderer::setTransform takes them.
   std::vector<std::pair<size_t, Mat4>> transforms;
   /// Kept meshes' vertices at this frame (Scene::keepsVertices), by mesh index.
+  /// Each device keeps what the frames it drew gave: a mesh that one frame
+  /// rewrites should come in every frame, or a frame's pixels would depend on
+  /// which device drew it.
   std::vector<std::pair<int, MeshVertices>> vertices;
 };
 

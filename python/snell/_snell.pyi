@@ -292,7 +292,11 @@ class Renderer:
     def __exit__(self, *args: Any) -> None: ...
 
 class ShotFrame:
-    """One frame of a shot (render_frames): a time, and what the host changes at it."""
+    """One frame of a shot (render_frames): a time, and what the host changes at it.
+
+    Each device keeps the vertices the frames it drew gave: a mesh one frame rewrites
+    should come in every frame, or a frame's pixels would depend on its device.
+    """
 
     def __init__(
         self,

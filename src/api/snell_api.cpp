@@ -750,12 +750,7 @@ ShotSummary renderFrames(const std::string& devices, Scene& scene, const View& v
     settings.keepVertices = scene.impl().keep;
 
     // No list: one worker, on the device `options` names (or snell's own choice).
-    std::vector<render::ShotDevice> workers{{options.device, ""}};
-    if (!devices.empty()) {
-      std::string why;
-      workers.clear();
-      for (uint32_t index : vk::devicesForList(devices, io::deviceEnvironment(), why)) workers.push_back({std::to_string(index), why});
-    }
+    std::vector<render::ShotDevice> workers = render::shotDevices(devices, io::deviceEnvironment(), options.device);
     DeviceOptions shared = options;
     shared.device.clear();
 

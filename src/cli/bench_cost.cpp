@@ -64,7 +64,9 @@ CostCounters countersOf(const std::vector<gpu::TraceAov>& aov) {
 int runCost(const Options& o) {
   if (!o.json.empty()) io::checkWritable(o.json);
   scene::Scene scene = o.file.empty() ? scene::makeEye(o.eye) : scene::loadGltf(o.file);
-  std::string label = o.file.empty() ? "eye (resolution " + std::to_string(o.eye.resolution) + ")" : o.file;
+  std::string label = !o.file.empty() ? o.file
+                      : o.eye.crowd  ? "eye crowd of " + std::to_string(o.eye.crowd)
+                                     : "eye (resolution " + std::to_string(o.eye.resolution) + ")";
   vk::ContextDesc desc = io::contextDescFromEnvironment();
   desc.driverRayTracing = true;  // for the peer, where the device has it
   auto context = vk::Context::create(desc);
@@ -182,12 +184,9 @@ void addBenchCost(CLI::App& bench, Runner& run) {
       "Medians over --frames rounds, each drawing the trace, the replay and the\n"
       "driver's ray tracing (where the device has it) in turn.");
   sub->footer(kHelpFooter);
-  sub->add_option("scene", o->file, "the glTF file instead of the procedural eye")->type_name("SCENE.glb");
-  addSize(*sub, "--size", o->width, o->height, "image size (default 1920x1080)");
+  addBenchScene(*sub, o->file, o->width, o->height, "1920x1080");
   sub->add_option("--frames", o->frames, "rounds measured (default 20)")->type_name("N")->check(positiveCount());
-  sub->add_option("--eye-resolution", o->eye.resolution, "segments of the procedural eye, 8-2048 (default 64)")
-      ->type_name("N")
-      ->check(CLI::Range(8u, 2048u));
+  addEyeOptions(*sub, o->eye);
   sub->add_option("--json", o->json, "write the results as JSON too")->type_name("FILE");
   sub->callback([o, &run] { run = [o] { return runCost(*o); }; });
 }

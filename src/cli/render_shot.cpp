@@ -230,14 +230,6 @@ render::ShotSettings shotSettings(const RenderOptions& o, const scene::Scene& sc
 
 // A device override per worker, and why: one, as --device or SNELL_DEVICE or
 // a launcher picks it; or with --devices, one per device it names.
-std::vector<render::ShotDevice> workerDevices(const RenderOptions& o) {
-  if (o.devices.empty()) return {{"", ""}};
-  std::string why;
-  std::vector<render::ShotDevice> devices;
-  for (uint32_t index : vk::devicesForList(o.devices, io::deviceEnvironment(), why)) devices.push_back({std::to_string(index), why});
-  return devices;
-}
-
 }  // namespace
 
 int renderShot(RenderOptions& o, render::ShotReport* report) {
@@ -260,7 +252,7 @@ int renderShot(RenderOptions& o, render::ShotReport* report) {
   io::checkWritable(pathOf(frames.front().first));
   if (!o.statsJson.empty()) io::checkWritable(framePath(o.statsJson, frames.front().first));
   if (!o.environment.empty()) o.optics.environment = std::make_shared<scene::Environment>(io::readEnvironment(o.environment));
-  const std::vector<render::ShotDevice> devices = workerDevices(o);
+  const std::vector<render::ShotDevice> devices = render::shotDevices(o.devices, io::deviceEnvironment());
   scene::Scene scene = o.shot.loadScene();
   FrameWriter writer(o, scene, frames.size(), o.reference ? 1 : devices.size());
 
@@ -273,14 +265,15 @@ int renderShot(RenderOptions& o, render::ShotReport* report) {
     if (o.reference) {
       drawReference(o, scene, frames, writer);
     } else {
-      render::ShotIo io;
+      const render::ShotSettings settings = shotSettings(o, scene, frames.front().second);
+      render::ShotIo shotIo;
       size_t next = 0;
-      io.next = [&]() -> std::optional<render::ShotFrame> {
+      shotIo.next = [&]() -> std::optional<render::ShotFrame> {
         if (next == frames.size()) return std::nullopt;
         const auto [number, time] = frames[next++];
         return render::ShotFrame{.number = number, .seconds = time};
       };
-      io.done = [&](render::ShotImage&& image) {
+      shotIo.done = [&](render::ShotImage&& image) {
         Drawn d{image.frame.number, image.frame.seconds, image.worker, image.device, image.why, image.method,
                 image.methodLine, &image.pose, image.view};
         d.image = io::LinearImage{o.shot.width, o.shot.height, {}, image.rgbaHalf()};
@@ -291,8 +284,8 @@ int renderShot(RenderOptions& o, render::ShotReport* report) {
         d.facts = image.facts;
         writer.write(d);
       };
-      io.sinkOnWorkers = true;
-      io.opened = [&](size_t worker, const render::ShotWorker& w) {
+      shotIo.sinkOnWorkers = true;
+      shotIo.opened = [&](size_t worker, const render::ShotWorker& w) {
         // A farm task's log says which GPU of the node it drew and why.
         if (frames.size() < 2 || quiet()) return;
         std::lock_guard lock(writer.output());
@@ -300,16 +293,15 @@ int renderShot(RenderOptions& o, render::ShotReport* report) {
                     w.device.c_str(), w.why.c_str());
         std::fflush(stdout);  // before the progress lines on stderr, in a farm's log too
       };
-      io.baked = [&](size_t worker, const render::RefractionBake& bake) {
+      shotIo.baked = [&](size_t worker, const render::RefractionBake& bake) {
         if (worker != 0) return;
         std::lock_guard lock(writer.output());
-        std::printf("baked the refraction map at %g s: %s\n", o.bakeTime.value_or(frames.front().second),
+        std::printf("baked the refraction map at %g s: %s\n", settings.bakeTime,
                     bake::describe(bake, scene).c_str());
       };
-      io.stop = &stopSignal;
+      shotIo.stop = &stopSignal;
       try {
-        shot = render::renderShot(scene, shotSettings(o, scene, frames.front().second), io::contextDescFromEnvironment(),
-                                  devices, io);
+        shot = render::renderShot(scene, settings, io::contextDescFromEnvironment(), devices, shotIo);
       } catch (const std::invalid_argument& e) {
         throw UsageError{std::string("render: ") + e.what()};
       }

@@ -37,11 +37,42 @@ std::string submit(const std::vector<std::string>& argv, const std::function<voi
   return id;
 }
 
-}  // namespace
-
 std::string slurmJobName(const FarmPlan& plan, const SlurmSettings& settings) {
   return settings.jobName.empty() ? "snell-" + plan.name() : settings.jobName;
 }
+
+// The check job's script: `snell farm check` of job `job`'s `tasks`.
+std::string slurmCheckScript(const FarmPlan& plan, const SlurmSettings& s, const std::string& job,
+                             const std::vector<size_t>& tasks) {
+  std::string script = "#!/bin/bash\n";
+  script += "# Runs after every task of job " + job + " however it ended (afterany), so that the\n";
+  script += "# summary names the frames missing and the tasks that failed; exits 1 if any did.\n";
+  script += sbatchHeader(s, slurmJobName(plan, s) + "-check", plan.folder() + "/logs/%j_check.out");
+  script += "exec " + io::shellQuoted(s.executable) + " farm check " + io::shellQuoted(plan.planPath()) + " --job " +
+            job + " --tasks " + arrayList(tasks) + "\n";
+  return script;
+}
+
+// Throws std::invalid_argument listing the cluster's partitions where
+// `partition` is none of them, std::runtime_error where sinfo cannot say.
+void checkSlurmPartition(const std::string& partition) {
+  if (!io::onPath("sinfo")) {
+    throw std::runtime_error("farm slurm: sinfo is not on PATH (Debian 12: apt-get install slurm-client)");
+  }
+  io::ProcessResult r = io::runProcess({"sinfo", "--noheader", "--format=%R"});
+  if (r.exitCode != 0) throw std::runtime_error("farm slurm: sinfo failed, is slurmctld reachable? " + io::trimmed(r.err));
+  std::string names;
+  std::istringstream lines(r.out);
+  for (std::string line; std::getline(lines, line);) {
+    line = io::trimmed(line);
+    if (line == partition) return;
+    if (!line.empty()) names += (names.empty() ? "" : ", ") + line;
+  }
+  throw std::invalid_argument("farm slurm: --partition " + partition + ": the cluster has no such partition; it has " +
+                              (names.empty() ? "none" : names));
+}
+
+}  // namespace
 
 std::string slurmJobScript(const FarmPlan& plan, const SlurmSettings& s) {
   std::string script = "#!/bin/bash\n";
@@ -72,17 +103,6 @@ std::string slurmJobScript(const FarmPlan& plan, const SlurmSettings& s) {
   return script;
 }
 
-std::string slurmCheckScript(const FarmPlan& plan, const SlurmSettings& s, const std::string& job,
-                             const std::vector<size_t>& tasks) {
-  std::string script = "#!/bin/bash\n";
-  script += "# Runs after every task of job " + job + " however it ended (afterany), so that the\n";
-  script += "# summary names the frames missing and the tasks that failed; exits 1 if any did.\n";
-  script += sbatchHeader(s, slurmJobName(plan, s) + "-check", plan.folder() + "/logs/%j_check.out");
-  script += "exec " + io::shellQuoted(s.executable) + " farm check " + io::shellQuoted(plan.planPath()) + " --job " +
-            job + " --tasks " + arrayList(tasks) + "\n";
-  return script;
-}
-
 void checkSlurmPlan(const FarmPlan& plan) {
   if (plan.tasks() > 1001) {
     throw std::invalid_argument("farm slurm: " + std::to_string(plan.tasks()) + " tasks of " +
@@ -94,23 +114,6 @@ void checkSlurmPlan(const FarmPlan& plan) {
     throw std::invalid_argument("farm slurm: " + plan.folder() +
                                 ": Slurm's log names cannot hold a space or '%'; write the images elsewhere");
   }
-}
-
-void checkSlurmPartition(const std::string& partition) {
-  if (!io::onPath("sinfo")) {
-    throw std::runtime_error("farm slurm: sinfo is not on PATH (Debian 12: apt-get install slurm-client)");
-  }
-  io::ProcessResult r = io::runProcess({"sinfo", "--noheader", "--format=%R"});
-  if (r.exitCode != 0) throw std::runtime_error("farm slurm: sinfo failed, is slurmctld reachable? " + io::trimmed(r.err));
-  std::string names;
-  std::istringstream lines(r.out);
-  for (std::string line; std::getline(lines, line);) {
-    line = io::trimmed(line);
-    if (line == partition) return;
-    if (!line.empty()) names += (names.empty() ? "" : ", ") + line;
-  }
-  throw std::invalid_argument("farm slurm: --partition " + partition + ": the cluster has no such partition; it has " +
-                              (names.empty() ? "none" : names));
 }
 
 std::string submitSlurmTasks(const FarmPlan& plan, const SlurmSettings& s, const std::vector<size_t>& tasks) {

@@ -23,19 +23,12 @@ struct SlurmSettings {
   std::string workingDirectory;  ///< where the tasks start (#SBATCH --chdir)
 };
 
-std::string slurmJobName(const FarmPlan& plan, const SlurmSettings& settings);
 /// The array job's batch script.
 std::string slurmJobScript(const FarmPlan& plan, const SlurmSettings& settings);
-/// The check job's script: `snell farm check` of job `job`'s `tasks`.
-std::string slurmCheckScript(const FarmPlan& plan, const SlurmSettings& settings, const std::string& job,
-                             const std::vector<size_t>& tasks);
 
 /// Whether the plan fits a Slurm job (array size, names Slurm's log
 /// patterns can hold); throws std::invalid_argument saying what to change.
 void checkSlurmPlan(const FarmPlan& plan);
-/// Throws std::invalid_argument listing the cluster's partitions where
-/// `partition` is none of them, std::runtime_error where sinfo cannot say.
-void checkSlurmPartition(const std::string& partition);
 
 /// Writes the plan and the job's script into the plan's folder and submits
 /// tasks `tasks` of it; returns the job's id.

@@ -272,6 +272,15 @@ bool pump(const ShotIo& io, Queue& q, std::vector<std::unique_ptr<Worker>>& work
 
 }  // namespace
 
+std::vector<ShotDevice> shotDevices(const std::string& list, const vk::DeviceEnvironment& environment,
+                                    const std::string& single) {
+  if (list.empty()) return {{single, ""}};
+  std::string why;
+  std::vector<ShotDevice> devices;
+  for (uint32_t index : vk::devicesForList(list, environment, why)) devices.push_back({std::to_string(index), why});
+  return devices;
+}
+
 ShotReport renderShot(const scene::Scene& scene, const ShotSettings& settings, const vk::ContextDesc& context,
                       const std::vector<ShotDevice>& devices, const ShotIo& io) {
   if (devices.empty()) throw std::invalid_argument("shot: no device to draw on");

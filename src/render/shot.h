@@ -45,6 +45,9 @@ struct ShotFrame {
   /// Draw item i's world matrix, over the scene's own pose.
   std::vector<std::pair<size_t, glm::dmat4>> transforms;
   /// A kept shape's vertices (ShotSettings::keepVertices), packed float triples.
+  /// Each worker keeps what the frames it drew gave: a shape that one frame
+  /// rewrites should come in every frame, or a frame's pixels would depend
+  /// on which worker drew it.
   struct Vertices {
     int shape = 0;
     std::vector<float> positions, normals;
@@ -141,6 +144,11 @@ struct ShotDevice {
   std::string override;
   std::string why;
 };
+
+/// The workers of a --devices list (vk::devicesForList), or with no list one
+/// worker on the device `single` names ("": snell's own choice).
+std::vector<ShotDevice> shotDevices(const std::string& list, const vk::DeviceEnvironment& environment,
+                                    const std::string& single = "");
 
 /// Draws every frame `io.next` gives, with one worker per entry of
 /// `devices` (an entry twice: two workers on one device), each made from

@@ -150,9 +150,7 @@ gpu::TracePush TracePass::push(const TraceInputs& in, const FrameSettings& setti
   push.maxInterfaces = settings.maxInterfaces;
   push.maxBends = settings.maxBends;
   push.lightCount = in.lightCount;
-  push.flags = (target.aov ? gpu::kTraceFlagAov : 0u) | (v.orthographic ? gpu::kTraceFlagOrthographic : 0u) |
-               (target.rays ? gpu::kTraceFlagRayList : 0u) | (masked ? gpu::kTraceFlagPixelList : 0u) |
-               replayFlags(settings);  // as prefetch()
+  push.flags = flagsFor(settings, target.aov != nullptr, masked);  // the pipeline's flags: prefetch() made it
   push.tilesX = (settings.width + gpu::kTraceTile - 1) / gpu::kTraceTile;
   push.shiftX = float(v.shift.x);
   push.shiftY = float(v.shift.y);

@@ -83,7 +83,6 @@ VkImageAspectFlags aspectOf(VkFormat format);
 uint32_t formatBytes(VkFormat format);
 
 /// A 2D VkImage in device memory with a view of its one mip level.
-
 class Image {
  public:
   Image() = default;

@@ -25,7 +25,6 @@
 
 namespace snell::vk {
 
-/// How snell creates its own context.
 /// What the process environment says about the device, where no one names
 /// one: SNELL_DEVICE, else the GPUs a launcher gave the process (Slurm or a
 /// CUDA-style scheduler), which no Vulkan driver reads and launcherOverride
@@ -35,6 +34,7 @@ struct DeviceEnvironment {
   std::string launcherVariable, launcherValue;  ///< e.g. CUDA_VISIBLE_DEVICES and "2" ("": none)
 };
 
+/// How snell creates its own context.
 struct ContextDesc {
   std::string applicationName = "snell";
   /// Turn on VK_LAYER_KHRONOS_validation; creation fails if the layer is missing.
@@ -118,7 +118,8 @@ DeviceReport surveyDevices(const std::string& deviceOverride, const DeviceEnviro
 
 /// The devices of a --devices list (chooseDeviceList), a worker each; "all"
 /// within a launcher's GPUs (`environment`) is every GPU it lists. `why`
-/// says how they were found; throws VulkanError naming a bad entry.
+/// says how they were found; throws std::invalid_argument naming a bad entry
+/// (VulkanError where the launcher's own list names no device).
 std::vector<uint32_t> devicesForList(const std::string& list, const DeviceEnvironment& environment, std::string& why);
 
 /// Owns (or borrows) the Vulkan device everything else runs on, counts

@@ -79,8 +79,9 @@ std::vector<uint32_t> launcherDevices(std::span<const DeviceFacts> devices, cons
 /// The devices --devices names, a worker each: "all" is every qualifying
 /// device of the best one's type (every GPU; lavapipe where there is none);
 /// otherwise a comma list of indices and UUIDs, where one device may come
-/// twice (two workers on it). Throws VulkanError naming the entry that names
-/// no device, or one that does not qualify, and why.
+/// twice (two workers on it). Throws std::invalid_argument naming the entry
+/// that names no device, or one that does not qualify, and why (VulkanError
+/// where "all" finds no qualifying device).
 std::vector<uint32_t> chooseDeviceList(std::span<const DeviceFacts> devices, const std::string& list);
 
 /// "discrete GPU", "integrated GPU", "virtual GPU", "CPU" or "other".

@@ -33,7 +33,6 @@ import numpy as np
 
 IDENTITY_SCALE = (1.0, 1.0, 1.0, 1.0)
 NO_BIAS = (0.0, 0.0, 0.0, 0.0)
-KINDS = ("colour", "emission", "normal")
 
 
 class TextureReadError(Exception):
