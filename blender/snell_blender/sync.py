@@ -234,10 +234,7 @@ class SceneSync:
         if self._lights_of(depsgraph) != self.light_state:
             raise TopologyChanged("a light changed")
         vertices = {}
-        for instance in depsgraph.object_instances:
-            obj = instance.object
-            if instance.is_instance or obj.original.name not in self.geometry:
-                continue
+        for obj in self._mesh_objects(depsgraph):
             co, loop_normals = self._evaluated_vertices(obj)
             for part in self.geometry[obj.original.name].parts:
                 vertices[part.mesh] = (co[part.vertex_of_loop], loop_normals[part.loops])
@@ -277,8 +274,7 @@ class SceneSync:
         started = time.perf_counter()
         if self._lights_of(depsgraph) != self.light_state:
             raise TopologyChanged("a light changed")
-        objects = [i.object for i in depsgraph.object_instances
-                   if not i.is_instance and i.object.original.name in self.geometry]
+        objects = self._mesh_objects(depsgraph)
         sent = []
         for done, obj in enumerate(objects):
             if stop():
@@ -293,13 +289,21 @@ class SceneSync:
     def send_every_mesh(self, depsgraph) -> list:
         """Sends every object's evaluated vertices, whatever changed (bench/record_blender_feed.py's feed)."""
         sent = []
-        for instance in depsgraph.object_instances:
-            name = instance.object.original.name
-            if name in self.geometry and name not in sent and not instance.is_instance:
-                self.send_vertices(instance.object)
-                sent.append(name)
+        for obj in self._mesh_objects(depsgraph):
+            self.send_vertices(obj)
+            sent.append(obj.original.name)
         self._update_transforms(depsgraph)
         return sent
+
+    def _mesh_objects(self, depsgraph) -> list:
+        """The depsgraph's evaluated objects that are snell meshes, each once (not its instances)."""
+        objects, seen = [], set()
+        for instance in depsgraph.object_instances:
+            name = instance.object.original.name
+            if not instance.is_instance and name in self.geometry and name not in seen:
+                seen.add(name)
+                objects.append(instance.object)
+        return objects
 
     @staticmethod
     def _lights_of(depsgraph) -> list:

@@ -485,7 +485,6 @@ struct Renderer::Impl {
   FrameInfo last;
   std::optional<render::MethodChoice> choice;  ///< the last request's (auto keeps timing while it stays)
   render::Method drawn = render::Method::Trace;  ///< the last request's method
-  bool viewportShown = false;                    ///< the last request's output was the viewport
 
   Impl(Device& device, Scene& s, const RendererOptions& options)
       : mutex(device.impl().mutex), context(*device.impl().context), scene(s.impl()),
@@ -504,14 +503,13 @@ struct Renderer::Impl {
     render::FrameSettings settings = frameSettings(view, scene.scene, pose);
     const std::string name = view.method.empty() ? "auto" : view.method;
     const bool viewportOutput = view.output == View::Output::Viewport;
-    if (!choice || choice->name() != name || viewportOutput != viewportShown) {
+    if (!choice || choice->name() != name || viewportOutput != choice->viewport()) {
       try {
         choice.emplace(name, context.caps().driverRayTracing, viewportOutput);
       } catch (const std::invalid_argument& e) {
         throw Error(std::string("view: ") + e.what() +
                     (name == "driver-rt" ? " (make the Device with DeviceOptions::driverRayTracing)" : ""));
       }
-      viewportShown = viewportOutput;
     }
     drawn = choice->next();
     render::RasterOptions raster;

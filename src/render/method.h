@@ -110,6 +110,7 @@ class MethodChoice {
   MethodChoice(const std::string& name, bool driverRayTracing, bool viewport, uint64_t frames = UINT64_MAX);
   const std::string& name() const { return name_; }
   bool isAuto() const { return chooser_.has_value(); }
+  bool viewport() const { return viewport_; }
   /// The method the next frame draws with.
   Method next() const;
   /// The view that draws `settings` with `method` (next()'s), as the caller shows it.
