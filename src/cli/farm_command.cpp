@@ -165,9 +165,7 @@ struct OpenJdOptions {
 };
 
 int runOpenJd(OpenJdOptions& o, const std::vector<std::string>& renderOptions) {
-  if (!farm::isOpenJdTemplatePath(o.output)) {
-    throw UsageError{"farm openjd: -o " + o.output + ": a template ends in .yaml, .yml or .json"};
-  }
+  usageErrors([&] { farm::checkOpenJdTemplatePath(o.output); });
   io::checkWritable(o.output);
   FarmPlan plan = usageErrors([&] { return FarmPlan::make(o.scene, o.images, *o.frames, o.chunk, {}); });
   plan.renderOptions = taskRenderOptions(plan.scene, plan.output, plan.frames, renderOptions);

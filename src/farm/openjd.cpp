@@ -66,15 +66,15 @@ io::Json openJdTemplate(const FarmPlan& plan, const std::string& name, uint32_t 
   return t;
 }
 
-bool isOpenJdTemplatePath(const std::string& path) {
+void checkOpenJdTemplatePath(const std::string& path) {
   const std::string ext = fs::path(path).extension().string();
-  return ext == ".yaml" || ext == ".yml" || ext == ".json";
+  if (ext != ".yaml" && ext != ".yml" && ext != ".json") {
+    throw std::invalid_argument("farm openjd: -o " + path + ": a template ends in .yaml, .yml or .json");
+  }
 }
 
 void writeOpenJdTemplate(const std::string& path, const io::Json& jobTemplate) {
-  if (!isOpenJdTemplatePath(path)) {
-    throw std::invalid_argument("farm openjd: -o " + path + ": a template ends in .yaml, .yml or .json");
-  }
+  checkOpenJdTemplatePath(path);
   const bool json = fs::path(path).extension() == ".json";
   io::writeTextFile(path, json ? io::jsonText(jobTemplate)
                                : "# Open Job Description job template (jobtemplate-2023-09 with TASK_CHUNKING)\n" +

@@ -22,7 +22,8 @@ io::Json openJdTemplate(const FarmPlan& plan, const std::string& name, uint32_t 
 /// Writes a template to `path`: YAML for .yaml and .yml, JSON for .json;
 /// another name is std::invalid_argument.
 void writeOpenJdTemplate(const std::string& path, const io::Json& jobTemplate);
-/// Whether `path` names a template file writeOpenJdTemplate can write.
-bool isOpenJdTemplatePath(const std::string& path);
+/// Throws std::invalid_argument unless `path` names a template file
+/// writeOpenJdTemplate can write (a check before any work).
+void checkOpenJdTemplatePath(const std::string& path);
 
 }  // namespace snell::farm
