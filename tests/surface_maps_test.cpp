@@ -1,6 +1,8 @@
 // Normal maps and alpha (trace.h: Normal maps, Alpha): the GPU's trace draws
 // them as the CPU reference does, they change the picture where they should
-// and only there, and the viewport composite agrees with the trace.
+// and only there, and the viewport composite agrees with the trace. A scene
+// whose materials use none of them traces a walk with them compiled out
+// (kTraceSpecSurface), and draws the same pixels with it.
 #include "golden_support.h"
 #include "gpu_test.h"
 
@@ -184,8 +186,59 @@ scene::Scene seeThroughCard(scene::AlphaMode mode, float factorAlpha) {
   return s;
 }
 
+// The trace's linear colours, for comparisons bit for bit.
+std::vector<glm::vec4> tracedLinear(vk::Context& context, const scene::Scene& s) {
+  scene::Pose pose = scene::evaluate(s, 0.0);
+  render::Renderer renderer(context, s, pose);
+  render::FrameSettings settings{kWidth, kHeight, frontView(s, pose), glm::vec3(scene::kDefaultBackground), 8};
+  return render::renderFrame(renderer, pose, settings).rgba;
+}
+
+uint32_t surfaceOf(vk::Context& context, const scene::Scene& s) {
+  return render::uploadScene(context, s, scene::evaluate(s, 0.0)).surface;
+}
+
+// `s` with one more material, bound to nothing, that uses every surface
+// feature: its trace compiles them all in and must draw the same picture.
+scene::Scene withUnusedFeatures(scene::Scene s) {
+  scene::Material every;
+  every.name = "every feature, on no face";
+  int map = addTextureTo(s, ripples(8, 0.5));
+  every.baseColorTexture.texture = every.emissiveTexture.texture = map;
+  every.normalTexture.texture = every.iorTexture.texture = map;
+  every.alphaMode = scene::AlphaMode::Blend;
+  addMaterialTo(s, every);
+  return s;
+}
+
 // The GPU tests of normal maps and alpha against the reference.
 class SurfaceMaps : public GpuTest {};
+
+TEST_F(SurfaceMaps, ASceneTracesWithOnlyTheSurfaceFeaturesItsMaterialsUse) {
+  EXPECT_EQ(surfaceOf(context(), rippledGlass(false)), gpu::kSurfaceTextures | gpu::kSurfaceEmissiveMaps);
+  EXPECT_EQ(surfaceOf(context(), rippledGlass(true)),
+            gpu::kSurfaceTextures | gpu::kSurfaceEmissiveMaps | gpu::kSurfaceNormalMaps);
+  EXPECT_EQ(surfaceOf(context(), seeThroughCard(scene::AlphaMode::Mask, 1.0f)),
+            gpu::kSurfaceTextures | gpu::kSurfaceEmissiveMaps | gpu::kSurfaceAlpha);
+  scene::Scene plain = rippledGlass(false);
+  plain.materials[0].emissiveTexture = {};
+  EXPECT_EQ(surfaceOf(context(), plain), 0u);
+  EXPECT_EQ(surfaceOf(context(), withUnusedFeatures(plain)), gpu::kSurfaceAll);
+}
+
+TEST_F(SurfaceMaps, TheLeanWalkDrawsTheSamePixelsAsTheWalkWithEveryFeature) {
+  scene::Scene textured = rippledGlass(false);
+  scene::Scene plain = textured;
+  plain.materials[0].emissiveTexture = {};
+  for (const scene::Scene& s : {textured, plain}) {
+    std::vector<glm::vec4> lean = tracedLinear(context(), s);
+    std::vector<glm::vec4> full = tracedLinear(context(), withUnusedFeatures(s));
+    ASSERT_EQ(lean.size(), full.size());
+    size_t differ = 0;
+    for (size_t i = 0; i < lean.size(); ++i) differ += lean[i] != full[i];
+    EXPECT_EQ(differ, 0u) << s.source << ": pixels that differ between the lean walk and the full one";
+  }
+}
 
 TEST_F(SurfaceMaps, ANormalMapBendsTheViewThroughGlassAsTheReferenceDoes) {
   std::string mismatches;

@@ -16,8 +16,10 @@ const float kInf = 1.0 / 0.0;  // folded to +infinity at compile time
 // What the pipeline was specialised for (shared/trace.h: kTraceSpecOptics), and what this dispatch draws.
 layout(constant_id = kTraceSpecOptics) const uint kSpecOptics = 0xffffffffu;
 layout(constant_id = kTraceSpecFlags) const uint kSpecFlags = 0xffffffffu;
+layout(constant_id = kTraceSpecSurface) const uint kSpecSurface = kSurfaceAll;
 bool opticsOn(uint bit) { return (kSpecOptics & pc.optics & bit) != 0u; }
 bool traceFlag(uint bit) { return (kSpecFlags & pc.flags & bit) != 0u; }
+bool surfaceUses(uint bit) { return (kSpecSurface & bit) != 0u; }
 
 uint visits;  // nodes visited by this pixel's whole path (the driver's pipeline cannot count them: 0)
 uint boxTests, triangleTests;  // child boxes and triangles tested over the path (trace.comp counts them)
@@ -195,6 +197,8 @@ bool tracePath(vec3 origin, vec3 dir, float width, float spread, int channel, ou
     // opaque face's light in two parts (phongParts), each from one call site
     // whatever the branches below use: every call site is compiled in full,
     // and the first image waits for the compile.
+    // What the scene does not use (kTraceSpecSurface) is compiled out: a
+    // slot without a texture reads 1 and an opaque face covers itself.
     vec3 texel = vec3(1.0), second = vec3(1.0), shine = vec3(0.0), weight = vec3(0.0);
     float coverage = 1.0;
     if (hit.instance != kNoHit) {
@@ -203,19 +207,23 @@ bool tracePath(vec3 origin, vec3 dir, float width, float spread, int channel, ou
       m = materials[s.material];
       opaque = !refractive(m);
       vec3 mapTexel = vec3(0.5, 0.5, 1.0);
-      [[dont_unroll]] for (uint k = 0u; k < 3u; ++k) {
+      uint slots = !surfaceUses(kSurfaceTextures) ? 0u : surfaceUses(kSurfaceNormalMaps) ? 3u : 2u;
+      [[dont_unroll]] for (uint k = 0u; k < slots; ++k) {
+        if (k == 1u && !surfaceUses(opaque ? kSurfaceEmissiveMaps : kSurfaceIorMaps)) continue;
         GpuTextureSlot slot = k == 0u ? m.base : k == 2u ? m.normal : opaque ? m.emissive : m.iorMap;
         vec4 read = textured(slot, s.uvs, s.lods, k == 0u || (k == 1u && opaque));
         if (k == 0u) {
           texel = read.rgb;
-          if (opaque) coverage = coverageOf(m, read.a);
+          if (opaque && surfaceUses(kSurfaceAlpha)) coverage = coverageOf(m, read.a);
         } else if (k == 1u) {
           second = read.rgb;
         } else {
           mapTexel = read.rgb;
         }
       }
-      if (m.normal.texture != kNoTexture) s.ns = normalMappedAt(hit, s, m, mapTexel);
+      // Alpha without textures: the factor's alone.
+      if (opaque && surfaceUses(kSurfaceAlpha) && !surfaceUses(kSurfaceTextures)) coverage = coverageOf(m, 1.0);
+      if (surfaceUses(kSurfaceNormalMaps) && m.normal.texture != kNoTexture) s.ns = normalMappedAt(hit, s, m, mapTexel);
       if (opaque) shine = phongLight(s.position, s.ns, m, second, dir, pc.lightCount, pc.forward.xyz, weight);
     }
     if (reflecting) {  // an opaque face is shaded; a miss or glass sees the environment

@@ -246,6 +246,17 @@ SNELL_CONST kTraceSpecFlags = 1;
 // Lanes that trace one listed pixel together (the masked trace only): 1, or
 // a power of two no larger than the subgroup (trace.comp's traverseLanes).
 SNELL_CONST kTraceSpecLanes = 2;
+// What the scene's materials use (kTraceSpecSurface): a pipeline made without
+// a bit compiles that work out of every hit. No push constant repeats them:
+// they are the scene's, fixed when it is uploaded (SceneGpu::surface), and a
+// scene without them draws the same pixels with them compiled in.
+SNELL_CONST kTraceSpecSurface = 3;
+SNELL_CONST kSurfaceTextures = 1u;      // some material reads a texture (any slot)
+SNELL_CONST kSurfaceEmissiveMaps = 2u;  // some material has an emissive texture
+SNELL_CONST kSurfaceIorMaps = 4u;       // some material has an IOR texture
+SNELL_CONST kSurfaceNormalMaps = 8u;    // some material has a normal map
+SNELL_CONST kSurfaceAlpha = 16u;        // some material masks or blends by alpha
+SNELL_CONST kSurfaceAll = 31u;
 // Nodes one ray segment may visit before it gives up: a corrupted tree ends here.
 SNELL_CONST kTraceMaxVisits = 1u << 20;
 

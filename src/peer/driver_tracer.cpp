@@ -26,7 +26,7 @@ static_assert(offsetof(DriverTracePush, topLevel) == 128 && sizeof(DriverTracePu
 
 DriverTracer::DriverTracer(vk::Context& context, const vk::Buffer& positions, uint32_t vertexCount,
                            const vk::Buffer& indices, const std::vector<DriverGeometry>& geometries,
-                           uint32_t instanceCapacity)
+                           uint32_t instanceCapacity, uint32_t surface)
     : context_(context) {
   if (!context.caps().driverRayTracing) {
     throw vk::VulkanError("driver-rt: this device offers no ray tracing pipelines (VK_KHR_ray_tracing_pipeline)");
@@ -39,7 +39,8 @@ DriverTracer::DriverTracer(vk::Context& context, const vk::Buffer& positions, ui
   }
   tlas_ = std::make_unique<DriverTlas>(context, instanceCapacity);
   program_ = std::make_unique<vk::RayTracingProgram>(
-      context, vk::RayTracingProgramDesc{"driver trace", kSpvDriverTrace, kSpvDriverTraceMiss, kSpvDriverTraceHit});
+      context, vk::RayTracingProgramDesc{"driver trace", kSpvDriverTrace, kSpvDriverTraceMiss, kSpvDriverTraceHit,
+                                         {{gpu::kTraceSpecSurface, surface}}});
   geometryFirst_ = vk::Buffer(context, {std::max<size_t>(first.size(), 1) * 4,
                                         VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
                                         vk::MemoryDomain::Device, "driver geometry first triangles"});

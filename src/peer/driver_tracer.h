@@ -28,8 +28,10 @@ struct DriverGeometry {
 class DriverTracer {
  public:
   /// `positions` and `indices` need kDriverInputUsage and device addresses.
+  /// `surface`: the gpu::kSurface* bits the scene's materials use; the path
+  /// code compiles out the rest, as the trace's does (kTraceSpecSurface).
   DriverTracer(vk::Context& context, const vk::Buffer& positions, uint32_t vertexCount, const vk::Buffer& indices,
-               const std::vector<DriverGeometry>& geometries, uint32_t instanceCapacity);
+               const std::vector<DriverGeometry>& geometries, uint32_t instanceCapacity, uint32_t surface);
   ~DriverTracer();
 
   /// Builds every bottom level the first time, then updates the `moved`

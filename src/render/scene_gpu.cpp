@@ -192,6 +192,21 @@ gpu::GpuMaterial packMaterial(const scene::Material& m, const scene::Scene& scen
   return g;
 }
 
+// What the packed materials use: a texture dropped as unusable counts as absent, as the trace sees it.
+uint32_t surfaceOf(const std::vector<gpu::GpuMaterial>& materials) {
+  uint32_t surface = 0;
+  for (const gpu::GpuMaterial& m : materials) {
+    for (const gpu::GpuTextureSlot* s : {&m.base, &m.emissive, &m.iorMap, &m.normal}) {
+      if (s->texture != gpu::kNoTexture) surface |= gpu::kSurfaceTextures;
+    }
+    if (m.emissive.texture != gpu::kNoTexture) surface |= gpu::kSurfaceEmissiveMaps;
+    if (m.iorMap.texture != gpu::kNoTexture) surface |= gpu::kSurfaceIorMaps;
+    if (m.normal.texture != gpu::kNoTexture) surface |= gpu::kSurfaceNormalMaps;
+    if (m.alphaMode != gpu::kAlphaOpaque) surface |= gpu::kSurfaceAlpha;
+  }
+  return surface;
+}
+
 }  // namespace
 
 // A host scene's checks: every shape on the host, inside the buffers, with no
@@ -292,6 +307,7 @@ SceneGpu uploadScene(vk::Context& context, const scene::Scene& scene, const scen
   std::vector<gpu::GpuMaterial> materials;
   for (const scene::Material& m : scene.materials) materials.push_back(packMaterial(m, scene));
   materials.push_back(packMaterial(scene::Material{}, scene));  // for shapes without one
+  gpu.surface = surfaceOf(materials);
 
   TexturePlacement place = placeTextures(context, scene);
   std::vector<gpu::GpuTexture> textures;

@@ -37,6 +37,8 @@ struct SceneGpu {
   /// Per pose item: a viewport leaves its pixels to the trace (its faces
   /// refract, or alpha may make them see-through).
   std::vector<char> itemSeeThrough;
+  /// gpu::kSurface* bits: what its materials use (the trace compiles out the rest).
+  uint32_t surface = 0;
   uint32_t vertexCount = 0, triangleCount = 0;
   vk::Buffer positions, normals;  ///< float[3 * vertexCount]; rest pose, deformed slices rewritten per frame
   vk::Buffer texcoords;           ///< vec4 per vertex: uv0, uv1

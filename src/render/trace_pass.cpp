@@ -29,7 +29,7 @@ uint32_t opticsOfScene(const scene::Scene& scene) {
 }  // namespace
 
 TracePass::TracePass(vk::Context& context, const scene::Scene& scene, const SceneGpu& gpu)
-    : context_(context), sceneOptics_(opticsOfScene(scene)) {
+    : context_(context), sceneOptics_(opticsOfScene(scene)), sceneSurface_(gpu.surface) {
   compact_ = std::make_unique<vk::ComputeProgram>(context, vk::ComputeProgramDesc{"trace compact", kSpvTraceCompact,
                                                                                   {}, false});
   placeholder_ = vk::Buffer(context, {sizeof(gpu::TracePixelListHeader), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
@@ -74,7 +74,8 @@ const vk::ComputeProgram& TracePass::program(uint32_t optics, uint32_t flags, ui
                               kSpvTrace,
                               {{gpu::kTraceSpecOptics, optics},
                                {gpu::kTraceSpecFlags, flags},
-                               {gpu::kTraceSpecLanes, lanes}},
+                               {gpu::kTraceSpecLanes, lanes},
+                               {gpu::kTraceSpecSurface, sceneSurface_}},
                               lanes > 1};
   return *programs_.emplace(key, std::make_unique<vk::ComputeProgram>(context_, desc)).first->second;
 }
@@ -219,7 +220,7 @@ void TracePass::recordDriverUpdate(vk::Commands& commands, vk::UploadArena& aren
     std::vector<peer::DriverGeometry> geometries;
     for (const GeometryRange& g : gpu.geometries) geometries.push_back({g.firstTriangle, g.triangleCount});
     driver_ = std::make_unique<peer::DriverTracer>(context_, gpu.positions, gpu.vertexCount, gpu.indices, geometries,
-                                                   static_cast<uint32_t>(instances.size()));
+                                                   static_cast<uint32_t>(instances.size()), sceneSurface_);
     std::fill(driverMoved_.begin(), driverMoved_.end(), 0);  // the first build sees them as they are
   }
   std::vector<uint32_t> moved;
@@ -244,9 +245,9 @@ uint64_t TracePass::recordDriver(vk::Commands& commands, const TraceInputs& in, 
 std::vector<std::string> TracePass::statistics() const {
   std::vector<std::string> lines;
   for (const auto& [key, program] : programs_) {
-    char variant[64];
-    std::snprintf(variant, sizeof variant, "trace (optics 0x%x, flags 0x%x, %u lanes a pixel): ", unsigned(key >> 32),
-                  unsigned(key & 0xffffu), unsigned(key >> 16 & 0xffffu));
+    char variant[96];
+    std::snprintf(variant, sizeof variant, "trace (optics 0x%x, flags 0x%x, surface 0x%x, %u lanes a pixel): ",
+                  unsigned(key >> 32), unsigned(key & 0xffffu), unsigned(sceneSurface_), unsigned(key >> 16 & 0xffffu));
     for (const std::string& line : program->statistics()) lines.push_back(variant + line);
   }
   return lines;

@@ -4,7 +4,8 @@
 // ray tracing (driver-rt). The Renderer lends it the scene, the trees and the
 // view's images each frame; it owns what only tracing needs: the trace
 // pipelines, specialised to the optics a view asks for and the scene can show
-// (a feature the scene lacks compiles out), the compaction of the masked
+// and to the surface features its materials use (a feature the scene lacks
+// compiles out, the driver's pipeline's too), the compaction of the masked
 // trace's pixel list, the environments reflected rays see, and the driver's
 // structures with what they have seen.
 #pragma once
@@ -116,6 +117,7 @@ class TracePass {
 
   vk::Context& context_;
   uint32_t sceneOptics_ = 0;  ///< gpu::kOptics* bits the scene's materials can show
+  uint32_t sceneSurface_ = 0;  ///< gpu::kSurface* bits its materials use (SceneGpu::surface)
   std::map<uint64_t, std::unique_ptr<vk::ComputeProgram>> programs_;  ///< by optics << 32 | lanes << 16 | flags
   std::unique_ptr<vk::ComputeProgram> compact_;
   vk::Buffer placeholder_;

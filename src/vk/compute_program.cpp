@@ -24,26 +24,19 @@ ComputeProgram::ComputeProgram(Context& context, const ComputeProgramDesc& desc)
                       std::to_string(caps.maxSubgroupSize));
   }
 
-  std::vector<VkSpecializationMapEntry> entries;
-  std::vector<uint32_t> values;
-  for (const SpecConstant& s : desc.specialization) {
-    entries.push_back({s.id, static_cast<uint32_t>(values.size() * sizeof(uint32_t)), sizeof(uint32_t)});
-    values.push_back(s.value);
-  }
   VkPipelineShaderStageCreateFlags stageFlags =
       desc.requireFullSubgroups ? VK_PIPELINE_SHADER_STAGE_CREATE_REQUIRE_FULL_SUBGROUPS_BIT : 0;
   VkPipelineCreateFlags pipelineFlags = caps.pipelineStatistics ? VK_PIPELINE_CREATE_CAPTURE_STATISTICS_BIT_KHR : 0;
   // The compile runs on its own thread; what it reads is copied into it or lives as long as this program.
-  pipeline_.emplace(context, name_, [&context, module = layout_.module(0), layout = layout_.pipelineLayout(), entries,
-                                      values, stageFlags, pipelineFlags](VkPipeline* pipeline) {
-    VkSpecializationInfo specInfo{static_cast<uint32_t>(entries.size()), entries.data(),
-                                  values.size() * sizeof(uint32_t), values.data()};
+  pipeline_.emplace(context, name_, [&context, module = layout_.module(0), layout = layout_.pipelineLayout(),
+                                      specialization = Specialization(desc.specialization), stageFlags,
+                                      pipelineFlags](VkPipeline* pipeline) mutable {
     VkPipelineShaderStageCreateInfo stage{VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO};
     stage.flags = stageFlags;
     stage.stage = VK_SHADER_STAGE_COMPUTE_BIT;
     stage.module = module;
     stage.pName = "main";
-    stage.pSpecializationInfo = entries.empty() ? nullptr : &specInfo;
+    stage.pSpecializationInfo = specialization.info();
     VkComputePipelineCreateInfo pipelineInfo{VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO};
     pipelineInfo.flags = pipelineFlags;
     pipelineInfo.stage = stage;

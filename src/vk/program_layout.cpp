@@ -15,6 +15,19 @@ ShaderReflection reflectProgramShader(std::span<const uint32_t> spirv, std::span
   }
 }
 
+Specialization::Specialization(std::span<const SpecConstant> constants) {
+  for (const SpecConstant& s : constants) {
+    entries.push_back({s.id, static_cast<uint32_t>(values.size() * sizeof(uint32_t)), sizeof(uint32_t)});
+    values.push_back(s.value);
+  }
+}
+
+const VkSpecializationInfo* Specialization::info() {
+  if (entries.empty()) return nullptr;
+  info_ = {static_cast<uint32_t>(entries.size()), entries.data(), values.size() * sizeof(uint32_t), values.data()};
+  return &info_;
+}
+
 ProgramLayout::ProgramLayout(Context& context, const std::string& name,
                              std::span<const std::span<const uint32_t>> spirv, std::span<const char* const> moduleNames,
                              std::vector<ReflectedBinding> bindings, VkShaderStageFlags stages,

@@ -22,6 +22,18 @@ namespace snell::vk {
 ShaderReflection reflectProgramShader(std::span<const uint32_t> spirv, std::span<const SpecConstant> specialization,
                                       const std::string& name);
 
+/// Specialisation constants as a stage's VkSpecializationInfo wants them; info() points into this object.
+struct Specialization {
+  explicit Specialization(std::span<const SpecConstant> constants);
+  std::vector<VkSpecializationMapEntry> entries;
+  std::vector<uint32_t> values;
+  /// Null when there are none.
+  const VkSpecializationInfo* info();
+
+ private:
+  VkSpecializationInfo info_{};
+};
+
 class ProgramLayout {
  public:
   /// Creates a module per SPIR-V blob (named "NAME" or "NAME STAGE" after

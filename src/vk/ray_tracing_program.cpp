@@ -19,7 +19,7 @@ ProgramLayout layoutOf(Context& context, const RayTracingProgramDesc& desc) {
     throw VulkanError("program '" + desc.name +
                       "': this device offers no ray tracing pipelines (VK_KHR_ray_tracing_pipeline)");
   }
-  ShaderReflection raygen = reflectProgramShader(desc.raygen, {}, desc.name);
+  ShaderReflection raygen = reflectProgramShader(desc.raygen, desc.raygenSpecialization, desc.name);
   for (std::span<const uint32_t> other : {desc.miss, desc.closestHit}) {
     if (!reflectProgramShader(other, {}, desc.name).bindings.empty()) {
       throw VulkanError("program '" + desc.name + "': only the ray generation shader may bind resources");
@@ -37,6 +37,7 @@ RayTracingProgram::RayTracingProgram(Context& context, const RayTracingProgramDe
   VkDevice device = context.device();
   const VkShaderStageFlagBits stages[3] = {VK_SHADER_STAGE_RAYGEN_BIT_KHR, VK_SHADER_STAGE_MISS_BIT_KHR,
                                            VK_SHADER_STAGE_CLOSEST_HIT_BIT_KHR};
+  Specialization raygenSpecialization(desc.raygenSpecialization);
   VkPipelineShaderStageCreateInfo stageInfo[3];
   VkRayTracingShaderGroupCreateInfoKHR groups[3];
   for (uint32_t i = 0; i < 3; ++i) {
@@ -44,6 +45,7 @@ RayTracingProgram::RayTracingProgram(Context& context, const RayTracingProgramDe
     stageInfo[i].stage = stages[i];
     stageInfo[i].module = layout_.module(i);
     stageInfo[i].pName = "main";
+    stageInfo[i].pSpecializationInfo = i == 0 ? raygenSpecialization.info() : nullptr;
     groups[i] = {VK_STRUCTURE_TYPE_RAY_TRACING_SHADER_GROUP_CREATE_INFO_KHR};
     groups[i].type = i == 2 ? VK_RAY_TRACING_SHADER_GROUP_TYPE_TRIANGLES_HIT_GROUP_KHR
                             : VK_RAY_TRACING_SHADER_GROUP_TYPE_GENERAL_KHR;

@@ -16,12 +16,14 @@
 #include <initializer_list>
 #include <span>
 #include <string>
+#include <vector>
 
 namespace snell::vk {
 
 struct RayTracingProgramDesc {
   std::string name;
   std::span<const uint32_t> raygen, miss, closestHit;
+  std::vector<SpecConstant> raygenSpecialization;  ///< the ray generation shader's specialisation constants
 };
 
 class RayTracingProgram {
