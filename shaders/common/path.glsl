@@ -4,11 +4,16 @@
 // including shader declares the trace's own bindings of trace.h
 // (environment, outImage, aovs, rays) and the push constant `pc`, and
 // defines traceClosest() and firstTriangleOf() after this file. An includer
-// whose lanes share pixels defines SNELL_PIXEL_WRITER: the one lane that writes.
+// whose lanes share pixels defines SNELL_PIXEL_WRITER: the one lane that writes;
+// one whose pixels are a subgroup's lanes may define SNELL_SUBGROUP_MAX and SNELL_SUBGROUP_SIZE.
 #ifndef SNELL_PATH_GLSL
 #define SNELL_PATH_GLSL
 #ifndef SNELL_PIXEL_WRITER
 #define SNELL_PIXEL_WRITER true
+#endif
+#ifndef SNELL_SUBGROUP_MAX
+#define SNELL_SUBGROUP_MAX(v) 0u
+#define SNELL_SUBGROUP_SIZE 0u
 #endif
 
 const float kInf = 1.0 / 0.0;  // folded to +infinity at compile time
@@ -23,6 +28,7 @@ bool surfaceUses(uint bit) { return (kSpecSurface & bit) != 0u; }
 
 uint visits;  // nodes visited by this pixel's whole path (the driver's pipeline cannot count them: 0)
 uint boxTests, triangleTests;  // child boxes and triangles tested over the path (trace.comp counts them)
+uint walkSteps, subgroupSteps;  // traversal loop passes of this lane, and of its subgroup it led (trace.comp)
 uint segments;  // closest-hit queries of the path so far
 uint tracedPixel;  // row-major index of the pixel being traced
 
@@ -375,7 +381,7 @@ void tracePixel(uvec2 pixel) {
   }
   if (!opticsOn(kOpticsTextureLod)) width = spread = 0.0;
 
-  visits = boxTests = triangleTests = segments = 0u;
+  visits = boxTests = triangleTests = segments = walkSteps = subgroupSteps = 0u;
   tracedPixel = pixel.y * pc.width + pixel.x;
   // One call site for the path (a compiler that inlines would copy it per
   // call): the first pass at the base IOR, then, where it met dispersion,
@@ -396,6 +402,8 @@ void tracePixel(uvec2 pixel) {
   }
   path.colour = colour;
 
+  // Every lane of the subgroup is here (main calls this once, outside any branch that lanes take apart).
+  uint subgroupVisits = traceFlag(kTraceFlagAov) ? SNELL_SUBGROUP_MAX(visits) : 0u;
   if (!(SNELL_PIXEL_WRITER)) return;
   imageStore(outImage, ivec2(pixel), vec4(path.colour, 1.0));
   if (traceFlag(kTraceFlagAov)) {
@@ -405,7 +413,8 @@ void tracePixel(uvec2 pixel) {
     aovs[pixel.y * pc.width + pixel.x] = TraceAov(path.firstDistance, path.firstInstance, path.firstPrimitive,
                                                   path.interfaces, path.outcome, visits, path.landing.x, path.landing.y,
                                                   path.landingMaterial, path.landingLod, shine.r, shine.g, shine.b,
-                                                  weight.r, weight.g, weight.b, segments, boxTests, triangleTests, 0u);
+                                                  weight.r, weight.g, weight.b, segments, boxTests, triangleTests,
+                                                  walkSteps, subgroupSteps, subgroupVisits, SNELL_SUBGROUP_SIZE, 0u);
   }
 }
 

@@ -8,6 +8,7 @@
 #extension GL_KHR_shader_subgroup_basic : require
 #extension GL_KHR_shader_subgroup_ballot : require
 #extension GL_KHR_shader_subgroup_shuffle : require
+#extension GL_KHR_shader_subgroup_arithmetic : require
 #include "../shared/bvh.h"
 #include "../shared/trace.h"
 #include "bvh/bvh_node.glsl"
@@ -37,6 +38,8 @@ layout(std430, binding = kTraceBindingPixels) readonly buffer Pixels {
 // its path (their hits are the same), and the first of them writes it.
 uint clusterLane() { return gl_SubgroupInvocationID & (kLanes - 1u); }
 #define SNELL_PIXEL_WRITER (clusterLane() == 0u)
+#define SNELL_SUBGROUP_MAX(v) subgroupMax(v)
+#define SNELL_SUBGROUP_SIZE gl_SubgroupSize
 #include "../common/path.glsl"
 
 const uint kStackSize = 64u;
@@ -45,6 +48,15 @@ const uint kStackSize = 64u;
 
 uint stack[kStackSize];
 uint budget;  // nodes this segment may still visit, top and bottom levels together
+
+// One pass of a traversal loop, counted for the AOV (TraceAov::walkSteps):
+// by this lane, and by the subgroup's lowest lane still in the loop for the
+// whole subgroup, so the host can tell how many lanes each pass kept busy.
+void countStep() {
+  if (!traceFlag(kTraceFlagAov)) return;
+  ++walkSteps;
+  if (subgroupElect()) ++subgroupSteps;
+}
 
 // Woop, Benthin & Wald 2013: the ray's shear, computed once per space.
 struct ShearedRay {
@@ -180,6 +192,7 @@ void traverseBlas(uint instance, vec3 origin, vec3 dir, uint skipPrim, float tMi
   uint leaves[2] = uint[2](ref & ~kBvhLeafBit, 0u);
   uint leafCount = haveNode ? 0u : 1u;
   for (;;) {
+    countStep();
     for (uint k = 0u; k < leafCount; ++k) {
       testTriangle(r, instance, leaves[k], skipPrim, group.first, end, tMin, hit.t, hit);
     }
@@ -223,6 +236,7 @@ Hit traverse(vec3 origin, vec3 dir, uint skipInstance, uint skipPrim, float tMin
   // it again in every instance the top level leads to.
   budget = kTraceMaxVisits;
   while (sp > 0u && budget > 0u) {
+    countStep();
     --budget;
     uint ref = stack[--sp];
     ++visits;

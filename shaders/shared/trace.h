@@ -192,7 +192,7 @@ SNELL_CONST kOutcomeInterfaceLimit = 2;  // more refractive faces than maxInterf
 
 
 // Per-pixel outputs for tests and tools, written when TracePush::flags has kTraceFlagAov.
-// 80 bytes, total: 80 bytes
+// 96 bytes, total: 96 bytes
 struct TraceAov {
   float distance;   // 4: to the first hit along the unit primary ray; -1 on a miss
   uint instance;    // 4: draw item of the first hit, kNoHit on a miss
@@ -221,6 +221,16 @@ struct TraceAov {
   uint segments;        // 4
   uint boxTests;        // 4
   uint triangleTests;   // 4
+  // How busy the subgroup's lanes were (trace.comp; 0 from the driver's
+  // pipeline, and no passes from the several-lanes walk): passes of the traversal loops this
+  // pixel's lane made, passes its subgroup made that this lane led (the
+  // lowest lane still walking counts them), the most node visits of any
+  // pixel of its subgroup, and the subgroup's size. sum(walkSteps) /
+  // sum(subgroupSteps x subgroupSize) is the loops' lane utilisation.
+  uint walkSteps;       // 4
+  uint subgroupSteps;   // 4
+  uint subgroupVisits;  // 4
+  uint subgroupSize;    // 4
   uint pad0;            // 4
 };
 

@@ -1,6 +1,7 @@
 // `snell bench cost`: what one traced frame costs and where its time goes.
 // Per pixel: closest-hit queries (segments), node visits, child boxes and
-// triangles tested (the trace's AOV counters); and the hit-replay ablation:
+// triangles tested (the trace's AOV counters), and how many of a subgroup's
+// lanes its traversal loops kept at work; and the hit-replay ablation:
 // the same view traced again reading each segment's recorded hit instead of
 // traversing, so the trace's time splits into traversal and the rest
 // (shading, refraction, textures). The driver's ray tracing is timed beside
@@ -36,13 +37,23 @@ struct Options {
 struct CostCounters {
   double segments = 0, visits = 0, boxTests = 0, triangleTests = 0;
   uint32_t visitsP50 = 0, visitsP99 = 0, visitsMax = 0, segmentsMax = 0;
+  /// The traversal loops' lanes at work: the share of a subgroup's lanes still
+  /// walking, over the passes it made (0: not counted, as by the driver's pipeline).
+  double laneUtilisation = 0;
+  /// How much longer a subgroup's longest walk is than its pixels' mean walk:
+  /// the sum over pixels of their subgroup's most node visits over the sum of their own.
+  double longestOverMean = 0;
 };
 
 CostCounters countersOf(const std::vector<gpu::TraceAov>& aov) {
   CostCounters c;
   std::vector<uint32_t> visits;
   visits.reserve(aov.size());
+  double laneSteps = 0, subgroupLanes = 0, longest = 0;
   for (const gpu::TraceAov& a : aov) {
+    laneSteps += a.walkSteps;
+    subgroupLanes += double(a.subgroupSteps) * a.subgroupSize;
+    longest += a.subgroupVisits;
     c.segments += a.segments;
     c.visits += a.nodeVisits;
     c.boxTests += a.boxTests;
@@ -50,6 +61,8 @@ CostCounters countersOf(const std::vector<gpu::TraceAov>& aov) {
     c.segmentsMax = std::max(c.segmentsMax, a.segments);
     visits.push_back(a.nodeVisits);
   }
+  if (subgroupLanes > 0) c.laneUtilisation = laneSteps / subgroupLanes;
+  if (c.visits > 0) c.longestOverMean = longest / c.visits;
   double n = std::max<double>(double(aov.size()), 1.0);
   c.segments /= n, c.visits /= n, c.boxTests /= n, c.triangleTests /= n;
   if (!visits.empty()) {
@@ -132,6 +145,10 @@ int runCost(const Options& o) {
               cost.boxTests, cost.triangleTests);
   std::printf("per segment: %.2f node visits, %.2f child boxes, %.2f triangles\n", cost.visits / cost.segments,
               cost.boxTests / cost.segments, cost.triangleTests / cost.segments);
+  std::printf("lanes: %.1f%% of a subgroup's lanes walk in each pass of the traversal loops (subgroups of %u); "
+              "a subgroup's longest walk is %.2fx its pixels' mean\n",
+              100.0 * cost.laneUtilisation, pixels.aov.empty() ? 0u : pixels.aov.front().subgroupSize,
+              cost.longestOverMean);
   if (driver) std::printf("driver-rt: %.3f segments per pixel\n", driverCost.segments);
   std::printf("\n%-22s %10s %12s\n", "trace", "median ms", "G segments/s");
   for (const std::string& row : rows) {
@@ -158,6 +175,9 @@ int runCost(const Options& o) {
                               {"node_visits_max", cost.visitsMax},
                               {"child_box_tests", cost.boxTests},
                               {"triangle_tests", cost.triangleTests}};
+    j["lane_utilisation"] = cost.laneUtilisation;
+    j["subgroup_longest_over_mean_visits"] = cost.longestOverMean;
+    j["subgroup_size"] = pixels.aov.empty() ? 0u : pixels.aov.front().subgroupSize;
     if (driver) j["driver_segments_per_pixel"] = driverCost.segments;
     io::Json medians = io::Json::object();
     for (const std::string& row : rows) medians[row] = io::median(times[row]);
