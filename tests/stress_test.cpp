@@ -1,6 +1,6 @@
 // The numerical stability grid at test size: every case rendered by the GPU and
 // by the CPU reference must agree within the case's stated bounds, with no NaN,
-// no leak and no self-hit anywhere. The full-size sweep is `snell bench stress`.
+// no leak, no self-hit and (where a case counts them) no missed hit anywhere. The full-size sweep is `snell bench stress`.
 #include "gpu_test.h"
 
 #include "render/one_view.h"
@@ -37,6 +37,7 @@ TEST_P(StressGrid, GpuAgreesWithTheReferenceWithoutNanLeakOrSelfHit) {
   EXPECT_EQ(r.nanCount, 0u);
   EXPECT_EQ(r.leakCount, 0u);
   EXPECT_EQ(r.selfHitCount, 0u);
+  EXPECT_EQ(r.missedHits, 0u) << "aimed rays whose first hit is not the reference's";
   EXPECT_EQ(r.capHits, 0u);
   EXPECT_LE(r.energyError, 1e-6) << "|R + T - 1| at a boundary, in the reference";
   EXPECT_LE(r.maxError, c.maxError) << "largest channel error, 1/255";

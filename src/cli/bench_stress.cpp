@@ -21,8 +21,8 @@ int runStress(const Options& o) {
   if (!o.json.empty()) io::checkWritable(o.json);
   auto context = vk::Context::create(io::contextDescFromEnvironment());
   std::printf("device: %s\n", context->facts().name.c_str());
-  std::printf("%-58s %8s %6s %7s %7s %5s %6s %6s %6s %7s %7s %8s\n", "case", "pixels", "max", "mean", ">1/255", "NaN",
-              "leaks", "self", "caps", "dropped", "seconds", "|R+T-1|");
+  std::printf("%-58s %8s %6s %7s %7s %5s %6s %6s %6s %6s %7s %7s %8s\n", "case", "pixels", "max", "mean", ">1/255",
+              "NaN", "leaks", "self", "missed", "caps", "dropped", "seconds", "|R+T-1|");
   std::vector<stress::Result> results;
   bool bad = false;
   for (const stress::Case& c : stress::grid(o.grid)) {
@@ -31,14 +31,15 @@ int runStress(const Options& o) {
     if (!r.error.empty()) {
       std::printf("%-58.58s error: %s\n", r.name.c_str(), r.error.c_str());
     } else {
-      std::printf("%-58.58s %8llu %6d %7.3f %7llu %5llu %6llu %6llu %6llu %7llu %7.1f %8.1e\n", r.name.c_str(),
+      std::printf("%-58.58s %8llu %6d %7.3f %7llu %5llu %6llu %6llu %6llu %6llu %7llu %7.1f %8.1e\n", r.name.c_str(),
                   (unsigned long long)r.pixels, r.maxError, r.meanError, (unsigned long long)r.overOne,
                   (unsigned long long)r.nanCount, (unsigned long long)r.leakCount, (unsigned long long)r.selfHitCount,
-                  (unsigned long long)r.capHits, (unsigned long long)r.dropped, r.seconds, r.energyError);
+                  (unsigned long long)r.missedHits, (unsigned long long)r.capHits, (unsigned long long)r.dropped,
+                  r.seconds, r.energyError);
     }
     if (o.verbose && !r.firstProblems.empty()) std::fputs(r.firstProblems.c_str(), stdout);
     std::fflush(stdout);
-    bad = bad || r.nanCount || r.leakCount || r.selfHitCount || r.energyError > 1e-6;
+    bad = bad || r.nanCount || r.leakCount || r.selfHitCount || r.missedHits || r.energyError > 1e-6;
     results.push_back(r);
   }
   if (!o.json.empty()) {
@@ -54,6 +55,7 @@ int runStress(const Options& o) {
                                {"nan_count", r.nanCount},
                                {"leak_count", r.leakCount},
                                {"self_hit_count", r.selfHitCount},
+                               {"missed_hits", r.missedHits},
                                {"cap_hits", r.capHits},
                                {"energy_error", r.energyError},
                                {"dropped_triangles", r.dropped},
@@ -85,10 +87,12 @@ void addBenchStress(CLI::App& bench, Runner& run) {
       "Columns: max and mean channel error against the reference (sRGB, 1/255),\n"
       "pixels more than 1/255 off, NaN pixels, leaks (aimed rays that slipped\n"
       "between triangles or never left a closed mesh), self-hits (more crossings\n"
-      "than the reference), rays that hit the traversal's step cap, triangles the\n"
-      "GPU dropped as non-finite, and |R+T-1|: the reference's largest energy\n"
-      "error at any boundary (T from the Fresnel amplitudes, not 1 - R). Exits 1\n"
-      "when any case leaks, self-hits or NaNs, or an energy error passes 1e-6.");
+      "than the reference), missed hits (in the edges group: aimed rays whose\n"
+      "first hit is not the reference's), rays that hit the traversal's step cap,\n"
+      "triangles the GPU dropped as non-finite, and |R+T-1|: the reference's\n"
+      "largest energy error at any boundary (T from the Fresnel amplitudes, not\n"
+      "1 - R). Exits 1 when any case leaks, self-hits, misses or NaNs, or an\n"
+      "energy error passes 1e-6.");
   sub->footer(kHelpFooter);
   addSize(*sub, "--size", o->grid.imageWidth, o->grid.imageHeight, "image cases' size (default 96x72)");
   sub->add_option("--rays", o->grid.aimedRaysSide, "aimed-ray cases trace N x N rays (default 1024: about 10^6)")

@@ -10,6 +10,7 @@
 #include "scene/view.h"
 #include "vk/context.h"
 
+#include <array>
 #include <functional>
 #include <string>
 #include <vector>
@@ -63,7 +64,7 @@ enum class Kind {
 
 struct Case {
   std::string name;
-  std::string group;  ///< far, scale, grazing, ior, watertight, self-hit, degenerate, deform, size
+  std::string group;  ///< far, scale, grazing, ior, watertight, edges, self-hit, degenerate, deform, optics, size
   Kind kind = Kind::Image;
   std::function<scene::Scene()> makeScene;
   uint32_t width = 64, height = 48;
@@ -71,6 +72,16 @@ struct Case {
   std::function<scene::View(const scene::Scene&, const scene::Pose&)> view;
   /// Ray lists: width * height rays and, per ray, how far its aimed point is.
   std::function<void(const scene::Scene&, const scene::Pose&, std::vector<scene::Ray>&, std::vector<double>&)> aim;
+  /// Rays aimed through the trees' own boxes (the edges group): the case renders
+  /// a camera frame first, which builds the trees, and this gets every child
+  /// box of the first shape's bottom-level tree as the trace decodes it
+  /// (quantised, in the shape's own space, which is the world for these cases'
+  /// root shapes) instead of `aim`.
+  std::function<void(const scene::Scene&, const scene::Pose&, const std::vector<std::array<float, 6>>& boxes,
+                     std::vector<scene::Ray>&, std::vector<double>&)>
+      aimAtBoxes;
+  /// Whether each aimed ray's first hit must be the reference's (Result::missedHits).
+  bool countMissedHits = false;
   /// Whether every aimed ray must come out again: a closed mesh of IOR 1, where
   /// every crossing is a refraction (internal reflections also count as crossings).
   bool closed = false;
@@ -102,6 +113,9 @@ struct Result {
   uint64_t nanCount = 0;     ///< GPU pixels with a NaN or infinite channel
   uint64_t leakCount = 0;    ///< aimed rays that slipped through, or entered a closed mesh and never left
   uint64_t selfHitCount = 0; ///< aimed rays that crossed more faces than the reference (hit their own surface)
+  /// Aimed rays whose first hit is not the reference's: none where the
+  /// reference has one, or at another distance (Case::countMissedHits).
+  uint64_t missedHits = 0;
   uint64_t capHits = 0;      ///< rays that ran into the traversal's step cap
   uint64_t dropped = 0;      ///< triangles the GPU dropped as non-finite
   double energyError = 0.0;  ///< the reference's largest |R + T - 1| at any boundary (T from amplitudes)

@@ -2,6 +2,7 @@
 // CPU reference) and compared.
 #include "io/image_file.h"
 #include "ref/reference_tracer.h"
+#include "render/bvh.h"
 #include "render/one_view.h"
 #include "render/renderer.h"
 #include "stress/stress.h"
@@ -81,6 +82,10 @@ std::vector<WorldTriangle> worldTriangles(const scene::Scene& s, const scene::Po
   return triangles;
 }
 
+using AimFn = std::function<void(const scene::Scene&, const scene::Pose&, std::vector<scene::Ray>&, std::vector<double>&)>;
+using BoxAimFn = std::function<void(const scene::Scene&, const scene::Pose&, const std::vector<std::array<float, 6>>&,
+                                    std::vector<scene::Ray>&, std::vector<double>&)>;
+
 // Where an aimed ray starts, given the aimed point, the unit geometric normal
 // of the triangle it was taken from, and the ray's index.
 using OriginFn = std::function<glm::dvec3(const glm::dvec3& p, const glm::dvec3& normal, size_t i)>;
@@ -137,6 +142,104 @@ OriginFn fromCentre(glm::dvec3 centre, double distance) {
   };
 }
 
+// Rays through the trees' own boxes: each passes exactly through a corner, a
+// point on an edge or a point on a face of a child box of the shape's tree
+// (group 0: the scene's first shape), on its way to a point well inside one
+// of the shape's triangles that it meets at least 15 degrees off grazing, so
+// it crosses the surface rather than touching it. With `axisRays`, every
+// fourth ray instead runs parallel to an axis through a box corner (its
+// direction has two zero components, the slab test's stand-in case); for the
+// unit sphere of sphereScene, only those whose line passes at least 0.05 from
+// its surface (a tangent ray may touch or miss in either precision), starting
+// 2 from its centre, aimed at no surface (distance -1).
+BoxAimFn aimAtBoxes(double distance, bool axisRays) {
+  return [=](const scene::Scene& s, const scene::Pose& pose, const std::vector<std::array<float, 6>>& all,
+             std::vector<scene::Ray>& rays, std::vector<double>& distances) {
+    std::vector<std::array<float, 6>> boxes;
+    for (const auto& b : all) {
+      if (b[0] <= b[3] && b[1] <= b[4] && b[2] <= b[5]) boxes.push_back(b);  // empty children hold nothing
+    }
+    auto triangles = worldTriangles(s, pose, [](const std::string& n) { return n.rfind("backdrop", 0) != 0; });
+    if (boxes.empty() || triangles.empty()) throw std::logic_error("stress: no boxes or triangles to aim at");
+    std::mt19937_64 rng(11);
+    std::uniform_real_distribution<double> u(0.0, 1.0);
+    distances.assign(rays.size(), -1.0);
+    for (size_t i = 0; i < rays.size(); ++i) {
+      for (size_t tries = 0;; ++tries) {
+        if (tries > 1000) throw std::logic_error("stress: no ray through a box found");
+        const auto& b = boxes[size_t(rng() % boxes.size())];
+        glm::dvec3 lo(b[0], b[1], b[2]), hi(b[3], b[4], b[5]);
+        // Per axis the low face, the high face, or (an edge's or a face's free axes) anywhere between.
+        int what = int(i % 4), free = int(rng() % 3);
+        glm::dvec3 c;
+        for (int axis = 0; axis < 3; ++axis) {
+          bool between = (what == 1 && axis == free) || (what == 2 && axis != free);
+          c[axis] = between ? lo[axis] + u(rng) * (hi[axis] - lo[axis]) : (rng() % 2 ? hi[axis] : lo[axis]);
+        }
+        if (what == 3 && axisRays) {
+          glm::dvec3 d(0.0);
+          d[free] = rng() % 2 ? 1.0 : -1.0;
+          glm::dvec3 across = c - glm::dot(c, d) * d;  // from the centre to the line
+          if (std::abs(glm::length(across) - 1.0) < 0.05) continue;
+          rays[i] = {across - 2.0 * d, d};  // from outside the sphere, before the backdrop (at 3)
+          break;
+        }
+        const WorldTriangle& tri = triangles[size_t(rng() % triangles.size())];
+        double b1 = u(rng), b2 = u(rng);
+        if (b1 + b2 > 1.0) b1 = 1.0 - b1, b2 = 1.0 - b2;
+        b1 = 0.1 + 0.7 * b1, b2 = 0.1 + 0.7 * b2;  // every barycentric at least 0.1: well inside every edge
+        glm::dvec3 q = (1.0 - b1 - b2) * tri.v[0] + b1 * tri.v[1] + b2 * tri.v[2];
+        glm::dvec3 normal = glm::normalize(glm::cross(tri.v[1] - tri.v[0], tri.v[2] - tri.v[0]));
+        if (!(glm::length(q - c) > 1e-3)) continue;
+        glm::dvec3 d = glm::normalize(q - c);
+        if (!(std::abs(glm::dot(d, normal)) >= 0.25)) continue;
+        rays[i] = {c - distance * d, d};
+        distances[i] = distance + glm::length(q - c);
+        break;
+      }
+    }
+  };
+}
+
+// Rays that graze the faces of the cube of cubeScene: aimed at points of the
+// top face's inner shared edges (where two of its coplanar triangles meet) at
+// 0.05 to 3 degrees above the face; every fifth ray runs parallel to the face
+// 1e-4 above it and must not touch it (aimed distance -1).
+AimFn grazeTheCube(double distance) {
+  return [=](const scene::Scene& s, const scene::Pose& pose, std::vector<scene::Ray>& rays,
+             std::vector<double>& distances) {
+    std::vector<std::pair<glm::dvec3, glm::dvec3>> edges;  // inner shared edges of the top face
+    for (const WorldTriangle& tri : worldTriangles(s, pose, [](const std::string& n) { return n == "cube"; })) {
+      for (size_t k = 0; k < 3; ++k) {
+        const glm::dvec3 &a = tri.v[k], &b = tri.v[(k + 1) % 3];
+        auto inner = [](const glm::dvec3& v) { return v.y == 1.0 && std::abs(v.x) < 0.99 && std::abs(v.z) < 0.99; };
+        if (tri.sharedEdge[k] && inner(a) && inner(b)) edges.emplace_back(a, b);
+      }
+    }
+    if (edges.empty()) throw std::logic_error("stress: the cube's top face has no inner edge");
+    const double angles[] = {0.05, 0.2, 1.0, 3.0};
+    std::mt19937_64 rng(13);
+    std::uniform_real_distribution<double> u(0.0, 1.0);
+    distances.resize(rays.size());
+    for (size_t i = 0; i < rays.size(); ++i) {
+      const auto& [a, b] = edges[(i * 7919) % edges.size()];
+      glm::dvec3 p = a + u(rng) * (b - a);
+      double phi = 2.0 * glm::pi<double>() * u(rng);
+      glm::dvec3 along(std::cos(phi), 0.0, std::sin(phi));
+      if (i % 5 == 4) {  // parallel, just above: it crosses the whole face without touching it
+        p.y += 1e-4;
+        rays[i] = {p - distance * along, along};
+        distances[i] = -1.0;
+        continue;
+      }
+      double theta = angles[i % 5 % 4] * kDegree;
+      glm::dvec3 d = std::cos(theta) * along - std::sin(theta) * glm::dvec3(0.0, 1.0, 0.0);
+      rays[i] = {p - distance * d, d};
+      distances[i] = distance;
+    }
+  };
+}
+
 Case image(std::string name, std::string group, std::function<scene::Scene()> make, ViewFn view,
            const GridOptions& o, int maxError, double overOneShare = 0.002) {
   Case c;
@@ -152,8 +255,7 @@ Case image(std::string name, std::string group, std::function<scene::Scene()> ma
 }
 
 Case aimed(std::string name, std::string group, std::function<scene::Scene()> make, ViewFn view, const GridOptions& o,
-           std::function<void(const scene::Scene&, const scene::Pose&, std::vector<scene::Ray>&, std::vector<double>&)> aim,
-           bool closed) {
+           AimFn aim, bool closed) {
   // Aimed rays are about leaks and self-hits: their colours are compared with
   // a loose bound, since rays aimed at one edge land side by side on the backdrop's tile borders.
   Case c = image(std::move(name), std::move(group), std::move(make), std::move(view), o, 255, 0.03);
@@ -223,6 +325,25 @@ std::vector<Case> grid(const GridOptions& o) {
                                      rays, d);
                         },
                         false));
+
+  // Edges and corners, each aimed ray's first hit held to the reference's:
+  // shared edges and vertices of a finer sphere, the corners, edges and faces
+  // of the trees' quantised boxes (axis-parallel rays among them), and rays
+  // grazing a flat face or running parallel just above it.
+  auto edgesCase = [&](std::string name, std::function<scene::Scene()> make, AimFn aim, bool closed) {
+    cases.push_back(aimed("edges: " + name, "edges", std::move(make), sphereView, o, std::move(aim), closed));
+    cases.back().countMissedHits = true;
+  };
+  edgesCase("shared edges and vertices of a sphere of 20000 triangles (IOR 1)", [] { return sphereScene(100, 1.0f); },
+            aimAt(3.0), true);
+  edgesCase("through corners, edges and faces of the sphere's quantised boxes (IOR 1)",
+            [] { return sphereScene(48, 1.0f); }, nullptr, true);
+  cases.back().aimAtBoxes = aimAtBoxes(3.0, true);
+  edgesCase("through corners, edges and faces of the cube's quantised boxes (IOR 1)", [] { return cubeScene(6, 1.0f); },
+            nullptr, true);
+  cases.back().aimAtBoxes = aimAtBoxes(3.0, false);
+  edgesCase("grazing the cube's face at 0.05 to 3 degrees, and parallel 1e-4 above it (IOR 1)",
+            [] { return cubeScene(6, 1.0f); }, grazeTheCube(4.0), true);
 
   // Self-intersection: thin slabs, rays through the top face's edges at an angle.
   for (float thickness : {1e-2f, 1e-3f, 1e-4f, 1e-5f}) {
@@ -354,6 +475,15 @@ Result run(vk::Context& context, const Case& c) {
     scene::Scene s = c.makeScene();
     scene::Pose firstPose = scene::evaluate(s, c.time);
     render::Renderer renderer(context, s, firstPose);
+    std::vector<std::array<float, 6>> boxes;
+    if (c.aimAtBoxes) {  // a camera frame builds the trees the rays are aimed at
+      render::FrameSettings first{c.width, c.height, c.view(s, firstPose), glm::vec3(scene::kDefaultBackground), 1};
+      render::renderFrame(renderer, firstPose, first);
+      render::BvhSnapshot tree = renderer.builder()->download(*renderer.blas());
+      render::BvhSnapshot::TreeBoxes t = tree.treeBoxes(0);  // the scene's first shape, the one aimed at
+      boxes.insert(boxes.end(), t.internal.begin(), t.internal.end());
+      boxes.insert(boxes.end(), t.leaves.begin(), t.leaves.end());
+    }
     for (uint32_t frame = 0; frame < c.frames; ++frame) {
       scene::Pose pose = scene::evaluate(s, c.time);
       if (c.morph) c.morph(pose, frame);
@@ -366,7 +496,11 @@ Result run(vk::Context& context, const Case& c) {
       std::vector<double> aimedDistance;
       if (c.kind == Kind::AimedRays) {
         settings.rays.resize(size_t(c.width) * c.height);
-        c.aim(s, pose, settings.rays, aimedDistance);
+        if (c.aimAtBoxes) {
+          c.aimAtBoxes(s, pose, boxes, settings.rays, aimedDistance);
+        } else {
+          c.aim(s, pose, settings.rays, aimedDistance);
+        }
       }
       render::RenderedFrame gpu = render::renderFrame(renderer, pose, settings, true);
       ref::ReferenceSettings rs;
@@ -407,24 +541,32 @@ Result run(vk::Context& context, const Case& c) {
           }
           continue;
         }
-        // Slipped through: no hit, or the first hit beyond the point the ray was aimed at.
+        // Slipped through: no hit, or the first hit beyond the point the ray was
+        // aimed at (a ray aimed at no surface, distance -1, cannot slip).
         double slack = 1e-4 * aimedDistance[i];
-        bool slipped = a.distance < 0.0f || double(a.distance) > aimedDistance[i] + slack;
+        bool slipped = aimedDistance[i] >= 0.0 && (a.distance < 0.0f || double(a.distance) > aimedDistance[i] + slack);
+        // Missed: the reference's first hit is not the GPU's (none, or at another distance).
+        bool referenceHit = std::isfinite(cpu.distance[i]), gpuHit = a.distance >= 0.0f;
+        bool missed = c.countMissedHits &&
+                      (referenceHit != gpuHit ||
+                       (referenceHit && std::abs(double(a.distance) - cpu.distance[i]) > 1e-4 * cpu.distance[i] + 1e-6));
+        r.missedHits += missed ? 1 : 0;
         // In a closed mesh every entry has an exit: an odd count that did not
         // stop at the interface limit means the ray got out through a gap.
         bool stranded = c.closed && (a.interfaces % 2 == 1) && a.outcome != gpu::kOutcomeInterfaceLimit;
         bool selfHit = c.countSelfHits && a.interfaces > cpu.interfaces[i] && cpu.outcome[i] != gpu::kOutcomeInterfaceLimit;
         r.leakCount += slipped || stranded ? 1 : 0;
         r.selfHitCount += selfHit ? 1 : 0;
-        if ((slipped || stranded || selfHit) && problems < 6) {
+        if ((slipped || stranded || selfHit || missed) && problems < 6) {
           ++problems;
           char line[512];
           const scene::Ray& ray = settings.rays[i];
           std::snprintf(line, sizeof line,
-                        "  ray %zu%s%s%s: origin (%.9g, %.9g, %.9g) direction (%.9g, %.9g, %.9g) aimed at %.9g; "
+                        "  ray %zu%s%s%s%s: origin (%.9g, %.9g, %.9g) direction (%.9g, %.9g, %.9g) aimed at %.9g; "
                         "GPU first hit %.9g item %u prim %u, %u crossings, outcome %u; reference %.9g item %d prim %d, %u "
                         "crossings, outcome %u\n",
-                        i, slipped ? " slipped" : "", stranded ? " stranded" : "", selfHit ? " self-hit" : "", ray.origin.x,
+                        i, slipped ? " slipped" : "", stranded ? " stranded" : "", selfHit ? " self-hit" : "",
+                        missed ? " missed" : "", ray.origin.x,
                         ray.origin.y, ray.origin.z, ray.direction.x, ray.direction.y, ray.direction.z, aimedDistance[i],
                         double(a.distance), a.instance, a.primitive, a.interfaces, a.outcome, cpu.distance[i], cpu.instance[i], cpu.primitive[i],
                         cpu.interfaces[i], cpu.outcome[i]);
