@@ -83,21 +83,29 @@ Surface surfaceAt(Hit hit) {
   return s;
 }
 
-// How fast the triangle's surface turns (trace.h: Textures): the largest
-// change of its unit world vertex normals per unit of edge length; 0 where
-// it has no normals or a degenerate edge.
-float curvatureAt(Hit hit) {
+// How the triangle's surface curves (trace.h: Textures), signed: the mean
+// over its edges of dot(n_j - n_i, p_j - p_i) / |p_j - p_i|^2, its unit world
+// vertex normals turned together to ng's side, so it is positive where the
+// surface bulges towards ng's side; 0 without normals or with no edge.
+float curvatureAt(Hit hit, vec3 ng) {
   GpuInstance inst = instances[hit.instance];
   uvec3 i = triangleAt(hit.primitive);
   mat3 toWorldNormal = normalToWorld(inst);
   vec3 n0 = toWorldNormal * normalAt(i.x), n1 = toWorldNormal * normalAt(i.y), n2 = toWorldNormal * normalAt(i.z);
   if (dot(n0, n0) == 0.0 || dot(n1, n1) == 0.0 || dot(n2, n2) == 0.0) return 0.0;
   n0 = normalize(n0), n1 = normalize(n1), n2 = normalize(n2);
+  if (dot(n0 + n1 + n2, ng) < 0.0) n0 = -n0, n1 = -n1, n2 = -n2;
   vec3 p0 = vectorToWorld(inst, vertexAt(i.x)), p1 = vectorToWorld(inst, vertexAt(i.y)),
        p2 = vectorToWorld(inst, vertexAt(i.z));
-  float k = max(max(length(n1 - n0) / length(p1 - p0), length(n2 - n1) / length(p2 - p1)),
-                length(n0 - n2) / length(p0 - p2));
-  return k < 1e30 ? k : 0.0;  // NaN and infinity: 0
+  vec3 e01 = p1 - p0, e12 = p2 - p1, e20 = p0 - p2;
+  vec3 lengths = vec3(dot(e01, e01), dot(e12, e12), dot(e20, e20));
+  vec3 turns = vec3(dot(n1 - n0, e01), dot(n2 - n1, e12), dot(n0 - n2, e20));
+  float sum = 0.0, edges = 0.0;
+  for (int e = 0; e < 3; ++e) {
+    if (lengths[e] > 0.0) sum += turns[e] / lengths[e], edges += 1.0;
+  }
+  float k = edges > 0.0 ? sum / edges : 0.0;
+  return abs(k) < 1e30 ? k : 0.0;  // NaN and infinity: 0
 }
 
 // The shading normal at a hit bent by its material's normal map, whose texel
@@ -313,7 +321,8 @@ bool tracePath(vec3 origin, vec3 dir, float width, float spread, int channel, ou
     float reflectedSpread = 0.0;
     width = hitWidth;
     if (bends) {
-      float widening = curvatureAt(hit) * hitWidth;  // how far the normal turns across the cone
+      // How far the normal turns across the cone, > 0 where the surface bulges towards the ray.
+      float turn = (entering ? 1.0 : -1.0) * curvatureAt(hit, s.ng) * hitWidth;
       vec3 n = entering ? s.ns : -s.ns;
       float eta = n1 / n2;
       float c = -dot(dir, n);
@@ -324,7 +333,7 @@ bool tracePath(vec3 origin, vec3 dir, float width, float spread, int channel, ou
       float k = 1.0 - eta * eta * (1.0 - c * c);
       if (k < 0.0) {
         dir = normalize(dir + 2.0 * c * n);  // total internal reflection keeps everything
-        spread += 2.0 * widening;
+        spread += 2.0 * turn;
       } else {
         float r = fresnel ? fresnelReflectance(eta, c) : 0.0;
         if (reflections > 0u) {
@@ -333,11 +342,11 @@ bool tracePath(vec3 origin, vec3 dir, float width, float spread, int channel, ou
             path.colour += throughput * highlight(s.position, n, dir, m.roughness, eta);
             reflectedWeight = throughput * r;
             reflected = normalize(dir + 2.0 * c * n);
-            reflectedSpread = spread + 2.0 * widening;
+            reflectedSpread = spread + 2.0 * turn;
           }
         }
         dir = normalize(eta * dir + (eta * c - sqrt(k)) * n);
-        spread = eta * spread + abs(1.0 - eta) * widening;
+        spread = eta * spread - (1.0 - eta) * turn;  // a surface that converges light narrows the cone
         throughput *= 1.0 - r;
       }
     }

@@ -108,9 +108,10 @@ vec2 uvDensity(vec3 e1, vec3 e2, vec4 uv0, vec4 uv1, vec4 uv2) {
 }
 
 // The level of detail a cone of `width` meeting the face at cosine `cosine`
-// (with its geometric normal) reads a texture of lodOffset 0 at.
+// (with its geometric normal) reads a texture of lodOffset 0 at. Past a focus
+// a cone's width is negative: its footprint is the width's size.
 vec2 coneLod(vec2 density, float width, float cosine) {
-  return density + vec2(log2(width) - log2(abs(cosine)));
+  return density + vec2(log2(abs(width)) - log2(abs(cosine)));
 }
 
 // The slot's UV set through its KHR_texture_transform.

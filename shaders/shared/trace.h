@@ -128,18 +128,23 @@
 //   perspective primary rays w = 0, a = atan(2 tanHalfFovY / H); orthographic
 //   w = 2 halfHeight / H, a = 0; listed rays w = 0, a = 0 (level 0). At a hit
 //   at distance t the cone is w' = w + a t wide, and a texture is read at
-//     lod = 0.5 log2(W H |det T2|) + 0.5 log2(A_uv / A_world) + log2(w') - log2|dot(d, Ng)|,
+//     lod = 0.5 log2(W H |det T2|) + 0.5 log2(A_uv / A_world) + log2|w'| - log2|dot(d, Ng)|,
 //   T2 the transform's 2x2 part, A_uv = |cross2(uv1 - uv0, uv2 - uv0)| of the
 //   texture's UV set and A_world = |cross(v1 - v0, v2 - v0)| (world space);
 //   clamped to [0, levels - 1], and 0 where it is not a number.
 //   The cone goes on from the hit w' wide. At a boundary that bends, with
-//   k = the triangle's curvature, the largest |n_i - n_j| / |v_i - v_j| over
-//   its edges (unit world vertex normals; 0 without normals or on a
-//   degenerate edge): a refracted ray's a' = eta a + |1 - eta| k w'; a
-//   reflected ray and total internal reflection a' = a + 2 k w'. A straight
-//   crossing keeps a. (|1 - eta| widens where a converging lens would narrow:
-//   it errs on the side of blur, never of aliasing.) The raster pass reads
-//   opaque fragments with the primary ray's cone, so it and the trace agree.
+//   k = the triangle's signed curvature as the ray meets it: the mean over its
+//   edges (v_i, v_j) with |v_j - v_i| > 0 of dot(n_j - n_i, v_j - v_i) / |v_j - v_i|^2,
+//   n the unit world vertex normals, all negated where dot(n_0 + n_1 + n_2, Ng) < 0,
+//   and the sum negated again where the ray leaves (dot(d, Ng) > 0), so k > 0
+//   where the surface bulges towards the ray (0 without normals or edges):
+//   a refracted ray's a' = eta a - (1 - eta) k w' (the paraxial refraction of
+//   the cone's edge rays: a surface that converges light narrows the cone, a
+//   magnifier's footprint shrinks); a reflected ray and total internal
+//   reflection a' = a + 2 k w'. A straight crossing keeps a. Past a focus w
+//   is negative: textures read at |w|, lod's log2(w') is log2|w'|. The raster
+//   pass reads opaque fragments with the primary ray's cone, so it and the
+//   trace agree.
 //   The environment map has no mips: reflected rays read it at full size.
 //   With kOpticsTextureLod off, traced rays read every texture at level 0.
 // With kOpticsDispersion off no material disperses (D = 0 everywhere); with

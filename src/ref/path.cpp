@@ -169,11 +169,12 @@ struct Tracer {
           c = -glm::dot(d, n);
         }
         const double k = 1.0 - eta * eta * (1.0 - c * c);
-        const double widening = tri.curvature * width;  // how far the normal turns across the cone
+        // How far the normal turns across the cone, > 0 where the surface bulges towards the ray.
+        const double turn = (entering ? 1.0 : -1.0) * tri.curvature * width;
         glm::dvec3 next;
         if (k < 0.0) {
           next = d + 2.0 * c * n;  // total internal reflection keeps everything
-          spread += 2.0 * widening;
+          spread += 2.0 * turn;
         } else {
           const double r = fresnel ? fresnelReflectance(eta, c) : 0.0;
           if (fresnel) {
@@ -183,12 +184,12 @@ struct Tracer {
             --reflections;
             if (r > 0.0) {
               result.color += throughput * (r * reflected(p, unitOrZero(d + 2.0 * c * n), hit.triangle, width,
-                                                          spread + 2.0 * widening) +
+                                                          spread + 2.0 * turn) +
                                             highlight(prepared, p, n, d, material.roughness, eta));
             }
           }
           next = eta * d + (eta * c - std::sqrt(k)) * n;
-          spread = eta * spread + std::abs(1.0 - eta) * widening;
+          spread = eta * spread - (1.0 - eta) * turn;  // a surface that converges light narrows the cone
           throughput *= 1.0 - r;
         }
         next = unitOrZero(next);

@@ -145,12 +145,18 @@ void PreparedScene::addItem(const scene::Scene& scene, const scene::DrawItem& it
       d.density[set] = 0.5 * std::log2(std::abs(d1.x * d2.y - d1.y * d2.x) / worldArea);
     }
     if (d.n[0] != glm::dvec3(0.0) && d.n[1] != glm::dvec3(0.0) && d.n[2] != glm::dvec3(0.0)) {
-      double k = 0.0;
+      glm::dvec3 n[3] = {glm::normalize(d.n[0]), glm::normalize(d.n[1]), glm::normalize(d.n[2])};
+      const double side = glm::dot(n[0] + n[1] + n[2], d.ng) < 0.0 ? -1.0 : 1.0;  // normals turned to ng's side
+      double sum = 0.0;
+      int edges = 0;
       for (int a = 0; a < 3; ++a) {
         int b = (a + 1) % 3;
-        k = std::max(k, glm::length(d.n[b] - d.n[a]) / glm::length(d.v[b] - d.v[a]));
+        const glm::dvec3 edge = d.v[b] - d.v[a];
+        const double length2 = glm::dot(edge, edge);
+        if (length2 > 0.0) sum += side * glm::dot(n[b] - n[a], edge) / length2, ++edges;
       }
-      d.curvature = k < 1e30 ? k : 0.0;  // NaN and infinity: 0
+      const double k = edges > 0 ? sum / edges : 0.0;
+      d.curvature = std::abs(k) < 1e30 ? k : 0.0;  // NaN and infinity: 0
     }
     d.item = itemIndex;
     d.primitive = int32_t(t);

@@ -34,7 +34,7 @@ struct TriangleData {
   glm::dvec2 uv[2][3];  // TEXCOORD_0 and _1, (0, 0) where missing
   glm::dvec3 ng;     // unit geometric normal
   double density[2] = {0.0, 0.0};  // 0.5 log2(UV area / world area) per UV set (trace.h: Textures)
-  double curvature = 0.0;          // the largest turn of the unit vertex normals per unit of edge
+  double curvature = 0.0;          // signed: the mean turn of the unit vertex normals along its edges, > 0 bulging to ng's side
   int32_t item = -1, primitive = -1;
   int material = -1;
 };

@@ -95,7 +95,7 @@ int64_t floorIndex(double x) {
 }
 
 glm::dvec2 coneLods(const TriangleData& tri, double width, const glm::dvec3& d) {
-  const double footprint = std::log2(width) - std::log2(std::abs(glm::dot(d, tri.ng)));
+  const double footprint = std::log2(std::abs(width)) - std::log2(std::abs(glm::dot(d, tri.ng)));
   return {tri.density[0] + footprint, tri.density[1] + footprint};
 }
 
