@@ -21,7 +21,8 @@
 # ratio of the first build's time to each other's, and whether each build draws the three trace
 # scenes with the same pixels (`snell render --stats-json`'s image hash, first round);
 # $OUT/compare.json holds every measurement. BUILDS (names, space-separated) limits `run` to some of
-# the carried builds; ROWS to some rows (same, trace, viewport).
+# the carried builds, and NAME+VAR=VALUE runs build NAME with VAR=VALUE set (an experiment's switch);
+# ROWS limits it to some rows (same, trace, viewport).
 set -uo pipefail
 cd "$(dirname "$0")/.."
 
@@ -66,6 +67,17 @@ build_one() {
   done
 }
 
+# Runs build NAME, or NAME+VAR=VALUE: that build with VAR=VALUE in its environment (an experiment's switch).
+snell_of() {
+  local b=$1
+  shift
+  if [[ $b == *+*=* ]]; then
+    env "${b#*+}" ".carry/snell-${b%%+*}" "$@"
+  else
+    ".carry/snell-$b" "$@"
+  fi
+}
+
 run_all() {
   local rounds=${1:-3}
   source bench/device_env.sh
@@ -91,14 +103,14 @@ run_all() {
       for ((i = ${#builds[@]} - 1; i >= 0; --i)); do order+=("${builds[i]}"); done
     fi
     for b in "${order[@]}"; do
-      export SNELL_PIPELINE_CACHE=/tmp/compare-cache-$b
+      export SNELL_PIPELINE_CACHE=/tmp/compare-cache-${b//[^A-Za-z0-9_.-]/_}
       mkdir -p "$SNELL_PIPELINE_CACHE"
       if [[ $rows == *trace* ]]; then
         for s in sphere-100k sphere-1m eye; do
           local args=(--eye)
           [[ $s != eye ]] && args=("$scenes/$s.gltf")
           echo "@@ round=$round build=$b row=$s"
-          ".carry/snell-$b" bench methods "${args[@]}" --methods trace,driver-rt --no-reference --frames 8 \
+          snell_of "$b" bench methods "${args[@]}" --methods trace,driver-rt --no-reference --frames 8 \
             --size 1920x1080 2>&1 | grep -E "rays per second"
         done
       fi
@@ -106,7 +118,7 @@ run_all() {
         for s in sphere-100k sphere-1m eye; do
           local args=(--eye)
           [[ $s != eye ]] && args=("$scenes/$s.gltf")
-          ".carry/snell-$b" -q render "${args[@]}" --method trace --size 1920x1080 -o "/tmp/compare-$s-$b.png" \
+          snell_of "$b" -q render "${args[@]}" --method trace --size 1920x1080 -o "/tmp/compare-$s-$b.png" \
             --stats-json "/tmp/compare-$s-$b.json" >/dev/null 2>&1
           echo "@@ round=$round build=$b row=pixels-$s"
           echo "image hash $(grep -o '"image_hash": *"[^"]*"' "/tmp/compare-$s-$b.json" | cut -d'"' -f4)"
@@ -118,7 +130,7 @@ run_all() {
         for v in crowd-2 eye-64 eye-256 crowd-100-4k; do
           echo "@@ round=$round build=$b row=viewport-$v"
           # shellcheck disable=SC2086
-          ".carry/snell-$b" bench frame ${frame[$v]} --viewport --warmup 200 2>&1 | grep -E "^refraction "
+          snell_of "$b" bench frame ${frame[$v]} --viewport --warmup 200 2>&1 | grep -E "^refraction "
         done
       fi
     done | tee -a "$log"
