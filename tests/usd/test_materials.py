@@ -166,19 +166,162 @@ def test_opacity_from_another_file_than_the_diffuse_one_is_a_warning_naming_the_
             "colour texture's alpha") in messages(contents)
 
 
-def test_a_textured_opacity_on_glass_is_a_warning_and_draws_opaque(tmp_path):
-    write_rgba_png(tmp_path / "mask.png", np.zeros((2, 2, 4), np.uint8))
+def test_a_textured_opacity_without_a_threshold_blends_as_gltfs_blend(tmp_path):
+    mask = np.random.default_rng(6).integers(0, 256, (4, 4, 4), dtype=np.uint8)
+    write_rgba_png(tmp_path / "mask.png", mask)
 
     def build(stage, prim):
-        material = preview_material(stage, "/World/Pane")
+        material = preview_material(stage, "/World/Pane", diffuseColor=(0.2, 0.4, 0.6))
         texture(stage, material, "./mask.png", input_name="opacity", output="a")
         bind(prim, material)
 
     contents = read_quad(tmp_path, build)
-    fields = material_of(contents).fields
-    assert fields["transmission"] == 0.0 and fields.get("alpha_mode", "opaque") == "opaque"
-    assert ("/World/Pane/Surface: inputs:opacity is connected to /World/Pane/Texture_opacity; without "
-            "opacityThreshold, in opacityMode 'transparent', opacity is glass") in messages(contents)
+    record = material_of(contents)
+    assert record.fields["transmission"] == 0.0 and record.fields["alpha_mode"] == "blend"
+    np.testing.assert_array_equal(contents.materials.textures[record.slots["base_color"].index][..., 3], mask[..., 3])
+    assert "coverage: opacity blends" in record.summary and not contents.problems.items
+
+
+def test_glass_whose_diffuse_color_is_unset_transmits_clear_light(tmp_path):
+    def build(stage, prim):
+        bind(prim, preview_material(stage, "/World/Glass", opacity=0.0, ior=1.5))
+
+    record = material_of(read_quad(tmp_path, build))
+    assert record.fields["transmission"] == 1.0 and record.fields["base_color"] == (1.0, 1.0, 1.0, 1.0)
+    assert "transmitting (1, 1, 1) (diffuseColor unset: clear)" in record.summary
+
+
+def test_glass_with_a_diffuse_color_transmits_that_colour(tmp_path):
+    def build(stage, prim):
+        bind(prim, preview_material(stage, "/World/Glass", opacity=0.0, diffuseColor=(0.18, 0.18, 0.18)))
+
+    record = material_of(read_quad(tmp_path, build))
+    np.testing.assert_allclose(record.fields["base_color"], (0.18, 0.18, 0.18, 1.0), rtol=1e-6)
+    assert "transmitting (0.18, 0.18, 0.18)," in record.summary
+
+
+def test_a_pane_of_preview_glass_without_a_diffuse_color_renders_what_is_behind_it_untinted(tmp_path, device):
+    """usdview shows such a pane clear; the 0.18 fallback taken as a tint made it near-black."""
+    pictures = []
+    for tint in ({}, {"diffuseColor": (1.0, 1.0, 1.0)}, {"diffuseColor": (0.18, 0.18, 0.18)}):
+        stage = new_stage(tmp_path / "pane.usda")
+        card = quad(stage, "/World/Card", size=4.0, z=-1.0).GetPrim()
+        bind(card, preview_material(stage, "/World/Lamp", diffuseColor=(0.0, 0.0, 0.0),
+                                    emissiveColor=(0.6, 0.6, 0.6)))
+        pane = quad(stage, "/World/Pane", size=1.0, z=0.5).GetPrim()
+        bind(pane, preview_material(stage, "/World/Glass", opacity=0.0, ior=1.5, **tint))
+        stage.GetRootLayer().Save()
+        with snell.usd.open(tmp_path / "pane.usda", device=device) as opened:
+            pictures.append(opened.render(40, 30, method="trace")[..., :3])
+    unset, white, grey = pictures
+    np.testing.assert_array_equal(unset, white)
+    through, beside = unset[15, 20], unset[15, 14]
+    assert (through >= 0.9 * beside).all(), (through, beside)  # clear: less only its reflections, plus highlights
+    assert (grey[15, 20] < 0.5 * through).all(), grey[15, 20]  # an authored grey tints it
+
+
+def test_display_color_read_through_a_primvar_reader_is_each_meshs_colour(tmp_path):
+    from pxr import Sdf, UsdGeom
+
+    def build(stage, prim):
+        material = preview_material(stage, "/World/ByColour", roughness=0.3)
+        reader = UsdShade.Shader.Define(stage, "/World/ByColour/Colour")
+        reader.CreateIdAttr("UsdPrimvarReader_float3")
+        reader.CreateInput("varname", Sdf.ValueTypeNames.Token).Set("displayColor")
+        connect(material, "diffuseColor", reader, "result")
+        UsdGeom.Gprim(prim).CreateDisplayColorPrimvar().Set([(0.1, 0.7, 0.3)])
+        other = quad(stage, "/World/Other", z=1.0).GetPrim()
+        UsdGeom.Gprim(other).CreateDisplayColorPrimvar().Set([(0.9, 0.2, 0.1)])
+        bind(prim, material)
+        bind(other, material)
+
+    contents = read_quad(tmp_path, build)
+    colours = [material_of(contents).fields["base_color"],
+               contents.materials.records[contents.sources[1].parts[0].material].fields["base_color"]]
+    np.testing.assert_allclose(colours, [(0.1, 0.7, 0.3, 1.0), (0.9, 0.2, 0.1, 1.0)], rtol=1e-6)
+    assert material_of(contents).fields["roughness"] == pytest.approx(0.3)
+
+
+def test_display_opacity_read_through_a_primvar_reader_blends_by_vertex(tmp_path):
+    from pxr import Sdf, UsdGeom
+
+    def build(stage, prim):
+        material = preview_material(stage, "/World/Fade", diffuseColor=(0.5, 0.5, 0.5))
+        reader = UsdShade.Shader.Define(stage, "/World/Fade/Opacity")
+        reader.CreateIdAttr("UsdPrimvarReader_float")
+        reader.CreateInput("varname", Sdf.ValueTypeNames.Token).Set("displayOpacity")
+        connect(material, "opacity", reader, "result")
+        UsdGeom.Gprim(prim).CreateDisplayOpacityPrimvar(UsdGeom.Tokens.vertex).Set([0.0, 1.0, 1.0, 0.0])
+        bind(prim, material)
+
+    contents = read_quad(tmp_path, build)
+    record = material_of(contents)
+    assert record.fields["alpha_mode"] == "blend" and record.fields["transmission"] == 0.0
+    texels = contents.materials.textures[record.fields["base_color_texture"]]
+    uvs = contents.snell_meshes()[0].uvs
+    alpha = bilinear(texels, uvs)[:, 3] / 255.0
+    points = contents.sources[0].parts[0].vertex_point
+    np.testing.assert_allclose(alpha, np.float64([0.0, 1.0, 1.0, 0.0])[points], atol=0.5 / 255)
+
+
+def bilinear(texels: np.ndarray, uvs: np.ndarray) -> np.ndarray:
+    """The texture's bilinear value at each uv (texel centres at (i + 0.5) / size), in bytes, sRGB decoded."""
+    decoded = texels.astype(np.float64)
+    decoded[..., :3] = srgb_to_linear(decoded[..., :3] / 255.0) * 255.0
+    h, w = texels.shape[:2]
+    p = np.asarray(uvs, np.float64) * (w, h) - 0.5
+    base = np.floor(p).astype(int)
+    f = p - base
+    x0, y0 = np.clip(base[:, 0], 0, w - 1), np.clip(base[:, 1], 0, h - 1)
+    x1, y1 = np.clip(base[:, 0] + 1, 0, w - 1), np.clip(base[:, 1] + 1, 0, h - 1)
+    top = decoded[y0, x0] * (1 - f[:, :1]) + decoded[y0, x1] * f[:, :1]
+    bottom = decoded[y1, x0] * (1 - f[:, :1]) + decoded[y1, x1] * f[:, :1]
+    return top * (1 - f[:, 1:]) + bottom * f[:, 1:]
+
+
+def srgb_to_linear(c: np.ndarray) -> np.ndarray:
+    return np.where(c <= 0.04045, c / 12.92, ((c + 0.055) / 1.055) ** 2.4)
+
+
+def test_a_meshs_vertex_display_color_is_interpolated_linearly_across_each_triangle(tmp_path):
+    from pxr import UsdGeom
+
+    corners = np.float64([(1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0), (1.0, 1.0, 1.0)])
+
+    def build(stage, prim):
+        UsdGeom.Gprim(prim).CreateDisplayColorPrimvar(UsdGeom.Tokens.vertex).Set([tuple(c) for c in corners])
+
+    contents = read_quad(tmp_path, build)
+    record = material_of(contents)
+    meshed = contents.snell_meshes()[0]
+    texels = contents.materials.textures[record.fields["base_color_texture"]]
+    points = contents.sources[0].parts[0].vertex_point
+    assert len(meshed.positions) == 6  # two triangles, each with its own three vertices
+    uvs = np.asarray(meshed.uvs, np.float64)
+    triangles = np.asarray(meshed.indices)
+    weights = np.random.default_rng(7).dirichlet((1, 1, 1), 20)
+    for triangle in triangles:
+        inside = weights @ uvs[triangle]
+        expected = weights @ corners[points[triangle]]
+        # Exact but for 8 bits and the clipping past a long edge (_colours.py: 0.02 at most).
+        np.testing.assert_allclose(bilinear(texels, inside)[:, :3] / 255.0, expected, atol=0.02)
+
+
+def test_a_meshs_uniform_display_color_colours_each_face_in_the_picture(tmp_path, device):
+    from pxr import UsdGeom
+
+    stage = new_stage(tmp_path / "faces.usda")
+    panel = mesh(stage, "/World/Panel", [(-2, -1, 0), (0, -1, 0), (2, -1, 0), (2, 1, 0), (0, 1, 0), (-2, 1, 0)],
+                 [4, 4], [0, 1, 4, 5, 1, 2, 3, 4], normals=[(0, 0, 1)] * 6)
+    UsdGeom.Gprim(panel).CreateDisplayColorPrimvar(UsdGeom.Tokens.uniform).Set([(0.8, 0.1, 0.1), (0.1, 0.1, 0.8)])
+    stage.GetRootLayer().Save()
+    with snell.usd.open(tmp_path / "faces.usda", device=device) as opened:
+        rgba = opened.render(48, 24, method="trace")
+    left, right = rgba[12, 16, :3], rgba[12, 32, :3]
+    # Lit alike, each face shows its own colour: highlights add the same to every channel.
+    assert left[0] > 2 * left[2] and right[2] > 2 * right[0], (left, right)
+    np.testing.assert_allclose([left[1], right[1]], [left[2], right[0]], rtol=0.02)
+    np.testing.assert_allclose(left[0] - left[2], right[2] - right[0], rtol=0.02)
 
 
 def test_an_emissive_color_is_read(tmp_path):

@@ -22,7 +22,7 @@ from dataclasses import dataclass, field, replace
 from typing import Any, Optional
 
 import numpy as np
-from pxr import Usd, UsdGeom, UsdShade
+from pxr import Usd, UsdShade
 
 from .. import Material, Texture, TextureTransform
 from ._problems import Problems
@@ -42,6 +42,8 @@ TEXTURE_FALLBACKS: dict[str, Any] = {
 }
 TEXTURE_OUTPUTS = ("rgb", "rgba", "r", "g", "b", "a")
 SNELL_WRAPS = ("repeat", "clamp", "mirror")  # UsdUVTexture's 'black' has no snell sampler
+# The primvar readers a colour or an opacity reads a mesh's primvar through, and the values each gives.
+_PRIMVAR_READER_SIZES = {"UsdPrimvarReader_float": 1, "UsdPrimvarReader_float3": 3, "UsdPrimvarReader_float4": 4}
 PURPOSES = {"preview": UsdShade.Tokens.preview, "full": UsdShade.Tokens.full, "all": UsdShade.Tokens.allPurpose}
 
 Transform = tuple[tuple[float, float], float, tuple[float, float]]  # KHR_texture_transform: offset, rotation, scale
@@ -102,6 +104,10 @@ class MaterialRecord:
     slots: dict[str, TextureSlot] = field(default_factory=dict)  #: 'base_color', 'emissive', 'normal'
     summary: str = ""
     double_sided: bool = False
+    #: diffuseColor and opacity read from the mesh (a UsdPrimvarReader, or an unbound mesh's displayColor):
+    #: (primvar name, the reader's fallback); each mesh resolves them (_colours.py)
+    colour_primvar: Optional[tuple[str, tuple[float, float, float]]] = None
+    opacity_primvar: Optional[tuple[str, float]] = None
 
     @property
     def st_primvar(self) -> Optional[str]:
@@ -149,13 +155,13 @@ class MaterialTable:
         """The snell material of prim (a mesh or one of its subsets), made on first use."""
         material = self.bound_material(prim)
         if material is None:
-            colour = _display_color(mesh, self.time, self.problems)
-            key: tuple = ("", colour, double_sided)
+            key: tuple = ("", None, double_sided)
             if key not in self._index:
-                fields = _surface_fields({})
-                fields["base_color"] = (*colour, 1.0)
-                record = MaterialRecord(path="", fields=fields, double_sided=double_sided,
-                                        summary=f"no material: UsdPreviewSurface fallbacks, colour {_fmt(colour)}")
+                fallback = tuple(PREVIEW_FALLBACKS["diffuseColor"])
+                record = MaterialRecord(path="", fields=_surface_fields({}), double_sided=double_sided,
+                                        summary="no material: UsdPreviewSurface fallbacks, colour from "
+                                                f"primvars:displayColor (else {_fmt(fallback)})",
+                                        colour_primvar=("displayColor", fallback))
                 self._index[key] = self._append(record)
             return self._index[key]
         path = str(material.GetPath())
@@ -168,6 +174,29 @@ class MaterialTable:
                              slots={name: replace(slot) for name, slot in template.slots.items()})
             self._index[key] = self._append(record)
         return self._index[key]
+
+    def variant(self, index: int, base_color: tuple, texture: int = -1) -> int:
+        """Material `index` with a mesh's own base colour (a constant primvar) or colour texture (a varying one,
+        _colours.py), made once per (material, colour, texture)."""
+        key = ("variant", index, tuple(float(c) for c in base_color), texture)
+        if key not in self._index:
+            template = self.records[index]
+            fields = dict(template.fields, base_color=tuple(float(c) for c in base_color))
+            if texture >= 0:
+                fields["base_color_texture"] = texture
+            slots = {name: replace(slot) for name, slot in template.slots.items()
+                     if texture < 0 or name != "base_color"}
+            record = replace(template, fields=fields, slots=slots, colour_primvar=None, opacity_primvar=None)
+            self.records.append(record)
+            self._index[key] = len(self.records) - 1
+        return self._index[key]
+
+    def add_texture(self, rgba: np.ndarray, name: str, wraps: tuple[str, str] = ("clamp", "clamp")) -> int:
+        """A texture snell's reader made itself (a mesh's colours), by index."""
+        self.textures.append(rgba)
+        self.texture_paths.append(name)
+        self.texture_wraps.append(wraps)
+        return len(self.textures) - 1
 
     def _append(self, record: MaterialRecord) -> int:
         for name, slot in list(record.slots.items()):
@@ -275,25 +304,33 @@ class MaterialTable:
             self.problems.warn(where, f"inputs:clearcoat is {values['clearcoat']:g}; snell has no clear coat: ignored")
 
         record = MaterialRecord(path=path, fields={})
-        colour = self._diffuse(record, shader)
+        colour, colour_authored = self._diffuse(record, shader)
         values["emissiveColor"] = self._emissive(record, shader)
         normal_scale = self._normal(record, shader)
         threshold = float(values["opacityThreshold"])
-        # UsdPreviewSurface: a threshold above 0 makes opacity a cut-out mask; 'presence' makes it coverage;
-        # otherwise an opacity below 1 is a translucent (here refractive) surface.
-        coverage = "mask" if threshold > 0.0 else "blend" if values["opacityMode"] == "presence" else None
-        opacity, alpha_textured = self._opacity(record, shader, coverage)
+        # UsdPreviewSurface: a threshold above 0 makes opacity a cut-out mask; 'presence' makes it coverage, and
+        # so does an opacity that varies over the surface (a texture or a primvar: how exporters write alpha
+        # blending, glTF's BLEND); otherwise a constant opacity below 1 is a translucent (here refractive) surface.
+        _, opacity_source = self._input(shader, "opacity")
+        coverage = ("mask" if threshold > 0.0 else
+                    "blend" if values["opacityMode"] == "presence" or opacity_source is not None else None)
+        opacity, alpha_varies = self._opacity(record, shader)
         record.fields = _surface_fields(values)
         record.fields["base_color"] = (*(float(c) for c in colour), opacity if coverage else 1.0)
-        if coverage is not None and (alpha_textured or opacity < 1.0):
+        if coverage is not None and (alpha_varies or opacity < 1.0):
             record.fields["alpha_mode"] = coverage
             if coverage == "mask":
                 record.fields["alpha_cutoff"] = threshold
         elif coverage is None and opacity < 1.0:
             record.fields["transmission"] = 1.0 - max(opacity, 0.0)
+            if not colour_authored:
+                # The transmission rule (docs/usd.md): an authored diffuseColor tints the light through glass
+                # (the talk's cornea); unauthored, its 0.18 fallback is a surface's grey, not a tint: clear.
+                record.fields["base_color"] = (1.0, 1.0, 1.0, 1.0)
+                colour = (1.0, 1.0, 1.0)
         if "normal" in record.slots:
             record.fields["normal_scale"] = normal_scale
-        record.summary = self._summary(record, colour, opacity)
+        record.summary = self._summary(record, colour, opacity, colour_authored)
         self._one_uv_set(record)
         return record
 
@@ -313,10 +350,30 @@ class MaterialTable:
         record.slots[slot_name] = slot
         return constant, slot
 
-    def _diffuse(self, record: MaterialRecord, shader: UsdShade.Shader) -> tuple[float, float, float]:
-        """diffuseColor: the base colour factor; a texture goes into record's base colour slot (factor 1)."""
+    def _diffuse(self, record: MaterialRecord, shader: UsdShade.Shader) -> tuple[tuple[float, float, float], bool]:
+        """diffuseColor: the base colour factor (a texture goes into record's base colour slot, factor 1; a
+        primvar reader into record.colour_primvar, each mesh's own), and whether the stage authored it."""
+        value, source = self._input(shader, "diffuseColor")
+        reader = self._primvar_reader(source)
+        if reader is not None:
+            record.colour_primvar = (reader[0], tuple(reader[1][:3]))
+            return tuple(reader[1][:3]), True
         colour, slot = self._colour(record, shader, "diffuseColor", "colour", "base_color")
-        return (1.0, 1.0, 1.0) if slot is not None else colour
+        return ((1.0, 1.0, 1.0) if slot is not None else colour), value is not None or source is not None
+
+    def _primvar_reader(self, source: Optional[Source]) -> Optional[tuple[str, tuple[float, ...]]]:
+        """A UsdPrimvarReader of a float or colour: (its varname, its fallback as a tuple); None otherwise."""
+        if source is None or source.id not in _PRIMVAR_READER_SIZES:
+            return None
+        name, _ = self._input(source.shader, "varname")
+        size = _PRIMVAR_READER_SIZES[source.id]
+        fallback, _ = self._input(source.shader, "fallback")
+        values = (0.0,) * size if fallback is None else tuple(np.atleast_1d(np.asarray(fallback, float)))
+        if not name:
+            self.problems.warn(source.path, "inputs:varname is not set: its fallback "
+                                            f"{_fmt(values)} is used")
+            return "", values
+        return str(name), values
 
     def _emissive(self, record: MaterialRecord, shader: UsdShade.Shader) -> tuple[float, float, float]:
         """emissiveColor: the emissive factor; a texture goes into the emissive slot (factor set on reading)."""
@@ -351,19 +408,18 @@ class MaterialTable:
             return k
         return 1.0
 
-    def _opacity(self, record: MaterialRecord, shader: UsdShade.Shader, coverage: Optional[str]) -> tuple[float, bool]:
-        """opacity: its constant value, or 1 and True where a texture's channel became the base colour's alpha
-        (coverage: 'mask', 'blend', or None where opacity is glass)."""
+    def _opacity(self, record: MaterialRecord, shader: UsdShade.Shader) -> tuple[float, bool]:
+        """opacity: its constant value, or True where it varies: a texture's channel became the base colour's
+        alpha (the value then 1), or a primvar reader's (record.opacity_primvar; the value its fallback)."""
         where = shader.GetPath()
         value, source = self._input(shader, "opacity")
         opacity = float(PREVIEW_FALLBACKS["opacity"] if value is None else value)
         if source is None:
             return opacity, False
-        if coverage is None:
-            self.problems.warn(where, f"inputs:opacity is connected to {source.path}; without opacityThreshold, "
-                                      "in opacityMode 'transparent', opacity is glass, and snell's glass has one "
-                                      "transmission per material: drawn opaque (opacity 1)")
-            return 1.0, False
+        reader = self._primvar_reader(source)
+        if reader is not None:
+            record.opacity_primvar = (reader[0], float(reader[1][0]))
+            return float(reader[1][0]), True
         if not (source.is_texture and source.output in ("r", "g", "b", "a")):
             self._cannot_evaluate(where, "opacity", source, 1.0)
             return 1.0, False
@@ -477,22 +533,29 @@ class MaterialTable:
                                               f"primvars:{first} is used")
                 slot.st_primvar = first
 
-    def _summary(self, record: MaterialRecord, colour: tuple, opacity: float) -> str:
+    def _summary(self, record: MaterialRecord, colour: tuple, opacity: float, colour_authored: bool = True) -> str:
         fields = record.fields
         base = record.slots.get("base_color")
         alpha_file = f"{base.file} ({base.request.alpha})" if base is not None and base.request.alpha else ""
         if fields.get("transmission", 0.0) > 0:
-            kind = f"glass (opacity {opacity:g}, ior {fields['ior']:g})"
+            tint = (f"the texture {base.file}" if base is not None and base.request.output else
+                    f"primvars:{record.colour_primvar[0]}" if record.colour_primvar else _fmt(colour))
+            clear = "" if colour_authored else " (diffuseColor unset: clear)"
+            kind = f"glass (opacity {opacity:g}, ior {fields['ior']:g}) transmitting {tint}{clear}"
         elif fields.get("alpha_mode") == "mask":
             kind = f"cut out where opacity < {fields['alpha_cutoff']:g}"
         elif fields.get("alpha_mode") == "blend":
             kind = "coverage: opacity blends" if alpha_file else f"coverage: opacity {opacity:g} blends"
         else:
             kind = "opaque"
-        colour_text = f"texture {base.file}" if base is not None and base.request.output else f"colour {_fmt(colour)}"
+        colour_text = (f"texture {base.file}" if base is not None and base.request.output else
+                       f"colour primvars:{record.colour_primvar[0]} (else {_fmt(colour)})" if record.colour_primvar
+                       else f"colour {_fmt(colour)}")
         parts = [f"UsdPreviewSurface, {kind}, {colour_text}, roughness {fields['roughness']:g}"]
         if alpha_file:
             parts.append(f"opacity from {alpha_file}")
+        if record.opacity_primvar:
+            parts.append(f"opacity from primvars:{record.opacity_primvar[0]} (else {record.opacity_primvar[1]:g})")
         if "emissive" in record.slots:
             parts.append(f"emissive texture {record.slots['emissive'].file}")
         if "normal" in record.slots:
@@ -544,19 +607,6 @@ def _surface_fields(values: dict[str, Any]) -> dict[str, Any]:
     return {"roughness": float(v["roughness"]), "ior": float(v["ior"]),
             "emissive": tuple(float(c) for c in v["emissiveColor"]), "transmission": 0.0,
             "base_color": (*(float(c) for c in v["diffuseColor"]), 1.0)}
-
-
-def _display_color(mesh: Usd.Prim, time: Usd.TimeCode, problems: Problems) -> tuple[float, float, float]:
-    """An unbound mesh's colour: its displayColor when it has a single value, else the preview fallback."""
-    primvar = UsdGeom.Gprim(mesh).GetDisplayColorPrimvar()
-    if primvar and primvar.HasAuthoredValue():
-        values = primvar.ComputeFlattened(time)
-        if values is not None and len(values) >= 1:
-            if len(values) > 1 and primvar.GetInterpolation() != UsdGeom.Tokens.constant:
-                problems.warn(mesh.GetPath(), f"primvars:displayColor varies ({primvar.GetInterpolation()}); snell "
-                                              "has no vertex colours: its first value is used")
-            return tuple(float(c) for c in values[0])
-    return tuple(PREVIEW_FALLBACKS["diffuseColor"])
 
 
 def _layer_of(shader: UsdShade.Shader, name: str) -> str:

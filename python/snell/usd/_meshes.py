@@ -205,13 +205,22 @@ class MeshSource:
         return bool(self.normals is not None and self.skin is not None and self.skin.skinned and not self.skin.rigid)
 
     def add_part(self, name: str, triangles: np.ndarray, material: int, st: Optional[Primvar],
-                 st_values: Optional[np.ndarray]) -> Part:
-        """A part of these triangles, with its vertices split where its normals or st differ."""
+                 st_values: Optional[np.ndarray], corner_uvs: Optional[np.ndarray] = None) -> Part:
+        """A part of these triangles, with its vertices split where its normals or st differ; with corner_uvs
+        ((T * 3, 2): a colour atlas's, _colours.py) every triangle has its own three vertices, with those UVs."""
         t = self.topology
         corners = t.triangles[triangles]
         normal_per_point = self.normals is None or self.normals.point_ids is not None
         st_per_point = st is None or st.point_ids is not None
         part = Part(name, triangles, material)
+        if corner_uvs is not None:
+            part.vertex_point = t.face_points[corners].reshape(-1)
+            part.vertex_normal = (part.vertex_point if self.normals is None else
+                                  self.normals.corner_ids[corners].reshape(-1))
+            part.indices = np.arange(3 * len(triangles), dtype=np.uint32).reshape(-1, 3)
+            part.uvs = np.ascontiguousarray(corner_uvs, np.float32)
+            self.parts.append(part)
+            return part
         if normal_per_point and st_per_point:
             corner_points = t.face_points[corners]
             used = np.unique(corner_points)

@@ -20,6 +20,7 @@ from pxr import Sdf, Tf, Usd, UsdGeom, UsdLux, UsdSkel
 
 from .. import Instance, Light, Material, Mesh
 from ._cameras import CameraState, camera_state
+from ._colours import colour_atlas, mesh_colours
 from ._lights import LightRecord, read_light, unsupported_light
 from ._materials import MaterialRecord, MaterialTable
 from ._meshes import MeshSource, Part, Pose, Topology, material_subsets, read_normals, read_primvar, read_topology
@@ -232,12 +233,13 @@ class StageContents:
         if pose is None:
             return None
         for bind, triangles, material in parts:
+            material, corner_uvs = self._own_colours(prim, topology, triangles, material, time)
             record = self.materials.records[material]
             st, st_values = None, None
-            if record.st_primvar is not None:
+            if record.st_primvar is not None and corner_uvs is None:
                 st, st_values = self._st(prim, record.st_primvar, topology, time, record.path)
             name = str(prim.GetPath()) if bind == prim else f"{prim.GetPath()} ({bind.GetName()})"
-            part = source.add_part(name, triangles, material, st, st_values)
+            part = source.add_part(name, triangles, material, st, st_values, corner_uvs)
             if flip:
                 part.indices = np.ascontiguousarray(part.indices[:, [0, 2, 1]])
             if part.uvs is not None:
@@ -245,6 +247,29 @@ class StageContents:
         self.sources.append(source)
         self._initial[id(source)] = pose
         return source
+
+    def _own_colours(self, prim: Usd.Prim, topology: Topology, triangles: np.ndarray, material: int,
+                     time: Usd.TimeCode) -> tuple[int, Optional[np.ndarray]]:
+        """A material whose colour or opacity reads the mesh's primvars, made the mesh's own (_colours.py): the
+        material's index for these triangles, and the UVs of their split corners where the colour varies."""
+        record = self.materials.records[material]
+        if record.colour_primvar is None and record.opacity_primvar is None:
+            return material, None
+        base_alpha = float(record.fields["base_color"][3])
+        colours = mesh_colours(prim, record.colour_primvar, record.opacity_primvar, base_alpha, topology, triangles,
+                               time, self.problems)
+        if colours.corners is None:
+            return self.materials.variant(material, tuple(colours.constant)), None
+        named = [f"primvars:{p[0]}" for p in (record.colour_primvar, record.opacity_primvar) if p is not None]
+        if record.slots:
+            mean = colours.corners.reshape(-1, 4).mean(axis=0)
+            self.problems.warn(prim.GetPath(), f"{' and '.join(named)} vary over the mesh, but {record.path}'s "
+                                               f"textures read primvars:{record.st_primvar}; snell's meshes carry one "
+                                               f"UV set: their mean {_fmt_colour(mean)} is used")
+            return self.materials.variant(material, tuple(mean)), None
+        texels, uvs = colour_atlas(colours.corners)
+        texture = self.materials.add_texture(texels, f"{prim.GetPath()} {' and '.join(named)}")
+        return self.materials.variant(material, (1.0, 1.0, 1.0, 1.0), texture), uvs
 
     def _undrawn_wraps(self, prim: Usd.Prim, part: Part, record: MaterialRecord) -> None:
         """A wrap snell has no sampler for ('black', 'useMetadata') matters only where the texture's UVs leave
@@ -355,6 +380,10 @@ class StageContents:
         self._xform_cache.SetTime(t)
         transforms = [(p, self._matrix(p.prim, p.rigid_skin, frame)) for p in self.dynamic_placements]
         return Frame(time_code, poses, transforms, clock.perf_counter() - started)
+
+
+def _fmt_colour(values: np.ndarray) -> str:
+    return "(" + ", ".join(f"{float(c):.3g}" for c in values) + ")"
 
 
 def _open_stage(path: str) -> Usd.Stage:
