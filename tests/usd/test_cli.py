@@ -51,9 +51,23 @@ def broken_stage(folder) -> object:
 
 
 def test_info_on_a_broken_stage_lists_the_error_and_exits_1(tmp_path):
-    done = snell_usd("info", broken_stage(tmp_path))
+    done = snell_usd("info", broken_stage(tmp_path), "--strict")
     assert done.returncode == 1
     assert "  error: /World/M/Texture_diffuseColor: texture file ./gone.png not found" in done.stdout
+
+
+def test_info_says_which_colour_preview_glass_transmits(tmp_path):
+    stage = new_stage(tmp_path / "glass.usda")
+    bind(quad(stage, "/World/Clear").GetPrim(), preview_material(stage, "/World/ClearGlass", opacity=0.0))
+    bind(quad(stage, "/World/Tinted", z=1).GetPrim(),
+         preview_material(stage, "/World/TintedGlass", opacity=0.0, diffuseColor=(0.5, 0.8, 1.0)))
+    stage.GetRootLayer().Save()
+    done = snell_usd("info", tmp_path / "glass.usda")
+    assert done.returncode == 0, done.stderr
+    assert "/World/ClearGlass: UsdPreviewSurface, glass (opacity 0, ior 1.5) transmitting (1, 1, 1) (diffuseColor " \
+           "unset: clear)" in done.stdout
+    assert "/World/TintedGlass: UsdPreviewSurface, glass (opacity 0, ior 1.5) transmitting (0.5, 0.8, 1)," \
+           in done.stdout
 
 
 def test_render_writes_exactly_the_frames_asked(eyes, tmp_path):
@@ -87,14 +101,31 @@ def test_quiet_prints_nothing(eyes, tmp_path):
     assert done.returncode == 0 and done.stdout == "" and done.stderr == ""
 
 
-def test_a_stage_with_a_missing_texture_exits_1_and_writes_nothing(tmp_path):
+def test_a_stage_with_a_missing_texture_renders_its_fallback_with_a_warning(tmp_path):
+    done = snell_usd("render", broken_stage(tmp_path), "-o", tmp_path / "f.png", "--size", SIZE)
+    assert done.returncode == 0, done.stderr
+    assert "warning: /World/M/Texture_diffuseColor: texture file ./gone.png not found" in done.stderr
+    assert (tmp_path / "f.png").is_file()
+
+
+def test_strict_refuses_a_stage_with_a_missing_texture_and_writes_nothing(tmp_path):
     broken = broken_stage(tmp_path)
     out = tmp_path / "out"
     out.mkdir()
-    done = snell_usd("render", broken, "-o", out / "f.####.exr", "--frames", "1-3", "--size", SIZE)
+    done = snell_usd("render", broken, "-o", out / "f.####.exr", "--frames", "1-3", "--size", SIZE, "--strict")
     assert done.returncode == 1
     assert "/World/M/Texture_diffuseColor: texture file ./gone.png not found" in done.stderr
     assert os.listdir(out) == []
+
+
+def test_a_start_time_code_after_the_end_renders_the_stages_start_frame(tmp_path):
+    stage = new_stage(tmp_path / "backwards.usda", time_range=(10, 1))
+    quad(stage, "/World/Card")
+    stage.GetRootLayer().Save()
+    done = snell_usd("render", tmp_path / "backwards.usda", "-o", tmp_path / "f.png", "--size", SIZE)
+    assert done.returncode == 0, done.stderr
+    assert "time code 10" in done.stdout and (tmp_path / "f.png").is_file()
+    assert "startTimeCode 10 is after endTimeCode 1: snell takes the range 1-10" in done.stderr
 
 
 def test_a_stage_with_a_mesh_without_points_exits_1_and_writes_nothing(tmp_path):

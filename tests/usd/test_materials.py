@@ -556,14 +556,27 @@ def textured(path: str):
     return build
 
 
-def test_a_missing_texture_is_an_error_naming_the_file(tmp_path):
-    build = textured("./nowhere.png")
+def test_a_missing_texture_is_a_warning_naming_the_file_and_its_fallback_is_drawn(tmp_path):
+    def build(stage, prim):
+        from pxr import Gf, Sdf
+
+        material = preview_material(stage, "/World/T")
+        image = texture(stage, material, "./nowhere.png")
+        image.CreateInput("fallback", Sdf.ValueTypeNames.Float4).Set(Gf.Vec4f(0.25, 0.5, 0.75, 1.0))
+        bind(prim, material)
+
     contents = read_quad(tmp_path, build)
-    errors = [str(w) for w in contents.problems.errors]
-    assert errors == ["error: /World/T/Texture_diffuseColor: texture file ./nowhere.png not found "
-                      f"(it resolves to nothing from {tmp_path / 'quad.usda'})"]
+    assert not contents.problems.errors
+    assert ("/World/T/Texture_diffuseColor: texture file ./nowhere.png not found (it resolves to nothing from "
+            f"{tmp_path / 'quad.usda'}): the texture's fallback (0.25, 0.5, 0.75, 1) is used") in messages(contents)
+    np.testing.assert_allclose(material_of(contents).fields["base_color"], (0.25, 0.5, 0.75, 1.0), rtol=1e-6)
+
+
+def test_a_missing_texture_is_an_error_when_strict(tmp_path):
     with pytest.raises(snell.usd.StageError, match="nowhere.png not found"):
-        read_quad(tmp_path, build, strict=True)
+        read_quad(tmp_path, textured("./nowhere.png"), strict=True)
+    contents = read_quad(tmp_path, textured("./nowhere.png"), missing_textures_fail=True)
+    assert [w.prim for w in contents.problems.errors] == ["/World/T/Texture_diffuseColor"]
 
 
 def test_a_udim_texture_is_a_warning(tmp_path):

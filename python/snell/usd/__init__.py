@@ -40,18 +40,22 @@ PathLike = Union[str, os.PathLike]
 
 def read(path: PathLike, *, time: Optional[float] = None, purpose: str = "preview",
          geometry_purpose: str = "render", meters_per_unit: Optional[float] = None, strict: bool = False,
-         load_textures: bool = True) -> StageContents:
+         load_textures: bool = True, missing_textures_fail: Optional[bool] = None) -> StageContents:
     """Reads a stage for snell without a GPU: its meshes, materials, lights, cameras and warnings.
 
     time: the time code (default: the stage's start); purpose: the material
     purpose bound first ('preview', 'full', or 'all' for the all-purpose
     binding alone); geometry_purpose: 'render' or 'proxy', drawn beside
     'default' ('guide' never is); meters_per_unit overrides the stage's;
-    strict: a broken stage (a missing texture, a mesh with faces but no
-    points) raises StageError instead of warning.
+    strict: a broken stage (a mesh with faces but no points, a missing
+    texture file) raises StageError instead of warning;
+    missing_textures_fail: a missing texture file is an error (default:
+    as strict; otherwise a warning, and the texture's fallback is drawn, as
+    usdview draws it).
     """
     options = ReadOptions(purpose=purpose, geometry_purpose=geometry_purpose, meters_per_unit=meters_per_unit,
-                          load_textures=load_textures, strict=strict)
+                          load_textures=load_textures, strict=strict,
+                          missing_textures_fail=strict if missing_textures_fail is None else missing_textures_fail)
     return StageContents(path, time, options)
 
 

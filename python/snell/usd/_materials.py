@@ -464,8 +464,10 @@ class MaterialTable:
                                       "texture's fallback is used")
             return None, seen
         if not asset.resolvedPath:
-            self.problems.fail(where, f"texture file {asset.path} not found (it resolves to nothing from "
-                                      f"{_layer_of(texture, 'file')})")
+            # As usdview: the texture's fallback, scaled and biased; strict readers (--strict) refuse the stage.
+            self.problems.strict_error(where, f"texture file {asset.path} not found (it resolves to nothing from "
+                                              f"{_layer_of(texture, 'file')}): the texture's fallback "
+                                              f"{_fmt(seen)} is used")
             return None, seen
         wraps = tuple(str(self._value(texture, name, TEXTURE_FALLBACKS)) for name in ("wrapS", "wrapT"))
         color_space = str(self._value(texture, "sourceColorSpace", TEXTURE_FALLBACKS))

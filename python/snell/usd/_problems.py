@@ -1,8 +1,9 @@
 """What goes wrong while reading a stage: warnings that name the prim, and errors.
 
 A warning says what snell leaves out or approximates (an unsupported shader,
-a wrap mode snell cannot draw). An error says the stage is broken where snell
-needs it (a texture file that is missing, a mesh whose faces have no
+a wrap mode snell cannot draw, a missing texture drawn with its fallback as
+usdview draws it; strict readers raise that one). An error says the stage is broken where snell
+needs it (a texture file that cannot be decoded, a mesh whose faces have no
 points): strict readers raise it at once, others keep it as a warning marked
 as an error, which `snell-usd render` refuses.
 """
@@ -10,6 +11,7 @@ as an error, which `snell-usd render` refuses.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Optional
 
 from .. import Error
 
@@ -34,9 +36,10 @@ class StageWarning:
 class Problems:
     """The warnings of one stage, each said once, in the order found."""
 
-    def __init__(self, stage_path: str, strict: bool) -> None:
+    def __init__(self, stage_path: str, strict: bool, strict_missing: Optional[bool] = None) -> None:
         self.stage_path = stage_path
         self.strict = strict
+        self.strict_missing = strict if strict_missing is None else strict_missing
         self.items: list[StageWarning] = []
         self._seen: set[tuple[str, str]] = set()
 
@@ -50,6 +53,14 @@ class Problems:
             where = f"{item.prim}: " if item.prim else ""
             raise StageError(f"{self.stage_path}: {where}{message}")
         self._add(item)
+
+    def strict_error(self, prim: object, message: str) -> None:
+        """What snell draws around (a missing texture, with the input's fallback): an error where missing files
+        are (strict), else a plain warning."""
+        if self.strict_missing:
+            self.fail(prim, message)
+        else:
+            self.warn(prim, message)
 
     def _add(self, item: StageWarning) -> None:
         key = (item.prim, item.message)

@@ -39,7 +39,8 @@ class ReadOptions:
     geometry_purpose: str = "render"  #: the purpose drawn beside default: render or proxy (guide never)
     meters_per_unit: Optional[float] = None  #: overrides the stage's metersPerUnit
     load_textures: bool = True
-    strict: bool = False  #: a broken stage (missing texture, mesh without points) raises StageError
+    strict: bool = False  #: a broken stage (mesh without points, missing texture) raises StageError
+    missing_textures_fail: bool = False  #: a missing texture file is an error, not a warning with its fallback
 
 
 @dataclass
@@ -87,13 +88,19 @@ class StageContents:
         if self.options.geometry_purpose not in GEOMETRY_PURPOSES:
             raise ValueError(f"geometry purpose must be render or proxy, got '{self.options.geometry_purpose}'")
         self.path = os.fspath(path)
-        self.problems = Problems(self.path, self.options.strict)
+        self.problems = Problems(self.path, self.options.strict, self.options.missing_textures_fail)
         self.stage = _open_stage(self.path)
         stage = self.stage
         for error in getattr(stage, "GetCompositionErrors", lambda: [])():
             self.problems.warn("", f"composition: {error}")
         self.has_range = stage.HasAuthoredTimeCodeRange()
         self.start, self.end = stage.GetStartTimeCode(), stage.GetEndTimeCode()
+        if self.has_range and self.start > self.end:
+            self.problems.warn("", f"startTimeCode {self.start:g} is after endTimeCode {self.end:g}: snell takes "
+                                   f"the range {self.end:g}-{self.start:g}, and opens at the start time code")
+            self.range_lo, self.range_hi = self.end, self.start
+        else:
+            self.range_lo, self.range_hi = self.start, self.end
         self.time_codes_per_second = stage.GetTimeCodesPerSecond()
         self.time = float(self.start if time is None else time)
         if not self.in_range(self.time):
@@ -104,6 +111,9 @@ class StageContents:
         if not self.meters_per_unit_authored and self.options.meters_per_unit is None:
             self.problems.warn("", "metersPerUnit is not authored: USD's fallback, 0.01 (centimetres), applies")
         self.up_axis = str(UsdGeom.GetStageUpAxis(stage))
+        if self.up_axis not in ("Y", "Z"):
+            self.problems.warn("", f"upAxis '{self.up_axis}' of {stage.GetRootLayer().identifier} is neither Y nor "
+                                   "Z (UsdGeom allows only those): read as Y")
         rotate = _Z_UP_TO_Y_UP if self.up_axis == "Z" else np.eye(4)
         self.to_snell = np.diag([self.meters_per_unit] * 3 + [1.0]) @ rotate
 
@@ -148,6 +158,7 @@ class StageContents:
                     self._skip("invisible", prim)
                     walk.PruneChildren()
                     continue
+            self._unhonoured_draw_mode(prim)
             if prim.IsA(UsdSkel.Root):
                 self._skel_cache.Populate(UsdSkel.Root(prim), predicate)
             if prim.IsA(UsdGeom.Camera):
@@ -179,6 +190,29 @@ class StageContents:
             first = ", ".join(paths[:3]) + (", ..." if len(paths) > 3 else "")
             self.problems.warn("", f"{len(paths)} {kind} prim(s) skipped: snell reads UsdGeomMesh ({first})")
 
+    def _unhonoured_draw_mode(self, prim: Usd.Prim) -> None:
+        """model:drawMode asks for a stand-in (bounds, cards, origin); snell draws the model's geometry."""
+        attribute = prim.GetAttribute("model:drawMode")
+        if attribute and attribute.HasAuthoredValue():
+            mode = str(attribute.Get())
+            if mode not in ("default", "inherited"):
+                self.problems.warn(prim.GetPath(), f"model:drawMode is '{mode}', which snell does not honour: the "
+                                                   "model's own geometry is drawn")
+
+    def _missing_materials(self, prim: Usd.Prim) -> None:
+        """A material:binding (of any purpose) on the prim or an ancestor whose target is not a prim."""
+        stage = prim.GetStage()
+        while prim and not prim.IsPseudoRoot():
+            for relationship in prim.GetRelationships():
+                name = relationship.GetName()
+                if not name.startswith("material:binding") or name.startswith("material:binding:collection"):
+                    continue
+                for target in relationship.GetTargets():
+                    if not stage.GetPrimAtPath(target).IsValid():
+                        self.problems.warn(prim.GetPath(), f"{name} targets {target}, which does not exist: "
+                                                           "USD binds nothing there")
+            prim = prim.GetParent()
+
     def _skin_of(self, prim: Usd.Prim) -> Optional[Skin]:
         query = self._skel_cache.GetSkinningQuery(prim)
         if not query or not (query.HasJointInfluences() or query.HasBlendShapes()):
@@ -203,6 +237,7 @@ class StageContents:
                 self._topologies[key] = topology
         if topology is None:
             return
+        self._missing_materials(prim)
         double_sided = bool(mesh.GetDoubleSidedAttr().Get(time))
         parts = [(bind, triangles, self.materials.index_for(bind, prim, double_sided))
                  for bind, triangles in material_subsets(prim, topology, time, self.problems)]
@@ -317,7 +352,7 @@ class StageContents:
 
     def in_range(self, time_code: float) -> bool:
         """Whether a time code lies in the stage's authored range (any does, without one)."""
-        return not self.has_range or self.start <= time_code <= self.end
+        return not self.has_range or self.range_lo <= time_code <= self.range_hi
 
     def snell_meshes(self) -> list[Mesh]:
         """Every part of every source as a snell.Mesh, numbering the parts (part.mesh) on the way."""

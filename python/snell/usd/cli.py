@@ -55,15 +55,16 @@ and sent to the GPU each frame. Without --camera the stage's first camera
 draws it; a stage without one gets snell render's framed view of its
 bounds. SIGTERM or SIGINT drops the frame under way, keeps those written
 and exits 128+N; --skip-existing then picks up where it stopped. A stage
-snell cannot draw as it says (a missing texture, a mesh with faces but no
-points) is an error, and nothing is written."""
+snell cannot draw as it says (a mesh with faces but no points, a texture
+that cannot be decoded; with --strict a missing texture file too) is an
+error, and nothing is written."""
 
 INFO_DESCRIPTION = """\
 Lists what snell reads from a stage: its units and time range, the meshes
 drawn (with their parts and materials, skinning and deformation), the
 materials bound for --purpose, cameras and lights (with snell's units), what
 was skipped, and every warning. Exits 1 when the stage is broken where snell
-needs it (a missing texture, a mesh with faces but no points)."""
+needs it (a mesh with faces but no points; with --strict a missing texture)."""
 
 
 class _Parser(argparse.ArgumentParser):
@@ -126,6 +127,9 @@ def _parser() -> argparse.ArgumentParser:
                          help="the geometry drawn beside 'default' ('guide' never is; default render)")
     reading.add_argument("--meters-per-unit", type=_positive, metavar="M",
                          help="the stage's unit in metres, instead of its metersPerUnit")
+    reading.add_argument("--strict", action="store_true",
+                         help="a missing texture file is an error (by default a warning, and the texture's "
+                              "fallback is drawn, as usdview draws it)")
 
     parser = _Parser(prog="snell-usd", parents=[_global_options(defaults=True)],
                      formatter_class=argparse.RawDescriptionHelpFormatter,
@@ -201,7 +205,7 @@ class _Console:
 
 def _info(args: argparse.Namespace, console: _Console) -> int:
     contents = read(args.stage, time=args.time, purpose=args.purpose, geometry_purpose=args.geometry_purpose,
-                    meters_per_unit=args.meters_per_unit, load_textures=False)
+                    meters_per_unit=args.meters_per_unit, load_textures=False, missing_textures_fail=args.strict)
     listing = _listing(contents)
     if args.json:
         print(json.dumps(listing, indent=2))
@@ -335,7 +339,10 @@ def _render(args: argparse.Namespace, console: _Console) -> int:
         if not frames:
             return EXIT_OK
     contents = read(args.stage, time=frames[0] if frames else None, purpose=args.purpose,
-                    geometry_purpose=args.geometry_purpose, meters_per_unit=args.meters_per_unit, strict=True)
+                    geometry_purpose=args.geometry_purpose, meters_per_unit=args.meters_per_unit,
+                    missing_textures_fail=args.strict)
+    if contents.problems.errors:  # a stage broken where snell needs it: nothing is drawn
+        raise StageError(f"{contents.path}: {contents.problems.errors[0]}".replace(": error: ", ": ", 1))
     if frames is None:
         if not float(contents.time).is_integer():
             raise StageError(f"{contents.path}: its start time code {contents.time:g} is not a whole frame: "
