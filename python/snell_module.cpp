@@ -336,6 +336,40 @@ PYBIND11_MODULE(_snell, m) {
         return all;
       },
       "The ways of drawing glass View(method=...) takes: (name, one-line summary) pairs.");
+  m.def(
+      "read_image_file",
+      [](const std::string& path) -> py::array {
+        snell::ImageFile image;
+        {
+          py::gil_scoped_release release;
+          image = snell::readImageFile(path);
+        }
+        py::dtype type = image.bits == 32   ? py::dtype::of<float>()
+                         : image.bits == 16 ? py::dtype::of<uint16_t>()
+                                            : py::dtype::of<uint8_t>();
+        py::array out(type, {py::ssize_t(image.height), py::ssize_t(image.width), py::ssize_t(image.channels)});
+        std::memcpy(out.mutable_data(), image.data.data(), image.data.size());
+        return out;
+      },
+      "path"_a,
+      "An image file's samples as stored, (height, width, channels) with row 0 at the top: uint8, uint16 "
+      "(16-bit PNG) or float32 (Radiance HDR). Decoded by stb_image, as snell's glTF loader decodes textures: "
+      "PNG, JPEG, TGA, BMP, PSD, GIF, HDR, PIC, PNM; anything else raises snell.Error naming the file.");
+  m.def(
+      "write_png",
+      [](const std::string& path, const py::array_t<float, py::array::c_style | py::array::forcecast>& rgba,
+         bool alpha) {
+        if (rgba.ndim() != 3 || rgba.shape(2) != 4) {
+          throw snell::Error(path + ": the picture must be (height, width, 4) RGBA");
+        }
+        const float* data = rgba.data();
+        auto width = uint32_t(rgba.shape(1)), height = uint32_t(rgba.shape(0));
+        py::gil_scoped_release release;
+        snell::writePng(path, width, height, data, alpha);
+      },
+      "path"_a, "rgba"_a, "alpha"_a = false,
+      "Writes a (height, width, 4) scene-linear picture as an 8-bit sRGB PNG, as `snell render` does: complete "
+      "or not at all (a temporary file renamed). Alpha is kept with alpha=True, else the PNG is opaque.");
 
   py::class_<PyDevice>(m, "Device", "The GPU snell runs on (a Vulkan device of its own).")
       .def(py::init([](const std::string& device, bool validation, bool interop, bool driverRayTracing) {

@@ -556,6 +556,27 @@ class SharedSemaphore {
   std::unique_ptr<Impl> impl_;
 };
 
+/// An image file's samples as it stores them, decoded; row 0 at the top.
+struct ImageFile {
+  uint32_t width = 0, height = 0;
+  uint32_t channels = 0;  ///< 1 grey, 2 grey and alpha, 3 RGB, 4 RGBA
+  uint32_t bits = 8;      ///< 8 or 16 (unsigned integers, native-endian) or 32 (float: Radiance HDR)
+  std::vector<uint8_t> data;  ///< width * height * channels samples of bits / 8 bytes, row after row
+};
+
+/// Decodes an image file as stb_image reads it (PNG of 8 or 16 bits, JPEG,
+/// TGA, BMP, PSD, GIF, Radiance HDR, PIC, PNM: the decoder snell's glTF
+/// loader uses), so a host needs no image library of its own. Throws Error
+/// naming the file and the problem (another format, such as EXR, included).
+ImageFile readImageFile(const std::string& path);
+
+/// Writes linear RGBA floats (width * height * 4, row 0 at the top) as an
+/// 8-bit sRGB PNG, as `snell render` writes one: into a temporary file in the
+/// same folder, renamed into place once complete, so a failed write leaves
+/// nothing. Alpha is kept where `alpha` is set, else opaque. Throws Error
+/// naming the file and the problem.
+void writePng(const std::string& path, uint32_t width, uint32_t height, const float* rgba, bool alpha = false);
+
 }  // namespace snell
 
 #pragma GCC visibility pop

@@ -33,8 +33,10 @@ from ._snell import (
     TextureTransform,
     View,
     methods,
+    read_image_file,
     render_frames,
     version,
+    write_png,
 )
 
 __version__ = version()
@@ -55,6 +57,8 @@ __all__ = [
     "TextureTransform",
     "View",
     "methods",
+    "read_image_file",
     "render_frames",
     "version",
+    "write_png",
 ]

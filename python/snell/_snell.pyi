@@ -17,6 +17,13 @@ def version() -> str:
 def methods() -> list[tuple[str, str]]:
     """The ways of drawing glass View(method=...) takes: (name, one-line summary) pairs."""
 
+def read_image_file(path: str) -> np.ndarray:
+    """An image file's samples as stored, (height, width, channels), row 0 at the top: uint8, uint16 (16-bit
+    PNG) or float32 (Radiance HDR); decoded by stb_image (PNG, JPEG, TGA, BMP, PSD, GIF, HDR, PIC, PNM)."""
+
+def write_png(path: str, rgba: npt.ArrayLike, alpha: bool = False) -> None:
+    """Writes a (height, width, 4) scene-linear picture as an 8-bit sRGB PNG, complete or not at all."""
+
 class Device:
     """The GPU snell runs on (a Vulkan device of its own)."""
 

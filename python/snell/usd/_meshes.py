@@ -155,7 +155,7 @@ def read_primvar(prim: Usd.Prim, attribute: Usd.Attribute, interpolation: str, i
 
 def read_normals(mesh: UsdGeom.Mesh, topology: Topology, time: Usd.TimeCode, problems: Problems) -> Optional[Primvar]:
     """primvars:normals, else normals; None: computed from the points."""
-    primvar = UsdGeom.PrimvarsAPI(mesh).GetPrimvar("normals")
+    primvar = UsdGeom.PrimvarsAPI(mesh.GetPrim()).GetPrimvar("normals")
     if primvar and primvar.HasAuthoredValue():
         indices = np.asarray(primvar.GetIndices(time), np.int64) if primvar.IsIndexed() else None
         return read_primvar(mesh.GetPrim(), primvar.GetAttr(), primvar.GetInterpolation(), indices, topology, time,

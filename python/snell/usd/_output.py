@@ -1,5 +1,7 @@
 """Pictures to files as `snell render` writes them: EXR linear (half or float), PNG 8-bit sRGB; atomically.
 
+PNG is snell's own (snell.write_png); EXR goes through OpenImageIO's Python module.
+
 A file appears only once it is complete: the image is written to a hidden
 temporary file in the same folder and renamed over the name asked for, so a
 farm's retry or `--skip-existing` never takes a half-written frame for a
@@ -14,8 +16,6 @@ from typing import Mapping, Union
 
 import numpy as np
 
-from ._textures import linear_to_srgb
-
 EXTENSIONS = (".exr", ".png")
 
 
@@ -23,20 +23,13 @@ class OutputError(Exception):
     """An image that cannot be written; the message names the file."""
 
 
-def _oiio():
+def _oiio(path: Path):
     try:
         import OpenImageIO
-    except ImportError as e:
-        raise OutputError("writing EXR and PNG needs OpenImageIO's Python module "
-                          "(Debian: python3-openimageio; pip: OpenImageIO)") from e
+    except ImportError:
+        raise OutputError(f"{path}: writing EXR needs OpenImageIO's Python module (Debian: python3-openimageio; "
+                          "pip: OpenImageIO); snell writes .png itself") from None
     return OpenImageIO
-
-
-def srgb8(rgba: np.ndarray) -> np.ndarray:
-    """Linear RGB to 8-bit sRGB, as snell's PNG writer rounds it; alpha 255."""
-    out = np.full(rgba.shape[:2] + (4,), 255, np.uint8)
-    out[..., :3] = np.rint(linear_to_srgb(rgba[..., :3].astype(np.float64)) * 255.0)
-    return out
 
 
 def check_writable(path: Union[str, os.PathLike]) -> None:
@@ -53,20 +46,26 @@ def check_writable(path: Union[str, os.PathLike]) -> None:
 
 def write_image(path: Union[str, os.PathLike], rgba: np.ndarray, float_pixels: bool = False,
                 metadata: Mapping[str, object] = ()) -> None:
-    """Writes a (height, width, 4) float32 scene-linear picture; the extension picks EXR or PNG."""
-    oiio = _oiio()
+    """Writes a (height, width, 4) float32 scene-linear picture; the extension picks EXR or PNG (8-bit sRGB,
+    written by snell itself, as `snell render` writes it; the metadata is EXR's alone)."""
     path = Path(path)
     ext = path.suffix.lower()
     if ext not in EXTENSIONS:
         raise OutputError(f"{path}: unsupported image type '{path.suffix}' (use .exr or .png)")
-    height, width = rgba.shape[:2]
     if ext == ".png":
-        pixels, spec = srgb8(rgba), oiio.ImageSpec(width, height, 4, "uint8")
-    else:
-        kind = "float" if float_pixels else "half"
-        pixels, spec = np.ascontiguousarray(rgba, np.float32), oiio.ImageSpec(width, height, 4, kind)
-        spec.attribute("compression", "zip")
-        spec.attribute("oiio:ColorSpace", "Linear")
+        from .. import Error, write_png
+
+        try:
+            write_png(str(path), np.ascontiguousarray(rgba, np.float32))
+        except Error as e:
+            raise OutputError(str(e)) from None
+        return
+    oiio = _oiio(path)
+    height, width = rgba.shape[:2]
+    kind = "float" if float_pixels else "half"
+    pixels, spec = np.ascontiguousarray(rgba, np.float32), oiio.ImageSpec(width, height, 4, kind)
+    spec.attribute("compression", "zip")
+    spec.attribute("oiio:ColorSpace", "Linear")
     spec.channelnames = ("R", "G", "B", "A")
     spec.alpha_channel = 3
     for name, value in dict(metadata).items():

@@ -13,7 +13,7 @@ from __future__ import annotations
 import os
 import time as clock
 from dataclasses import dataclass
-from typing import Optional, Union
+from typing import Callable, Optional, Union
 
 import numpy as np
 from pxr import Sdf, Tf, Usd, UsdGeom, UsdLux, UsdSkel
@@ -21,6 +21,8 @@ from pxr import Sdf, Tf, Usd, UsdGeom, UsdLux, UsdSkel
 from .. import Instance, Light, Material, Mesh
 from ._cameras import CameraState, camera_state
 from ._colours import colour_atlas, mesh_colours
+from ._gprims import TYPES as GPRIM_TYPES
+from ._gprims import GprimMesh
 from ._lights import LightRecord, read_light, unsupported_light
 from ._materials import MaterialRecord, MaterialTable
 from ._meshes import MeshSource, Part, Pose, Topology, material_subsets, read_normals, read_primvar, read_topology
@@ -53,6 +55,8 @@ class Placement:
     varying: bool
     matrix: np.ndarray  #: current mesh-to-snell-world, 4x4, column vectors
     rigid_skin: Optional[Skin] = None
+    #: a PointInstancer's instance: its matrix at a time code (None where the instancer no longer fits)
+    placed: Optional[Callable[[Usd.TimeCode], Optional[np.ndarray]]] = None
 
 
 @dataclass
@@ -164,10 +168,9 @@ class StageContents:
             if prim.IsA(UsdGeom.Camera):
                 self.cameras.append(prim)
             elif prim.IsA(UsdGeom.PointInstancer):
-                self.problems.warn(prim.GetPath(), "a PointInstancer: snell does not read point instancing yet: "
-                                                   "skipped, with its prototypes")
-                walk.PruneChildren()
-            elif prim.IsA(UsdGeom.Mesh):
+                self._add_instancer(prim, time, excluded)
+                walk.PruneChildren()  # its prototypes are drawn where it places them, not where they stand
+            elif prim.IsA(UsdGeom.Mesh) or prim.GetTypeName() in GPRIM_TYPES:
                 purpose = imageable.ComputePurpose()
                 if purpose in excluded:
                     self._skip(f"purpose {purpose}", prim)
@@ -188,7 +191,8 @@ class StageContents:
             if kind in ("invisible",) or kind.startswith("purpose"):
                 continue
             first = ", ".join(paths[:3]) + (", ..." if len(paths) > 3 else "")
-            self.problems.warn("", f"{len(paths)} {kind} prim(s) skipped: snell reads UsdGeomMesh ({first})")
+            self.problems.warn("", f"{len(paths)} {kind} prim(s) skipped: snell reads UsdGeomMesh and "
+                                   f"{', '.join(GPRIM_TYPES)} ({first})")
 
     def _unhonoured_draw_mode(self, prim: Usd.Prim) -> None:
         """model:drawMode asks for a stand-in (bounds, cards, origin); snell draws the model's geometry."""
@@ -224,9 +228,81 @@ class StageContents:
             return None
         return Skin(prim, query, skel_query, self.problems)
 
-    def _add_mesh(self, prim: Usd.Prim, time: Usd.TimeCode) -> None:
-        mesh = UsdGeom.Mesh(prim)
-        skin = self._skin_of(prim)
+    def _add_instancer(self, prim: Usd.Prim, time: Usd.TimeCode, excluded: set[str]) -> None:
+        """A PointInstancer: each visible, active instance of a prototype places that prototype's meshes (snell
+        instances of shared meshes), by USD's own ComputeInstanceTransformsAtTime (positions, orientations,
+        scales, the prototype root's transform); invisibleIds and inactiveIds are its mask."""
+        instancer = UsdGeom.PointInstancer(prim)
+        where = prim.GetPath()
+        prototypes = [self.stage.GetPrimAtPath(p) for p in instancer.GetPrototypesRel().GetTargets()]
+        indices = np.asarray(instancer.GetProtoIndicesAttr().Get(time) or [], np.int64)
+        if len(indices) == 0 or not prototypes:
+            self.problems.warn(where, "a PointInstancer without protoIndices or prototypes: nothing to draw")
+            return
+        mask = instancer.ComputeMaskAtTime(time)
+        keep = np.asarray(mask, bool) if mask else np.ones(len(indices), bool)
+        bad = (indices < 0) | (indices >= len(prototypes))
+        if bad.any():
+            self.problems.warn(where, f"{int(bad.sum())} protoIndices are outside its {len(prototypes)} prototypes: "
+                                      "those instances are skipped")
+        for n, proto in enumerate(prototypes):
+            if not proto.IsValid():
+                self.problems.warn(where, f"prototype {n} is not a prim of the stage: its instances are skipped")
+        attributes = [instancer.GetPositionsAttr(), instancer.GetOrientationsAttr(), instancer.GetScalesAttr(),
+                      instancer.GetProtoIndicesAttr()]
+        varying = transform_might_vary(prim) or any(a.ValueMightBeTimeVarying() for a in attributes)
+        if any(a.ValueMightBeTimeVarying() for a in (instancer.GetProtoIndicesAttr(), instancer.GetIdsAttr())) or \
+                prim.GetAttribute("invisibleIds").ValueMightBeTimeVarying():
+            self.problems.warn(where, "its protoIndices, ids or invisibleIds are animated; snell keeps the instances "
+                                      f"of time code {self.time:g} and moves them")
+        count = len(indices)
+        cache: dict[float, list[np.ndarray]] = {}
+
+        def instance_matrices(t: Usd.TimeCode) -> list[np.ndarray]:
+            """Each instance's prototype-to-snell-world matrix at t (column vectors)."""
+            key = t.GetValue()
+            if key not in cache:
+                cache.clear()
+                xforms = instancer.ComputeInstanceTransformsAtTime(t, t, UsdGeom.PointInstancer.IncludeProtoXform,
+                                                                   UsdGeom.PointInstancer.IgnoreMask)
+                world = self.to_snell @ np.array(UsdGeom.XformCache(t).GetLocalToWorldTransform(prim)).T
+                if xforms is None or len(xforms) != count:
+                    cache[key] = []
+                else:
+                    cache[key] = [world @ np.array(x).T for x in xforms]
+            return cache[key]
+
+        if not instance_matrices(time):
+            self.problems.warn(where, "its positions, orientations or scales do not fit its protoIndices: skipped")
+            return
+        predicate = Usd.TraverseInstanceProxies(Usd.PrimDefaultPredicate)
+        for n, proto in enumerate(prototypes):
+            if not proto.IsValid() or not (keep & (indices == n)).any():
+                continue
+            for inner in Usd.PrimRange(proto, predicate):
+                imageable = UsdGeom.Imageable(inner)
+                if imageable and imageable.ComputeVisibility(time) == UsdGeom.Tokens.invisible:
+                    continue
+                if inner.IsA(UsdGeom.PointInstancer) and inner != prim:
+                    self.problems.warn(inner.GetPath(), "a PointInstancer inside a prototype: skipped")
+                    continue
+                if not (inner.IsA(UsdGeom.Mesh) or inner.GetTypeName() in GPRIM_TYPES):
+                    continue
+                if imageable.ComputePurpose() in excluded:
+                    continue
+                relative, _ = UsdGeom.XformCache(time).ComputeRelativeTransform(inner, proto)
+                below = np.array(relative).T  # the mesh in its prototype's space
+                for i in np.nonzero(keep & (indices == n))[0]:
+                    def placed(t: Usd.TimeCode, i: int = int(i), below: np.ndarray = below) -> np.ndarray:
+                        matrices = instance_matrices(t)
+                        return matrices[i] @ below if matrices else None
+                    self._add_mesh(inner, time, placed, varying)
+
+    def _add_mesh(self, prim: Usd.Prim, time: Usd.TimeCode, placed=None, varying_placement: bool = False) -> None:
+        """A UsdGeomMesh, or a gprim tessellated as one (_gprims.py); placed: a PointInstancer's instance (its
+        mesh-to-snell-world matrix at a time code), else the prim's own transform places it."""
+        mesh = UsdGeom.Mesh(prim) if prim.IsA(UsdGeom.Mesh) else GprimMesh(prim)
+        skin = self._skin_of(prim) if prim.IsA(UsdGeom.Mesh) else None
         prototype = prim.GetPrimInPrototype() if prim.IsInstanceProxy() else prim
         key = prototype.GetPath()
         if skin is None and key in self._topologies:
@@ -244,7 +320,7 @@ class StageContents:
         rigid = skin if skin is not None and skin.skinned and skin.rigid else None
         placed_by = skin.skeleton_prim if skin is not None and skin.skinned else prim
         frame = SkelFrame(time)
-        matrix = self._matrix(placed_by, rigid, frame)
+        matrix = placed(time) if placed is not None else self._matrix(placed_by, rigid, frame)
         flip = np.linalg.det(matrix[:3, :3]) < 0.0
         share = (key, tuple(m for _, _, m in parts), flip) if skin is None else None
         source = self._shared.get(share) if share is not None else None
@@ -255,9 +331,11 @@ class StageContents:
             if share is not None:
                 self._shared[share] = source
         varying = transform_might_vary(placed_by) or bool(rigid is not None and rigid.animated)
+        if placed is not None:
+            varying = varying_placement
         instances = list(range(self._instance_count, self._instance_count + len(source.parts)))
         self._instance_count += len(source.parts)
-        self.placements.append(Placement(placed_by, source, instances, varying, matrix, rigid))
+        self.placements.append(Placement(placed_by, source, instances, varying, matrix, rigid, placed))
 
     def _make_source(self, mesh: UsdGeom.Mesh, topology: Topology, skin: Optional[Skin], parts: list,
                      flip: bool, time: Usd.TimeCode) -> Optional[MeshSource]:
@@ -413,7 +491,11 @@ class StageContents:
             if pose is not None:
                 poses.append((source, pose))
         self._xform_cache.SetTime(t)
-        transforms = [(p, self._matrix(p.prim, p.rigid_skin, frame)) for p in self.dynamic_placements]
+        transforms = []
+        for p in self.dynamic_placements:
+            matrix = p.placed(t) if p.placed is not None else self._matrix(p.prim, p.rigid_skin, frame)
+            if matrix is not None:  # an instancer whose points no longer fit its instances keeps them where they were
+                transforms.append((p, matrix))
         return Frame(time_code, poses, transforms, clock.perf_counter() - started)
 
 

@@ -1,4 +1,4 @@
-"""UsdUVTexture images as snell textures: read with OpenImageIO, converted on the CPU.
+"""UsdUVTexture images as snell textures: decoded by snell (OpenImageIO for other formats), converted on the CPU.
 
 snell's textures are 8-bit RGBA, row 0 at the top (snell.Texture): sRGB
 colour in the base colour and emissive slots, data (bytes / 255) in the
@@ -71,13 +71,37 @@ def linear_to_srgb(c: np.ndarray) -> np.ndarray:
     return np.where(c <= 0.0031308, 12.92 * c, 1.055 * np.power(c, 1.0 / 2.4) - 0.055)
 
 
-def _oiio():
+def _decoded(path: str, shown: str) -> tuple[np.ndarray, str]:
+    """The file's samples (height, width, channels: uint8, uint16 or float32) and what it says of its colour
+    space: decoded by snell itself (stb_image, as its glTF loader decodes textures), or for other formats (EXR,
+    TIFF) by OpenImageIO's Python module where it is installed."""
+    from .. import Error, read_image_file
+
     try:
-        import OpenImageIO
-    except ImportError as e:  # the module is optional for stages without textures
-        raise TextureReadError("reading textures needs OpenImageIO's Python module "
-                               "(Debian: python3-openimageio; pip: OpenImageIO)") from e
-    return OpenImageIO
+        return read_image_file(path), ""
+    except Error as e:
+        snell_says = str(e).replace(path, shown, 1)
+    try:
+        import OpenImageIO as oiio
+    except ImportError:
+        raise TextureReadError(f"{snell_says} (other formats need OpenImageIO's Python module: "
+                               "Debian's python3-openimageio, or pip's OpenImageIO)") from None
+    # The file's own values: OpenImageIO would otherwise premultiply colour by alpha.
+    config = oiio.ImageSpec()
+    config.attribute("oiio:UnassociatedAlpha", 1)
+    image = oiio.ImageInput.open(path, config)
+    if image is None:
+        raise TextureReadError(f"{shown}: not an image snell or OpenImageIO reads ({oiio.geterror()})")
+    try:
+        spec = image.spec()
+        kind = "uint8" if spec.format == oiio.UINT8 else "float"
+        pixels = image.read_image(0, 0, 0, spec.nchannels, kind)
+        if pixels is None:
+            raise TextureReadError(f"{shown}: {image.geterror()}")
+        said = spec.get_string_attribute("oiio:ColorSpace", "")
+    finally:
+        image.close()
+    return np.asarray(pixels).reshape(spec.height, spec.width, spec.nchannels), said
 
 
 def is_srgb(color_space: str, bits8: bool, channels: int, file_says: str) -> bool:
@@ -132,33 +156,19 @@ def _passes_through(request: TextureRequest, bits8: bool, srgb: bool, channels: 
 
 
 def _read_texture(request: TextureRequest, path: str) -> TextureImage:
-    oiio = _oiio()
-    # The file's own values: OpenImageIO would otherwise premultiply a PNG's colour by its alpha.
-    config = oiio.ImageSpec()
-    config.attribute("oiio:UnassociatedAlpha", 1)
-    image = oiio.ImageInput.open(path, config)
-    if image is None:
-        raise TextureReadError(f"{request.path}: not an image OpenImageIO reads ({oiio.geterror()})")
-    try:
-        spec = image.spec()
-        channels = spec.nchannels
-        bits8 = spec.format == oiio.UINT8
-        srgb = is_srgb(request.color_space, bits8, channels, spec.get_string_attribute("oiio:ColorSpace", ""))
-        if _passes_through(request, bits8, srgb, channels):
-            pixels = image.read_image(0, 0, 0, channels, "uint8")
-            if pixels is None:
-                raise TextureReadError(f"{request.path}: {image.geterror()}")
-            rgba = np.full((spec.height, spec.width, 4), 255, np.uint8)
-            rgba[..., :3] = pixels[..., :3]
-            if request.alpha == "a" and channels >= 4:
-                rgba[..., 3] = pixels[..., 3]
-            return TextureImage(rgba)
-        pixels = image.read_image(0, 0, 0, channels, "float")
-        if pixels is None:
-            raise TextureReadError(f"{request.path}: {image.geterror()}")
-    finally:
-        image.close()
-    texels = _usd_channels(np.asarray(pixels, np.float64).reshape(spec.height, spec.width, channels))
+    pixels, file_says = _decoded(path, request.path)
+    height, width, channels = pixels.shape
+    bits8 = pixels.dtype == np.uint8
+    srgb = is_srgb(request.color_space, bits8, channels, file_says)
+    if _passes_through(request, bits8, srgb, channels):
+        rgba = np.full((height, width, 4), 255, np.uint8)
+        rgba[..., :3] = pixels[..., :3]
+        if request.alpha == "a" and channels >= 4:
+            rgba[..., 3] = pixels[..., 3]
+        return TextureImage(rgba)
+    scale = {np.dtype(np.uint8): 255.0, np.dtype(np.uint16): 65535.0}.get(pixels.dtype, 1.0)
+    pixels = pixels.astype(np.float64) / scale
+    texels = _usd_channels(pixels)
     if srgb:
         texels[..., :3] = srgb_to_linear(texels[..., :3])
     values = texels * np.asarray(request.scale) + np.asarray(request.bias)
