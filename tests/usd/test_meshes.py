@@ -191,9 +191,9 @@ def test_face_indices_past_the_points_are_an_error(tmp_path):
 
 def test_a_stage_with_nothing_to_draw_is_refused(tmp_path, device):
     stage = new_stage(tmp_path / "n.usda")
-    UsdGeom.Sphere.Define(stage, "/World/Ball")
+    UsdGeom.BasisCurves.Define(stage, "/World/Hair")
     stage.GetRootLayer().Save()
-    with pytest.raises(snell.usd.StageError, match="nothing to draw: no visible UsdGeomMesh"):
+    with pytest.raises(snell.usd.StageError, match="nothing to draw: no visible UsdGeomMesh or gprim"):
         snell.usd.open(tmp_path / "n.usda", device=device)
 
 

@@ -124,6 +124,9 @@ def read_light(prim: Usd.Prim, time: Usd.TimeCode, to_snell: np.ndarray, xform_c
     if shape:
         problems.warn(path, f"a {kind} shines as a point light of the same power ({candela:.4g} cd): snell has no "
                             "area lights")
+    elif area > 0.0:
+        problems.warn(path, f"a SphereLight of radius {r:g} shines as a point light at its centre ({candela:.4g} cd, "
+                            "its intensity in every direction): its highlights are points, not discs")
     shaping = UsdLux.ShapingAPI(prim)
     if prim.HasAPI(UsdLux.ShapingAPI):
         if _value(shaping.GetShapingIesFileAttr(), time, None):

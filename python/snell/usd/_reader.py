@@ -300,7 +300,16 @@ class StageContents:
 
     def _add_mesh(self, prim: Usd.Prim, time: Usd.TimeCode, placed=None, varying_placement: bool = False) -> None:
         """A UsdGeomMesh, or a gprim tessellated as one (_gprims.py); placed: a PointInstancer's instance (its
-        mesh-to-snell-world matrix at a time code), else the prim's own transform places it."""
+        mesh-to-snell-world matrix at a time code), else the prim's own transform places it. A prim whose
+        attributes are not of the types their schema gives is an error naming the attribute, never a traceback."""
+        if prim.IsA(UsdGeom.Mesh) and not _typed_as_schema(prim, self.problems):
+            return
+        try:
+            self._read_mesh(prim, time, placed, varying_placement)
+        except (TypeError, ValueError, IndexError, Tf.ErrorException) as e:
+            self.problems.fail(prim.GetPath(), f"cannot be read as a mesh ({str(e).strip().splitlines()[-1]})")
+
+    def _read_mesh(self, prim: Usd.Prim, time: Usd.TimeCode, placed, varying_placement: bool) -> None:
         mesh = UsdGeom.Mesh(prim) if prim.IsA(UsdGeom.Mesh) else GprimMesh(prim)
         skin = self._skin_of(prim) if prim.IsA(UsdGeom.Mesh) else None
         prototype = prim.GetPrimInPrototype() if prim.IsInstanceProxy() else prim
@@ -499,6 +508,30 @@ class StageContents:
         return Frame(time_code, poses, transforms, clock.perf_counter() - started)
 
 
+# What a mesh's attributes must hold for snell to read them: their schema's types (the value's shape).
+_MESH_TYPES = {"points": ("point3f[]", "float3[]", "vector3f[]", "point3h[]", "float3h[]", "point3d[]"),
+               "normals": ("normal3f[]", "float3[]", "vector3f[]", "normal3h[]", "normal3d[]"),
+               "primvars:normals": ("normal3f[]", "float3[]", "vector3f[]", "normal3h[]", "normal3d[]"),
+               "faceVertexCounts": ("int[]",), "faceVertexIndices": ("int[]",), "holeIndices": ("int[]",)}
+
+
+def _typed_as_schema(prim: Usd.Prim, problems: Problems) -> bool:
+    """Whether the mesh's authored points, normals and face lists are of their schema's types; where one is not
+    (scalar normals, int points, double[] points), an error naming the attribute and both types."""
+    for name, types in _MESH_TYPES.items():
+        attribute = prim.GetAttribute(name)
+        if not attribute or not attribute.HasAuthoredValue():
+            continue
+        # The type the layers author (the schema's type, GetTypeName's, hides a spec of another type).
+        specs = attribute.GetPropertyStack(Usd.TimeCode.Default())
+        kind = str(specs[0].typeName) if specs else str(attribute.GetTypeName())
+        if kind not in types:
+            problems.fail(prim.GetPath(), f"{name} is {kind}, not {types[0]} as UsdGeomMesh has it: the mesh is "
+                                          "not drawn")
+            return False
+    return True
+
+
 def _fmt_colour(values: np.ndarray) -> str:
     return "(" + ", ".join(f"{float(c):.3g}" for c in values) + ")"
 
@@ -509,8 +542,11 @@ def _open_stage(path: str) -> Usd.Stage:
     try:
         stage = Usd.Stage.Open(path, Usd.Stage.LoadAll)
     except Tf.ErrorException as e:
-        reason = str(e).strip().splitlines()[-1] if str(e).strip() else "USD cannot open it"
-        raise StageError(f"{path}: not a stage USD opens ({reason.strip()})") from None
+        # USD's own reason (a parse error, at its line), not only its closing "Failed to open layer".
+        said = [str(getattr(a, "commentary", a)).strip() for a in e.args] or [str(e).strip()]
+        reasons = [r for r in said if r and not r.startswith("Failed to open layer")] or said
+        reason = next((r for r in reasons if r.startswith(path)), reasons[0] if reasons else "USD cannot open it")
+        raise StageError(f"{path}: not a stage USD opens ({reason})") from None
     if stage is None:
         raise StageError(f"{path}: not a stage USD opens")
     return stage

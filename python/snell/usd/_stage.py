@@ -44,7 +44,7 @@ class Stage:
         self.contents = contents
         meshes = contents.snell_meshes()
         if not meshes:
-            raise StageError(f"{contents.path}: nothing to draw: no visible UsdGeomMesh with faces"
+            raise StageError(f"{contents.path}: nothing to draw: no visible UsdGeomMesh or gprim with faces"
                              + _skipped_note(contents))
         self._owns_device = device is None
         self.device = device if device is not None else Device()
