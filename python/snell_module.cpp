@@ -323,6 +323,7 @@ PYBIND11_MODULE(_snell, m) {
       "with projection (OpenGL: perspective or orthographic, off-centre for lens shift; its\n"
       "aspect must be width/height), else a look-at from eye to target with yfov radians.\n"
       "viewport=True draws the viewport composite: rasterised, with only the glass traced.\n"
+      "environment: a snell.Environment the glass reflects (None: snell's studio gradient).\n"
       "method: auto (trace, or driver-rt where it times faster) or one of snell.methods():\n" +
       methodList();
   m.doc() = "snell: refraction through deforming meshes, ray traced by Vulkan compute.";
@@ -606,12 +607,37 @@ PYBIND11_MODULE(_snell, m) {
                        : std::string("<snell.Scene (closed)>");
       });
 
+  py::class_<snell::Environment>(m, "Environment",
+                                 "What glass reflects: an equirectangular (lat-long) map of linear RGB radiance,\n"
+                                 "row 0 looking up (+Y), the middle column looking down -Z, +X right of it.")
+      .def(py::init([](const py::array_t<float, py::array::c_style | py::array::forcecast>& rgb,
+                       const std::string& name) {
+             if (rgb.ndim() != 3 || rgb.shape(2) != 3) {
+               throw snell::Error(name + ": an environment must be (height, width, 3) RGB");
+             }
+             const float* data = rgb.data();
+             auto width = uint32_t(rgb.shape(1)), height = uint32_t(rgb.shape(0));
+             py::gil_scoped_release release;
+             return snell::Environment::fromPixels(width, height, data, name);
+           }),
+           "rgb"_a, "name"_a = "environment",
+           "rgb: (height, width, 3) float32, row 0 at the top, each value finite and 0 or more (copied;\n"
+           "one wider than 4096 texels is halved until it fits). A View takes it as environment=.")
+      .def_property_readonly("width", &snell::Environment::width)
+      .def_property_readonly("height", &snell::Environment::height)
+      .def_property_readonly("name", &snell::Environment::name)
+      .def("__repr__", [](const snell::Environment& e) {
+        return "<snell.Environment '" + e.name() + "', " + std::to_string(e.width()) + "x" +
+               std::to_string(e.height()) + ">";
+      });
+
   py::class_<snell::View>(m, "View", "One picture of the scene: its size, camera, method and optics.")
       .def(py::init([](uint32_t width, uint32_t height, int camera, const py::object& viewMatrix,
                        const py::object& projection, const std::vector<float>& eye, const std::vector<float>& target,
                        const std::vector<float>& up, float yfov, bool viewport, const std::string& method,
                        uint32_t maxInterfaces, bool fresnel, bool dispersion, bool volume,
-                       const std::vector<float>& background, bool transparentBackground) {
+                       const std::vector<float>& background, bool transparentBackground,
+                       std::optional<snell::Environment> environment) {
              snell::View v;
              if (width == 0 || height == 0) throw snell::Error("a view needs a size, got " + std::to_string(width) + "x" + std::to_string(height));
              v.width = width;
@@ -633,6 +659,7 @@ PYBIND11_MODULE(_snell, m) {
              v.volume = volume;
              v.background = toVec3(background, "background");
              v.transparentBackground = transparentBackground;
+             v.environment = std::move(environment);
              return v;
            }),
            "width"_a = 640, "height"_a = 480, "camera"_a = -1, "view_matrix"_a = py::none(), "projection"_a = py::none(),
@@ -640,7 +667,7 @@ PYBIND11_MODULE(_snell, m) {
            "up"_a = std::vector<float>{0, 1, 0}, "yfov"_a = 0.6981317f, "viewport"_a = false, "method"_a = "auto",
            "max_interfaces"_a = 8, "fresnel"_a = true, "dispersion"_a = true, "volume"_a = true,
            "background"_a = std::vector<float>(kDefaultBackground.begin(), kDefaultBackground.end()),
-           "transparent_background"_a = false, kViewDoc.c_str())
+           "transparent_background"_a = false, "environment"_a = py::none(), kViewDoc.c_str())
       .def_readwrite("width", &snell::View::width)
       .def_readwrite("height", &snell::View::height)
       .def_readwrite("camera", &snell::View::sceneCamera)
@@ -654,6 +681,8 @@ PYBIND11_MODULE(_snell, m) {
       .def_readwrite("volume", &snell::View::volume)
       .def_readwrite("background", &snell::View::background)
       .def_readwrite("transparent_background", &snell::View::transparentBackground)
+      .def_readwrite("environment", &snell::View::environment,
+                     "What glass reflects (a snell.Environment); None: snell's studio gradient.")
       .def(
           "set_matrices",
           [](snell::View& v, const py::object& viewMatrix, const py::object& projection) {
@@ -930,7 +959,8 @@ PYBIND11_MODULE(_snell, m) {
         py::list workers;
         for (const snell::ShotSummary::Worker& w : summary.workers) {
           workers.append(py::dict("device"_a = w.device, "frames"_a = w.frames, "load_seconds"_a = w.loadSeconds,
-                                  "gpu_wait_seconds"_a = w.gpuWaitSeconds, "lost"_a = w.lost));
+                                  "gpu_wait_seconds"_a = w.gpuWaitSeconds, "lost"_a = w.lost,
+                                  "validation_messages"_a = w.validationMessages));
         }
         return py::dict("frames"_a = summary.frames, "seconds"_a = summary.seconds, "workers"_a = workers);
       },
@@ -943,5 +973,6 @@ PYBIND11_MODULE(_snell, m) {
       "on_frame(picture) gets each frame as it finishes, on this thread: a dict of number, seconds,\n"
       "rgba ((height, width, 4) float32, row 0 at the top), worker, device and method. The frames\n"
       "are read a few ahead of the GPUs, so a generator may pose a DCC's scene for each. A frame's\n"
-      "pixels do not depend on the device that drew it. Returns what each worker did.");
+      "pixels do not depend on the device that drew it. Returns what each worker did (device, frames,\n"
+      "load_seconds, gpu_wait_seconds, lost, validation_messages).");
 }

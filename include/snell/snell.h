@@ -290,6 +290,32 @@ struct CameraMatrices {
   Mat4 projection = kIdentity;
 };
 
+/// What glass reflects (View::environment): an equirectangular (lat-long)
+/// map of linear RGB radiance, as `snell render --environment` reads one:
+/// row 0 looks up (+Y), the middle column looks down -Z, and the columns turn
+/// towards +X to the right of the middle. Shared, not copied, by the Views
+/// that hold it: a Renderer uploads each environment once.
+class Environment {
+ public:
+  /// From the host's pixels: width * height * 3 floats (RGB, row 0 at the
+  /// top), each finite and 0 or more. One wider than 4096 texels is halved
+  /// (a box filter) until it fits. Throws Error naming `name` and the problem.
+  static Environment fromPixels(uint32_t width, uint32_t height, const float* rgb,
+                                const std::string& name = "environment");
+  /// Its size once fitted.
+  uint32_t width() const;
+  uint32_t height() const;
+  /// The name messages give it.
+  std::string name() const;
+
+  struct Impl;
+  const std::shared_ptr<const Impl>& impl() const { return impl_; }
+
+ private:
+  explicit Environment(std::shared_ptr<const Impl> impl);
+  std::shared_ptr<const Impl> impl_;
+};
+
 /// One picture of the scene.
 struct View {
   uint32_t width = 640, height = 480;
@@ -318,6 +344,10 @@ struct View {
   bool dispersion = true;  ///< KHR_materials_dispersion splits the colours
   bool volume = true;      ///< KHR_materials_volume tints light inside thick glass
   Vec3 background{0.02f, 0.02f, 0.025f};  ///< linear RGB where nothing is drawn
+  /// What the rays that glass reflects see where they meet nothing (with
+  /// `fresnel`); none: snell's studio gradient. Camera rays and the rays
+  /// glass transmits see `background` there.
+  std::optional<Environment> environment;
   /// Viewport only: alpha 0 (and black) where nothing is drawn, so the host
   /// composites the image over its own with premultiplied alpha.
   bool transparentBackground = false;
@@ -488,6 +518,7 @@ struct ShotSummary {
     double loadSeconds = 0.0;     ///< its device, the scene's upload and pipelines, before its first frame
     double gpuWaitSeconds = 0.0;  ///< waiting for its frames' GPU work
     std::string lost;             ///< why its device stopped early ("" when it ran to the end)
+    uint64_t validationMessages = 0;  ///< what the validation layer said on its device (DeviceOptions::validation)
   };
   std::vector<Worker> workers;
   size_t frames = 0;

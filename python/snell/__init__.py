@@ -20,6 +20,7 @@ docs/python.md covers the module.
 from ._snell import (
     Camera,
     Device,
+    Environment,
     Error,
     Instance,
     Light,
@@ -44,6 +45,7 @@ __version__ = version()
 __all__ = [
     "Camera",
     "Device",
+    "Environment",
     "Error",
     "Instance",
     "Light",

@@ -225,6 +225,15 @@ class Scene:
     def __enter__(self) -> "Scene": ...
     def __exit__(self, *args: Any) -> None: ...
 
+class Environment:
+    """What glass reflects: an equirectangular (lat-long) map of linear RGB radiance, row 0 looking up (+Y), the
+    middle column looking down -Z, +X right of it."""
+
+    width: int
+    height: int
+    name: str
+    def __init__(self, rgb: npt.ArrayLike, name: str = "environment") -> None: ...
+
 class View:
     """One picture of the scene: its size, camera, method and optics."""
 
@@ -239,6 +248,7 @@ class View:
     volume: bool
     background: Sequence[float]
     transparent_background: bool
+    environment: Optional[Environment]
     def __init__(
         self,
         width: int = 640,
@@ -258,6 +268,7 @@ class View:
         volume: bool = True,
         background: Sequence[float] = (0.02, 0.02, 0.025),
         transparent_background: bool = False,
+        environment: Optional[Environment] = None,
     ) -> None: ...
     def set_matrices(self, view_matrix: Matrix, projection: Matrix) -> None: ...
 

@@ -13,6 +13,7 @@
 #include "render/shot.h"
 #include "scene/evaluate.h"
 #include "scene/gltf_loader.h"
+#include "scene/optics.h"
 #include "scene/view.h"
 #include "vk/commands.h"
 #include "vk/context.h"
@@ -391,6 +392,35 @@ uint32_t Scene::vertexCount(int mesh) const {
 bool Scene::keepsVertices() const { return impl_->keep; }
 double Scene::duration() const { return scene::animationDuration(impl_->scene); }
 
+// ---------------------------------------------------------------- Environment
+
+// The core's environment itself: the trace keys its upload by this object, so
+// every View that holds the same Environment shares one buffer.
+struct Environment::Impl : scene::Environment {};
+
+Environment::Environment(std::shared_ptr<const Impl> impl) : impl_(std::move(impl)) {}
+
+Environment Environment::fromPixels(uint32_t width, uint32_t height, const float* rgb, const std::string& name) {
+  return guarded([&] {
+    if (width == 0 || height == 0 || !rgb) {
+      throw Error(name + ": an environment of " + std::to_string(width) + "x" + std::to_string(height) +
+                  " texels has nothing to show");
+    }
+    auto impl = std::make_shared<Impl>();
+    impl->source = name;
+    impl->width = width;
+    impl->height = height;
+    impl->texels.resize(size_t(width) * height);
+    for (size_t i = 0; i < impl->texels.size(); ++i) impl->texels[i] = glm::vec3(rgb[3 * i], rgb[3 * i + 1], rgb[3 * i + 2]);
+    scene::fitEnvironment(*impl);
+    return Environment(std::move(impl));
+  });
+}
+
+uint32_t Environment::width() const { return impl_->width; }
+uint32_t Environment::height() const { return impl_->height; }
+std::string Environment::name() const { return impl_->source; }
+
 // ---------------------------------------------------------------- Renderer
 
 namespace {
@@ -470,6 +500,7 @@ render::FrameSettings frameSettings(const View& view, const scene::Scene& model,
   settings.optics.fresnel = view.fresnel;
   settings.optics.dispersion = view.dispersion;
   settings.optics.volume = view.volume;
+  if (view.environment) settings.optics.environment = view.environment->impl();
   return settings;
 }
 
@@ -780,7 +811,7 @@ ShotSummary renderFrames(const std::string& devices, Scene& scene, const View& v
     summary.frames = report.frames;
     summary.seconds = report.seconds;
     for (const render::ShotWorker& w : report.workers) {
-      summary.workers.push_back({w.device, w.frames, w.loadSeconds, w.gpuWaitSeconds, w.lost});
+      summary.workers.push_back({w.device, w.frames, w.loadSeconds, w.gpuWaitSeconds, w.lost, w.validationMessages});
     }
     return summary;
   });

@@ -228,29 +228,6 @@ Rgb8Image readRgb8(const std::string& path) {
   return image;
 }
 
-namespace {
-
-/// Box-filters the environment to half its size in each direction.
-void halve(scene::Environment& env) {
-  uint32_t w = std::max(1u, env.width / 2), h = std::max(1u, env.height / 2);
-  std::vector<glm::vec3> out(size_t(w) * h);
-  for (uint32_t y = 0; y < h; ++y) {
-    for (uint32_t x = 0; x < w; ++x) {
-      glm::vec3 sum(0.0f);
-      for (uint32_t dy = 0; dy < 2; ++dy) {
-        for (uint32_t dx = 0; dx < 2; ++dx) {
-          sum += env.texels[size_t(std::min(2 * y + dy, env.height - 1)) * env.width + std::min(2 * x + dx, env.width - 1)];
-        }
-      }
-      out[size_t(y) * w + x] = 0.25f * sum;
-    }
-  }
-  env.width = w;
-  env.height = h;
-  env.texels = std::move(out);
-}
-
-}  // namespace
 
 scene::Environment readEnvironment(const std::string& path) {
   if (!fs::is_regular_file(path)) throw std::runtime_error(path + ": no such environment file");
@@ -290,12 +267,7 @@ scene::Environment readEnvironment(const std::string& path) {
     throw std::runtime_error(path + ": this build has no OpenImageIO, so only .png environments");
 #endif
   }
-  for (const glm::vec3& t : env.texels) {
-    if (!(std::isfinite(t.r) && std::isfinite(t.g) && std::isfinite(t.b)) || t.r < 0.0f || t.g < 0.0f || t.b < 0.0f) {
-      throw std::runtime_error(path + ": the environment has a negative or non-finite texel");
-    }
-  }
-  while (env.width > kMaxEnvironmentWidth) halve(env);
+  scene::fitEnvironment(env);
   return env;
 }
 

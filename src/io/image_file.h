@@ -94,10 +94,8 @@ struct Rgb8Image {
 Rgb8Image readRgb8(const std::string& path);
 void writeRgb8(const std::string& path, const Rgb8Image& image);
 /// Reads an equirectangular environment (HDR or EXR through OpenImageIO, or
-/// an 8-bit PNG decoded from sRGB), halved until it is at most
-/// kMaxEnvironmentWidth texels wide. Throws std::runtime_error naming the file
-/// and the problem.
-inline constexpr uint32_t kMaxEnvironmentWidth = 4096;
+/// an 8-bit PNG decoded from sRGB), fitted by scene::fitEnvironment. Throws
+/// std::runtime_error naming the file and the problem.
 scene::Environment readEnvironment(const std::string& path);
 /// The image as 8-bit sRGB, as writeImage would put it in a PNG.
 Rgb8Image toSrgb8(const LinearImage& image);

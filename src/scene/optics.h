@@ -27,6 +27,14 @@ struct Environment {
 /// the reflected rays carry a catch light of their own. `width` x width/2 texels.
 Environment proceduralSky(uint32_t width = 1024);
 
+/// The widest environment the trace keeps: a wider one is halved until it fits.
+inline constexpr uint32_t kMaxEnvironmentWidth = 4096;
+/// Makes an environment ready to draw, whoever decoded it (a file, a host's
+/// pixels): throws std::runtime_error naming its source where its texels do
+/// not fill its size or one is negative or not finite, then box-filters it
+/// to half its size until it is at most kMaxEnvironmentWidth texels wide.
+void fitEnvironment(Environment& env);
+
 struct Optics {
   bool fresnel = true;  ///< R and T at every boundary, the reflected ray and the lights' highlights
   uint32_t reflections = gpu::kDefaultReflections;  ///< boundaries per path that send a reflected ray
