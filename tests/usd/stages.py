@@ -186,3 +186,29 @@ def write_rgba_png(path: Path, rgba: np.ndarray) -> Path:
     from eye_stage import write_png
 
     return write_png(path, rgba)
+
+
+def write_hdr(path: Path, rgb: np.ndarray) -> Path:
+    """A Radiance HDR (RGBE, flat scanlines) of an (h, w, 3) float array, row 0 at the top."""
+    rgb = np.maximum(np.asarray(rgb, np.float64), 0.0)
+    height, width, _ = rgb.shape
+    peak = rgb.max(axis=2)
+    mantissa, exponent = np.frexp(peak)  # peak = mantissa * 2^exponent, mantissa in [0.5, 1)
+    scale = np.where(peak > 1e-32, mantissa * 256.0 / np.where(peak > 1e-32, peak, 1.0), 0.0)
+    rgbe = np.zeros((height, width, 4), np.uint8)
+    rgbe[..., :3] = np.clip(rgb * scale[..., None], 0, 255).astype(np.uint8)
+    rgbe[..., 3] = np.where(peak > 1e-32, exponent + 128, 0).astype(np.uint8)
+    header = f"#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y {height} +X {width}\n".encode()
+    path.write_bytes(header + rgbe.tobytes())
+    return path
+
+
+def dome_light(stage: Usd.Stage, path: str, texture: Optional[str] = None, version_1: bool = False,
+               **attributes) -> UsdLux.DomeLight:
+    """A DomeLight (or DomeLight_1) with an optional texture file and LightAPI inputs (intensity, color, ...)."""
+    light = (UsdLux.DomeLight_1 if version_1 else UsdLux.DomeLight).Define(stage, path)
+    if texture is not None:
+        light.CreateTextureFileAttr(Sdf.AssetPath(texture))
+    for name, value in attributes.items():
+        getattr(light, f"Create{name[0].upper()}{name[1:]}Attr")(value)
+    return light

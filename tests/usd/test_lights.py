@@ -85,9 +85,9 @@ def test_a_rect_light_is_a_point_light_of_the_same_power_with_a_message(tmp_path
     assert "/World/Panel: a RectLight shines as a point light of the same power (10 cd)" in text
 
 
-def test_a_dome_light_is_a_warning_and_gives_snell_no_light(tmp_path):
-    _, lights, text = lights_of(tmp_path, lambda stage: UsdLux.DomeLight.Define(stage, "/World/Sky"))
-    assert lights == [] and "/World/Sky: a DomeLight: snell has no environment lighting" in text
+def test_a_portal_light_is_a_warning_and_gives_snell_no_light(tmp_path):
+    _, lights, text = lights_of(tmp_path, lambda stage: UsdLux.PortalLight.Define(stage, "/World/Window"))
+    assert lights == [] and "/World/Window: a PortalLight: a portal only guides a dome light: skipped" in text
 
 
 def test_a_stage_without_lights_is_lit_by_snells_headlight(tmp_path, device):

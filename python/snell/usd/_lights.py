@@ -149,10 +149,9 @@ def read_light(prim: Usd.Prim, time: Usd.TimeCode, to_snell: np.ndarray, xform_c
 
 
 def unsupported_light(prim: Usd.Prim, problems: Problems) -> LightRecord:
-    """A light snell has no counterpart for (a dome, a mesh light, a portal)."""
+    """A light snell has no counterpart for (a geometry light, a portal; a dome is _dome.py's)."""
     kind = prim.GetTypeName() or "LightAPI"
-    what = {"DomeLight": "snell has no environment lighting (the glass reflects its own studio gradient)",
-            "PortalLight": "a portal only guides a dome light"}.get(kind, "snell draws points, spots and directional "
-                                                                          "lights")
+    what = {"PortalLight": "a portal only guides a dome light"}.get(
+        kind, "snell draws points, spots and directional lights")
     problems.warn(prim.GetPath(), f"a {kind}: {what}: skipped")
     return LightRecord(str(prim.GetPath()), kind, None, "skipped")

@@ -10,8 +10,11 @@ as an error, which `snell-usd render` refuses.
 
 from __future__ import annotations
 
+import contextlib
 from dataclasses import dataclass
-from typing import Optional
+from typing import Iterator, Optional
+
+from pxr import Tf
 
 from .. import Error
 
@@ -71,3 +74,25 @@ class Problems:
     @property
     def errors(self) -> list[StageWarning]:
         return [w for w in self.items if w.error]
+
+    @contextlib.contextmanager
+    def usd_diagnostics(self) -> Iterator[None]:
+        """USD's own warnings, statuses and posted errors while the block runs (what it would print on standard
+        error: a reference to a missing layer, a value of the wrong type), kept as this stage's warnings ('USD
+        says: ...') instead, so they go where snell's warnings go (snell-usd prints them; -q silences them).
+        Errors USD raises (Tf.ErrorException) pass through as they are. A usd-core without Tf.DiagnosticTrap
+        leaves them on standard error."""
+        trap_type = getattr(Tf, "DiagnosticTrap", None)
+        if trap_type is None:
+            yield
+            return
+        with trap_type() as trap:
+            try:
+                yield
+            finally:
+                said = list(trap.GetErrors()) + list(trap.GetWarnings()) + list(trap.GetStatuses())
+                trap.Clear()
+                for diagnostic in said:
+                    text = " ".join(str(diagnostic.commentary).split())
+                    if text:
+                        self.warn("", f"USD says: {text}")

@@ -21,6 +21,7 @@ from pxr import Sdf, Tf, Usd, UsdGeom, UsdLux, UsdSkel
 from .. import Instance, Light, Material, Mesh
 from ._cameras import CameraState, camera_state
 from ._colours import colour_atlas, mesh_colours
+from ._dome import Dome, read_dome
 from ._gprims import TYPES as GPRIM_TYPES
 from ._gprims import GprimMesh
 from ._lights import LightRecord, read_light, unsupported_light
@@ -93,10 +94,16 @@ class StageContents:
             raise ValueError(f"geometry purpose must be render or proxy, got '{self.options.geometry_purpose}'")
         self.path = os.fspath(path)
         self.problems = Problems(self.path, self.options.strict, self.options.missing_textures_fail)
+        with self.problems.usd_diagnostics():  # what USD says while reading is this stage's warnings
+            self._read(time)
+        self.load_seconds = clock.perf_counter() - started
+
+    def _read(self, time: Optional[float]) -> None:
         self.stage = _open_stage(self.path)
         stage = self.stage
-        for error in getattr(stage, "GetCompositionErrors", lambda: [])():
-            self.problems.warn("", f"composition: {error}")
+        if not hasattr(Tf, "DiagnosticTrap"):  # with it, USD's own report of these is kept (usd_diagnostics)
+            for error in getattr(stage, "GetCompositionErrors", lambda: [])():
+                self.problems.warn("", f"composition: {error}")
         self.has_range = stage.HasAuthoredTimeCodeRange()
         self.start, self.end = stage.GetStartTimeCode(), stage.GetEndTimeCode()
         if self.has_range and self.start > self.end:
@@ -126,6 +133,7 @@ class StageContents:
         self.sources: list[MeshSource] = []
         self.placements: list[Placement] = []
         self.lights: list[LightRecord] = []
+        self.dome: Optional[Dome] = None  #: the DomeLight that is snell's environment
         self.cameras: list[Usd.Prim] = []
         self.skipped: dict[str, list[str]] = {}
         self._skel_cache = UsdSkel.Cache()
@@ -137,7 +145,6 @@ class StageContents:
         self._traverse()
         self.dynamic_sources = [s for s in self.sources if s.deforms]
         self.dynamic_placements = [p for p in self.placements if p.varying]
-        self.load_seconds = clock.perf_counter() - started
 
     # ------------------------------------------------------------------ traversal
 
@@ -180,8 +187,9 @@ class StageContents:
                 self._add_mesh(prim, time)
             elif prim.HasAPI(UsdLux.LightAPI) or prim.IsA(UsdLux.BoundableLightBase) or \
                     prim.IsA(UsdLux.NonboundableLightBase):
-                if prim.IsA(UsdLux.DomeLight) or prim.IsA(UsdLux.DomeLight_1) or prim.IsA(UsdLux.PortalLight) or \
-                        prim.IsA(UsdLux.GeometryLight):
+                if prim.IsA(UsdLux.DomeLight) or prim.IsA(UsdLux.DomeLight_1):
+                    self._add_dome(prim, time)
+                elif prim.IsA(UsdLux.PortalLight) or prim.IsA(UsdLux.GeometryLight):
                     self.lights.append(unsupported_light(prim, self.problems))
                 else:
                     self.lights.append(read_light(prim, time, self.to_snell, self._xform_cache, self.problems))
@@ -193,6 +201,18 @@ class StageContents:
             first = ", ".join(paths[:3]) + (", ..." if len(paths) > 3 else "")
             self.problems.warn("", f"{len(paths)} {kind} prim(s) skipped: snell reads UsdGeomMesh and "
                                    f"{', '.join(GPRIM_TYPES)} ({first})")
+
+    def _add_dome(self, prim: Usd.Prim, time: Usd.TimeCode) -> None:
+        """The first visible dome is snell's environment (_dome.py); snell has one, so others are skipped."""
+        kind = prim.GetTypeName()
+        if self.dome is not None:
+            self.problems.warn(prim.GetPath(), f"a second {kind}: snell has one environment, {self.dome.path}'s: "
+                                               "skipped")
+            self.lights.append(LightRecord(str(prim.GetPath()), kind, None, "skipped"))
+            return
+        self.dome = read_dome(prim, time, self.to_snell, self.up_axis, self._xform_cache, self.problems,
+                              self.options.load_textures)
+        self.lights.append(LightRecord(self.dome.path, kind, None, self.dome.summary))
 
     def _unhonoured_draw_mode(self, prim: Usd.Prim) -> None:
         """model:drawMode asks for a stand-in (bounds, cards, origin); snell draws the model's geometry."""
@@ -466,8 +486,16 @@ class StageContents:
     def snell_lights(self) -> list[Light]:
         return [record.light for record in self.lights if record.light is not None]
 
+    def snell_environment(self):
+        """The dome's snell.Environment (what the glass reflects), or None for snell's studio gradient."""
+        return self.dome.environment() if self.dome is not None else None
+
     def camera(self, which: Union[None, int, str], time_code: float) -> Optional[CameraState]:
         """A camera by prim path or index (None: the first, or None if the stage has none)."""
+        with self.problems.usd_diagnostics():
+            return self._camera(which, time_code)
+
+    def _camera(self, which: Union[None, int, str], time_code: float) -> Optional[CameraState]:
         if which is None:
             if not self.cameras:
                 return None
@@ -491,6 +519,10 @@ class StageContents:
 
     def evaluate(self, time_code: float) -> Frame:
         """Posed points and normals of the deforming sources and transforms of the moving placements."""
+        with self.problems.usd_diagnostics():
+            return self._evaluate(time_code)
+
+    def _evaluate(self, time_code: float) -> Frame:
         started = clock.perf_counter()
         t = Usd.TimeCode(time_code)
         frame = SkelFrame(t)

@@ -14,11 +14,11 @@ import math
 import time as clock
 from dataclasses import dataclass
 from types import TracebackType
-from typing import Any, Optional, Union
+from typing import Any, Callable, Optional, Union
 
 import numpy as np
 
-from .. import Device, Renderer, Scene, View
+from .. import Device, Environment, Mesh, Renderer, Scene, ShotFrame, View
 from ._cameras import CameraState
 from ._problems import StageError, StageWarning
 from ._reader import Frame, StageContents
@@ -42,17 +42,11 @@ class Stage:
 
     def __init__(self, contents: StageContents, device: Optional[Device] = None, frames_in_flight: int = 2) -> None:
         self.contents = contents
-        meshes = contents.snell_meshes()
-        if not meshes:
-            raise StageError(f"{contents.path}: nothing to draw: no visible UsdGeomMesh or gprim with faces"
-                             + _skipped_note(contents))
+        self.scene, _ = scene_of(contents)
+        self.environment: Optional[Environment] = contents.snell_environment()  # the dome, shared by every view
         self._owns_device = device is None
         self.device = device if device is not None else Device()
         try:
-            self.scene = Scene.from_arrays(
-                meshes, materials=contents.snell_materials(),
-                textures=contents.materials.snell_textures(),
-                instances=contents.snell_instances(), lights=contents.snell_lights(), name=contents.path)
             self.renderer = Renderer(self.device, self.scene, frames_in_flight)
         except Exception:
             self._close_device()
@@ -132,18 +126,14 @@ class Stage:
     def view(self, width: int, height: int, camera: Union[None, int, str] = None,
              conform: str = "expandAperture", **options: Any) -> View:
         """A snell.View of the stage: a USD camera's matrices (None: its first camera) or, with no camera
-        in the stage, snell render's framed view of the bounds. options go to snell.View (method, ...)."""
+        in the stage, snell render's framed view of the bounds. options go to snell.View (method, ...); the
+        stage's DomeLight is its environment unless options give one."""
+        options.setdefault("environment", self.environment)
         state = self.camera(camera)
         if state is not None:
             view_matrix, projection = state.matrices(width, height, conform)
             return View(width, height, view_matrix=view_matrix, projection=projection, **options)
-        lo, hi = self.bounds()
-        centre, radius = np.zeros(3), 1.0
-        if np.all(lo <= hi):
-            centre, radius = 0.5 * (lo + hi), max(0.5 * float(np.linalg.norm(hi - lo)), 1e-6)
-        distance = radius / math.sin(FRAMED_YFOV / 2)
-        return View(width, height, eye=tuple(centre + (0.0, 0.0, distance)), target=tuple(centre), up=(0, 1, 0),
-                    yfov=FRAMED_YFOV, **options)
+        return framed_view(*self.bounds(), width, height, **options)
 
     def render(self, width: int, height: int, camera: Union[None, int, str] = None, **options: Any) -> np.ndarray:
         """The picture at the current time code: (height, width, 4) float32, scene-linear, row 0 at the top."""
@@ -151,15 +141,7 @@ class Stage:
 
     def bounds(self) -> tuple[np.ndarray, np.ndarray]:
         """The world bounds of what is drawn now, in snell's space (metres, +Y up): (lo, hi)."""
-        lo, hi = np.full(3, np.inf), np.full(3, -np.inf)
-        for placement in self.contents.placements:
-            for part in placement.source.parts:
-                p = self.renderer.positions(part.mesh).astype(np.float64)
-                world = p @ placement.matrix[:3, :3].T + placement.matrix[:3, 3]
-                world = world[np.isfinite(world).all(axis=1)]
-                if len(world):
-                    lo, hi = np.minimum(lo, world.min(axis=0)), np.maximum(hi, world.max(axis=0))
-        return lo, hi
+        return world_bounds(self.contents, self.renderer.positions)
 
     # ------------------------------------------------------------------ lifetime
 
@@ -186,6 +168,63 @@ class Stage:
     def __repr__(self) -> str:
         return (f"<snell.usd.Stage '{self.path}', {self.scene.mesh_count} meshes, time code {self.time:g}, "
                 f"{len(self.warnings)} warnings>")
+
+
+def scene_of(contents: StageContents) -> tuple[Scene, list[Mesh]]:
+    """The stage's snell.Scene at the time code read (its meshes, materials, textures, instances and lights),
+    and its meshes; StageError where nothing is drawn."""
+    meshes = contents.snell_meshes()
+    if not meshes:
+        raise StageError(f"{contents.path}: nothing to draw: no visible UsdGeomMesh or gprim with faces"
+                         + _skipped_note(contents))
+    scene = Scene.from_arrays(meshes, materials=contents.snell_materials(),
+                              textures=contents.materials.snell_textures(), instances=contents.snell_instances(),
+                              lights=contents.snell_lights(), name=contents.path)
+    return scene, meshes
+
+
+def world_bounds(contents: StageContents, positions: Callable[[int], np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
+    """The world bounds (lo, hi) of the placed meshes, each mesh's positions given by `positions(mesh)`."""
+    lo, hi = np.full(3, np.inf), np.full(3, -np.inf)
+    for placement in contents.placements:
+        for part in placement.source.parts:
+            p = np.asarray(positions(part.mesh), np.float64)
+            world = p @ placement.matrix[:3, :3].T + placement.matrix[:3, 3]
+            world = world[np.isfinite(world).all(axis=1)]
+            if len(world):
+                lo, hi = np.minimum(lo, world.min(axis=0)), np.maximum(hi, world.max(axis=0))
+    return lo, hi
+
+
+def framed_view(lo: np.ndarray, hi: np.ndarray, width: int, height: int, **options: Any) -> View:
+    """snell render's framed view of bounds, for a stage without a camera: the whole of them, looking down -Z."""
+    centre, radius = np.zeros(3), 1.0
+    if np.all(lo <= hi):
+        centre, radius = 0.5 * (lo + hi), max(0.5 * float(np.linalg.norm(hi - lo)), 1e-6)
+    distance = radius / math.sin(FRAMED_YFOV / 2)
+    return View(width, height, eye=tuple(centre + (0.0, 0.0, distance)), target=tuple(centre), up=(0, 1, 0),
+                yfov=FRAMED_YFOV, **options)
+
+
+def shot_frame(contents: StageContents, time_code: float, camera: Optional[CameraState], width: int, height: int,
+               conform: str) -> ShotFrame:
+    """A snell.ShotFrame of the stage at a time code, for render_frames: every deforming mesh's vertices and
+    every moving instance's transform (each device keeps what its frames gave, so every frame gives them all),
+    and the camera's matrices where the stage has one."""
+    frame = contents.evaluate(time_code)
+    vertices = {}
+    for source, pose in frame.poses:
+        for part in source.parts:
+            positions = np.empty((len(part.vertex_point), 3), np.float32)
+            normals = np.empty_like(positions)
+            source.write(part, pose, positions, normals)
+            vertices[part.mesh] = (positions, normals)
+    transforms = {instance: matrix for placement, matrix in frame.transforms for instance in placement.instances}
+    matrices: dict[str, Any] = {}
+    if camera is not None:
+        matrices["view_matrix"], matrices["projection"] = camera.matrices(width, height, conform)
+    seconds = time_code / contents.time_codes_per_second if contents.time_codes_per_second else 0.0
+    return ShotFrame(int(time_code), seconds, transforms=transforms, vertices=vertices, **matrices)
 
 
 def _skipped_note(contents: StageContents) -> str:
