@@ -197,3 +197,50 @@ def test_the_frames_written_are_the_api_s_pictures(eyes, tmp_path, device):
         stage.set_time(17)
         expected = stage.render(64, 48)
     np.testing.assert_allclose(read_image(tmp_path / "f.exr"), expected, atol=1e-6)
+
+
+def stage_usd_warns_about(folder) -> object:
+    """A card that references a layer that is not there: USD warns while composing it, and draws the card."""
+    stage = new_stage(folder / "warns.usda")
+    quad(stage, "/World/Card").GetPrim().GetReferences().AddReference("./missing_layer.usda")
+    stage.GetRootLayer().Save()
+    return folder / "warns.usda"
+
+
+def test_usds_own_diagnostics_are_snell_usds_warnings_and_not_its_raw_stderr(tmp_path):
+    done = snell_usd("render", stage_usd_warns_about(tmp_path), "-o", tmp_path / "f.png", "--size", SIZE)
+    assert done.returncode == 0, done.stderr
+    said = "USD says: In </World/Card>: Could not open asset @" + str(tmp_path / "missing_layer.usda@")
+    assert f"snell-usd: warning: {said}" in done.stderr, done.stderr
+    assert "Warning: in " not in done.stderr, "USD printed its diagnostic itself"
+    listed = snell_usd("info", tmp_path / "warns.usda")
+    assert said in listed.stdout and listed.returncode == 0, listed.stdout
+    assert listed.stderr == "", listed.stderr
+
+
+def test_quiet_silences_usds_own_diagnostics(tmp_path):
+    done = snell_usd("-q", "render", stage_usd_warns_about(tmp_path), "-o", tmp_path / "f.png", "--size", SIZE)
+    assert done.returncode == 0 and done.stdout == "" and done.stderr == "", done.stderr
+    assert (tmp_path / "f.png").is_file()
+
+
+def test_devices_spreads_the_frames_over_workers_and_writes_one_devices_pixels(eyes, tmp_path):
+    """Two workers on one device (as the GPU machine would have two GPUs): the rig's skinning, blend shape
+    and camera go with each frame, and every frame's pixels are those the single renderer writes."""
+    one = snell_usd("render", eyes.usd, "-o", tmp_path / "one.####.exr", "--frames", "1-41x20", "--size", SIZE,
+                    "--float", "--method", "trace")
+    two = snell_usd("render", eyes.usd, "-o", tmp_path / "two.####.exr", "--frames", "1-41x20", "--size", SIZE,
+                    "--float", "--method", "trace", "--devices", "0,0")
+    assert one.returncode == 0 and two.returncode == 0, one.stderr + two.stderr
+    assert two.stderr.count("frame ") == 3 and "(3/3)" in two.stderr, two.stderr
+    assert "3 frames in" in two.stdout and two.stdout.count("llvmpipe") == 2, two.stdout  # both workers listed
+    for frame in (1, 21, 41):
+        single, shot = read_image(tmp_path / f"one.{frame:04d}.exr"), read_image(tmp_path / f"two.{frame:04d}.exr")
+        np.testing.assert_allclose(shot, single, atol=2e-3, err_msg=f"frame {frame}")
+    assert not np.allclose(read_image(tmp_path / "two.0001.exr"), read_image(tmp_path / "two.0021.exr"))
+
+
+def test_devices_takes_snell_renders_lists_and_refuses_a_bad_one(eyes, tmp_path):
+    done = snell_usd("render", eyes.usd, "-o", tmp_path / "f.png", "--devices", "0,,1")
+    assert done.returncode == 2 and "--devices 0,,1: give all, or device indices" in done.stderr, done.stderr
+    assert os.listdir(tmp_path) == []

@@ -1,6 +1,7 @@
 """Pictures to files as `snell render` writes them: EXR linear (half or float), PNG 8-bit sRGB; atomically.
 
-PNG is snell's own (snell.write_png); EXR goes through OpenImageIO's Python module.
+PNG is snell's own (snell.write_png); EXR goes through OpenImageIO's Python module, since snell's own EXR
+writer (src/io/image_file.cpp) is OpenImageIO's C++ library, which the pip package does not carry.
 
 A file appears only once it is complete: the image is written to a hidden
 temporary file in the same folder and renamed over the name asked for, so a
@@ -27,9 +28,18 @@ def _oiio(path: Path):
     try:
         import OpenImageIO
     except ImportError:
-        raise OutputError(f"{path}: writing EXR needs OpenImageIO's Python module (Debian: python3-openimageio; "
-                          "pip: OpenImageIO); snell writes .png itself") from None
+        raise OutputError(f"{path}: writing EXR needs OpenImageIO's Python module, which is not installed "
+                          "(Debian: python3-openimageio; pip: OpenImageIO); snell writes .png without it") from None
     return OpenImageIO
+
+
+def check_format(path: Union[str, os.PathLike]) -> None:
+    """Fails early, naming the file, where its format needs what is not installed: EXR needs OpenImageIO's
+    Python module (snell's own EXR writer is its command line's, through OpenImageIO's C++ library, which a
+    pip install does not carry); PNG needs nothing."""
+    path = Path(path)
+    if path.suffix.lower() == ".exr":
+        _oiio(path)
 
 
 def check_writable(path: Union[str, os.PathLike]) -> None:

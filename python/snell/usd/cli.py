@@ -22,11 +22,13 @@ from typing import Any, Optional, Sequence
 
 import numpy as np
 
-from .. import Device, Error, methods, version
+from .. import Device, Error, View, methods, render_frames, version
 from . import Stage, StageError, read
+from ._cameras import CameraState
 from ._frames import UsageError, check_frame_pattern, frame_path, parse_frames
-from ._output import EXTENSIONS, OutputError, check_writable, write_image
+from ._output import EXTENSIONS, OutputError, check_format, check_writable, write_image
 from ._reader import StageContents
+from ._stage import framed_view, scene_of, shot_frame, world_bounds
 
 EXIT_OK, EXIT_FAILURE, EXIT_USAGE = 0, 1, 2
 
@@ -46,15 +48,17 @@ UsdSkel), UsdPreviewSurface materials bound for --purpose (glass: opacity
 below 1 refracts with its ior), UsdLux lights and a UsdGeomCamera. PNG is
 written as 8-bit sRGB; EXR as linear half floats (or --float), with the
 stage, time code and camera in its header. A file appears only once it is
-complete.
+complete. EXR needs OpenImageIO's Python module; PNG needs nothing more.
 
 Frames are time codes: --frames takes the lists farms write (1001-1048,
 1001-1048x2, 1001:1048:2, 1,5,10-20), each frame inside the stage's time
 range unless --allow-outside-range. Only what moves is re-read from USD
 and sent to the GPU each frame. Without --camera the stage's first camera
 draws it; a stage without one gets snell render's framed view of its
-bounds. SIGTERM or SIGINT drops the frame under way, keeps those written
-and exits 128+N; --skip-existing then picks up where it stopped. A stage
+bounds. --devices spreads the frames over GPUs through snell.render_frames,
+as snell render --devices does (without a camera the shot is framed on its
+first frame). SIGTERM or SIGINT drops the frame under way, keeps those
+written and exits 128+N; --skip-existing then picks up where it stopped. A stage
 snell cannot draw as it says (a mesh with faces but no points, a texture
 that cannot be decoded; with --strict a missing texture file too) is an
 error, and nothing is written."""
@@ -170,6 +174,10 @@ def _parser() -> argparse.ArgumentParser:
                              "existing one is a finished frame")
     render.add_argument("--allow-outside-range", action="store_true",
                         help="render frames outside the stage's time range (USD holds the nearest samples)")
+    render.add_argument("--devices", metavar="LIST",
+                        help="render on several devices, a worker each, as snell render --devices: all (every "
+                             "GPU), or device indices (0,1; 0,0 runs two workers on one device); each takes the "
+                             "next frame as it finishes one, and the pixels are those one device writes")
     return parser
 
 
@@ -315,6 +323,9 @@ def _check_render_options(args: argparse.Namespace) -> Optional[list[int]]:
     names = [name for name, _ in methods()]
     if args.method != "auto" and args.method not in names:
         raise UsageError(f"--method takes auto or one of {', '.join(names)}, got '{args.method}'")
+    if args.devices is not None and (not args.devices or args.devices.startswith(",") or
+                                     args.devices.endswith(",") or ",," in args.devices):
+        raise UsageError(f"--devices {args.devices}: give all, or device indices separated by commas (0,1)")
     if args.frames is None:
         return None
     frames = parse_frames("--frames", args.frames)
@@ -334,6 +345,10 @@ def _unfinished(frames: list[int], args: argparse.Namespace, console: _Console) 
 
 def _render(args: argparse.Namespace, console: _Console) -> int:
     frames = _check_render_options(args)
+    try:
+        check_format(args.output)  # EXR without OpenImageIO fails before any work
+    except OutputError as e:
+        raise StageError(str(e)) from None
     if frames is not None:
         frames = _unfinished(frames, args, console)
         if not frames:
@@ -365,25 +380,72 @@ def _render(args: argparse.Namespace, console: _Console) -> int:
     except OutputError as e:
         raise StageError(str(e)) from None
     console.warnings(contents.problems.items)
+    if args.devices is not None:
+        return _draw_on_devices(contents, frames, args, console)
     return _draw(contents, frames, args, console)
+
+
+class _Writer:
+    """Writes each frame's picture (with its EXR header) and says so, counting what it wrote."""
+
+    def __init__(self, contents: "StageContents", frames: list[int], args: argparse.Namespace,
+                 console: _Console) -> None:
+        self.contents, self.frames, self.args, self.console = contents, frames, args, console
+        self.written = 0
+        self.started = clock.perf_counter()
+        self.camera_name = args.camera or (str(contents.cameras[0].GetPath()) if contents.cameras
+                                           else "a framed view of the bounds")
+
+    def write(self, frame: int, rgba: np.ndarray, device_name: str, camera: Optional[CameraState],
+              seconds: float) -> None:
+        path = frame_path(self.args.output, frame)
+        metadata: dict[str, Any] = {"Software": f"snell-usd {version()}"}
+        if path.lower().endswith(".exr"):
+            metadata.update({"snell:stage": self.contents.path, "snell:timeCode": float(frame),
+                             "snell:camera": self.camera_name, "snell:device": device_name,
+                             "snell:materialPurpose": self.args.purpose})
+            if camera is not None:  # OpenEXR's worldToCamera: row vectors, translation in the last row
+                metadata["worldToCamera"] = np.linalg.inv(camera.camera_to_world).T.astype(np.float32)
+        try:
+            write_image(path, rgba, float_pixels=self.args.float_pixels, metadata=metadata)
+        except OutputError as e:
+            raise StageError(str(e)) from None
+        self.written += 1
+        width, height = self.args.size
+        if len(self.frames) > 1:
+            self.console.progress(f"frame {frame} ({self.written}/{len(self.frames)}) -> {path}, {seconds:.2f} s")
+        else:
+            self.console.out(f"wrote {path}: {width}x{height}, camera {self.camera_name}, time code {frame}, "
+                             f"{device_name}, {seconds:.2f} s")
+
+    def finish(self, where: str, messages: int) -> int:
+        """The exit code, once the frames are done or a signal stopped them."""
+        if _stop_signal:
+            self.console.error(f"render: stopped by signal {_stop_signal}; the {self.written} frames written are "
+                               "whole, the one under way was dropped")
+            return 128 + _stop_signal
+        if len(self.frames) > 1:
+            self.console.out(f"{self.written} frames in {clock.perf_counter() - self.started:.1f} s on {where}")
+        if messages:
+            self.console.error(f"the Khronos validation layer reported {messages} messages")
+            return EXIT_FAILURE
+        return EXIT_OK
 
 
 def _draw(contents: "StageContents", frames: list[int], args: argparse.Namespace, console: _Console) -> int:
     """Renders and writes the frames; a signal drops the frame under way and exits 128 + N."""
     global _stop_signal
-    started = clock.perf_counter()
     said = len(contents.problems.items)
     validation = os.environ.get("SNELL_VALIDATION") == "1"
     device = Device(device=args.device, validation=validation)
     device_name = device.name
     width, height = args.size
-    written = 0
+    writer = _Writer(contents, frames, args, console)
     _stop_signal = 0
     previous = {s: signal.signal(s, _on_stop) for s in (signal.SIGINT, signal.SIGTERM)}
     try:
         with Stage(contents, device=device) as stage:
-            camera_name = args.camera or (stage.cameras[0] if stage.cameras else "a framed view of the bounds")
-            for index, frame in enumerate(frames):
+            for frame in frames:
                 if _stop_signal:
                     break
                 frame_started = clock.perf_counter()
@@ -392,42 +454,75 @@ def _draw(contents: "StageContents", frames: list[int], args: argparse.Namespace
                                                         method=args.method))
                 if _stop_signal:
                     break  # the frame under way is dropped: only whole frames are ever written
-                path = frame_path(args.output, frame)
-                metadata: dict[str, Any] = {"Software": f"snell-usd {version()}"}
-                if path.lower().endswith(".exr"):
-                    metadata.update({"snell:stage": contents.path, "snell:timeCode": float(frame),
-                                     "snell:camera": camera_name, "snell:device": device_name,
-                                     "snell:materialPurpose": args.purpose})
-                    state = stage.camera(args.camera)
-                    if state is not None:  # OpenEXR's worldToCamera: row vectors, translation in the last row
-                        metadata["worldToCamera"] = np.linalg.inv(state.camera_to_world).T.astype(np.float32)
-                try:
-                    write_image(path, rgba, float_pixels=args.float_pixels, metadata=metadata)
-                except OutputError as e:
-                    raise StageError(str(e)) from None
-                written += 1
-                seconds = clock.perf_counter() - frame_started
-                if len(frames) > 1:
-                    console.progress(f"frame {frame} ({index + 1}/{len(frames)}) -> {path}, {seconds:.2f} s")
-                else:
-                    console.out(f"wrote {path}: {width}x{height}, camera {camera_name}, time code {frame}, "
-                                f"{device_name}, {seconds:.2f} s")
+                writer.write(frame, rgba, device_name, stage.camera(args.camera),
+                             clock.perf_counter() - frame_started)
             console.warnings(stage.warnings[said:])  # what the frames found (a UsdSkel failure, ...)
     finally:
         for s, handler in previous.items():
             signal.signal(s, handler)
         messages = device.validation_messages if validation else 0
         device.close()
-    if _stop_signal:
-        console.error(f"render: stopped by signal {_stop_signal}; the {written} frames written are whole, the one "
-                      "under way was dropped")
-        return 128 + _stop_signal
-    if len(frames) > 1:
-        console.out(f"{written} frames in {clock.perf_counter() - started:.1f} s on {device_name}")
-    if messages:
-        console.error(f"the Khronos validation layer reported {messages} messages")
-        return EXIT_FAILURE
-    return EXIT_OK
+    return writer.finish(device_name, messages)
+
+
+class _Stopped(Exception):
+    """A signal came during a shot on several devices: render_frames stops and raises this."""
+
+
+def _draw_on_devices(contents: "StageContents", frames: list[int], args: argparse.Namespace,
+                     console: _Console) -> int:
+    """Renders the frames with snell.render_frames, a worker per device of --devices (as snell render
+    --devices): each frame's posed meshes, moved instances and camera go with it, and its picture comes back
+    here, on this thread, to be written. A signal drops the frames under way and exits 128 + N."""
+    global _stop_signal
+    said = len(contents.problems.items)
+    validation = os.environ.get("SNELL_VALIDATION") == "1"
+    width, height = args.size
+    scene, meshes = scene_of(contents)
+    environment = contents.snell_environment()
+    first = contents.camera(args.camera, frames[0])
+    if first is not None:
+        view_matrix, projection = first.matrices(width, height, args.conform)
+        view = View(width, height, view_matrix=view_matrix, projection=projection, method=args.method,
+                    environment=environment)
+    else:  # no camera: the whole shot is framed on the first frame's bounds (the stage is read at that frame)
+        view = framed_view(*world_bounds(contents, lambda mesh: meshes[mesh].positions), width, height,
+                           method=args.method, environment=environment)
+    writer = _Writer(contents, frames, args, console)
+    cameras: dict[int, Optional[CameraState]] = {}
+    started: dict[int, float] = {}
+
+    def poses():
+        for frame in frames:
+            if _stop_signal:
+                raise _Stopped()
+            started[frame] = clock.perf_counter()
+            cameras[frame] = contents.camera(args.camera, frame)
+            yield shot_frame(contents, frame, cameras[frame], width, height, args.conform)
+
+    def keep(picture: dict) -> None:
+        if _stop_signal:
+            raise _Stopped()
+        frame = int(picture["number"])
+        writer.write(frame, picture["rgba"], picture["device"], cameras.pop(frame, None),
+                     clock.perf_counter() - started.pop(frame, writer.started))
+
+    _stop_signal = 0
+    previous = {s: signal.signal(s, _on_stop) for s in (signal.SIGINT, signal.SIGTERM)}
+    messages, where = 0, args.devices
+    try:
+        summary = render_frames(scene, view, poses(), keep, devices=args.devices, device=args.device,
+                                validation=validation)
+        messages = sum(int(w["validation_messages"]) for w in summary["workers"])
+        where = ", ".join(f"{w['device']} ({w['frames']})" for w in summary["workers"])
+    except _Stopped:
+        pass
+    finally:
+        for s, handler in previous.items():
+            signal.signal(s, handler)
+        scene.close()
+    console.warnings(contents.problems.items[said:])
+    return writer.finish(where, messages)
 
 
 # ---------------------------------------------------------------- main
