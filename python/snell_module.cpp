@@ -345,12 +345,16 @@ PYBIND11_MODULE(_snell, m) {
           py::gil_scoped_release release;
           image = snell::readImageFile(path);
         }
-        py::dtype type = image.bits == 32   ? py::dtype::of<float>()
-                         : image.bits == 16 ? py::dtype::of<uint16_t>()
-                                            : py::dtype::of<uint8_t>();
-        py::array out(type, {py::ssize_t(image.height), py::ssize_t(image.width), py::ssize_t(image.channels)});
-        std::memcpy(out.mutable_data(), image.data.data(), image.data.size());
-        return out;
+        // array_t<T> takes its strides from sizeof(T): a py::array made from a py::dtype takes them from
+        // the dtype's itemsize, which Debian's pybind11 (2.10) reads wrongly under numpy 2 (a plain venv's),
+        // giving every sample the first one's bytes.
+        auto samples = [&image](auto zero) -> py::array {
+          py::array_t<decltype(zero)> out({py::ssize_t(image.height), py::ssize_t(image.width),
+                                           py::ssize_t(image.channels)});
+          std::memcpy(out.mutable_data(), image.data.data(), image.data.size());
+          return out;
+        };
+        return image.bits == 32 ? samples(float{}) : image.bits == 16 ? samples(uint16_t{}) : samples(uint8_t{});
       },
       "path"_a,
       "An image file's samples as stored, (height, width, channels) with row 0 at the top: uint8, uint16 "
