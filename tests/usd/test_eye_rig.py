@@ -7,7 +7,7 @@ import pytest
 
 import snell
 import snell.usd
-from conftest import srgb8
+from conftest import srgb8, unexpected
 from eye_stage import TIME_CODES_PER_SECOND
 
 WIDTH, HEIGHT = 160, 120
@@ -20,7 +20,7 @@ def pictures(device, eyes):
     gltf = snell.Renderer(device, snell.Scene.load(str(eyes.gltf)))
     out = {}
     with snell.usd.open(eyes.usd, device=device) as stage:
-        assert not stage.warnings, [str(w) for w in stage.warnings]
+        assert not unexpected(stage.warnings), unexpected(stage.warnings)
         for t in TIMES:
             stage.set_time(t)
             gltf.set_time(t / TIME_CODES_PER_SECOND)

@@ -6,7 +6,7 @@ import numpy as np
 from pxr import Gf, UsdLux
 
 import snell.usd
-from conftest import srgb8
+from conftest import srgb8, unexpected
 from stages import bind, mesh, new_stage, preview_material, sphere_arrays, sphere_light, texture, write_rgba_png
 
 WIDTH, HEIGHT = 160, 120
@@ -63,7 +63,7 @@ def test_a_z_up_centimetre_stage_renders_as_the_y_up_metre_one(tmp_path, device)
     pictures, bounds = [], []
     for path in (metres, centimetres):
         with snell.usd.open(path, device=device) as stage:
-            assert not stage.warnings, [str(w) for w in stage.warnings]
+            assert not unexpected(stage.warnings), unexpected(stage.warnings)
             pictures.append(srgb8(stage.render(WIDTH, HEIGHT)))  # no camera: the framed view, looking down -Z
             bounds.append(stage.bounds())
     np.testing.assert_allclose(bounds[1], bounds[0], rtol=1e-5, atol=1e-5)  # in metres, +Y up, both
