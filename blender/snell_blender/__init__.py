@@ -4,9 +4,10 @@
 snell renders refraction through deforming meshes with Vulkan compute. This
 add-on feeds it Blender's evaluated meshes (armatures, shape keys,
 modifiers) every frame and draws its image in the Rendered viewport, or
-writes it as the render result. It needs the `snell` Python module (built
-with the project, see its README's "In Blender") and a Vulkan device; when
-either is missing, the panel and the console say so and nothing crashes.
+writes it as the render result. It needs the `snell` Python module (in the
+extension's wheels, or built with the project: see its README's "In
+Blender") and a Vulkan device; when either is missing, the panel and the
+console say so and nothing crashes.
 """
 
 bl_info = {

@@ -1,5 +1,5 @@
 # SPDX-License-Identifier: GPL-3.0-or-later
-"""Every difference between the Blender versions the add-on runs in (3.4 to 5.0), in one place.
+"""Every difference between the Blender versions the add-on runs in (3.4 to 5.2), in one place.
 
 The rest of the add-on never tests a version: it asks this module. Each gate
 says which release changed what, as read in Blender's sources and release

@@ -17,6 +17,13 @@ read (docs: README "In Blender"):
   otherwise the side the factor favours decides what the face is, and where
   both sides are opaque their colours blend by the factor.
 
+On the output's Volume, a Volume Absorption absorbs as Cycles' does
+(cycles_absorption); a Principled Volume's Color absorbs the same way, its
+scattering undrawn (and named). Blender's glass shaders have no dispersion:
+a glass disperses by the "Dispersion" input of the glTF add-on's "glTF
+Material Output" group (KHR_materials_dispersion's 20 / Abbe number), which
+also gives a volume's thickness.
+
 A colour or a normal may come from an Image Texture, through a Mapping node
 (location, Z rotation, scale) and a UV Map node, or a Normal Map node. Any
 other node is named in a problem, with the material, and its input's own
@@ -135,12 +142,15 @@ def _output_node(material):
 
 
 def _gltf_settings_input(material, name: str):
-    """An input of the exporter's "glTF Material Output" (or older "glTF Settings") group node."""
+    """An input of the glTF add-on's "glTF Material Output" (or older "glTF Settings") group node, found as the
+    exporter finds it: by the start of its tree's name, in any case ("glTF Material Output.001" too)."""
     for node in material.node_tree.nodes:
         tree = getattr(node, "node_tree", None)
         if node.bl_idname == "ShaderNodeGroup" and tree is not None:
-            if tree.name.lower() in ("gltf material output", "gltf settings"):
-                return node.inputs.get(name)
+            if tree.name.lower().startswith(("gltf material output", "gltf settings")):
+                found = node.inputs.get(name)
+                if found is not None:
+                    return found
     return None
 
 
@@ -407,6 +417,9 @@ class MaterialReader:
         if surface.kind == "glass":
             out.transmission = surface.transmission
             out.ior = surface.ior
+            # No glass shader of Blender 3.4 to 5.2 has a Dispersion input; the glTF add-on's group carries
+            # KHR_materials_dispersion's value (20 / Abbe number), and from 5.2 it exports that input.
+            out.dispersion = max(0.0, self._value(_gltf_settings_input(material, "Dispersion"), 0.0))
         out.roughness = surface.roughness
         out.emissive = surface.emissive
         if surface.emissive_texture is not None:
@@ -420,21 +433,41 @@ class MaterialReader:
         return out
 
     def _volume(self, out, output) -> None:
-        """Volume Absorption on the output's Volume: glTF's attenuation, as the exporter writes it."""
+        """Volume Absorption (or a Principled Volume) on the output's Volume, absorbing as Cycles absorbs."""
         volume, _ = _linked(output.inputs["Volume"])
         if volume is None:
             return
         if volume.bl_idname not in ("ShaderNodeVolumeAbsorption", "ShaderNodeVolumePrincipled"):
             self.problem(volume, "on Volume is not read; the glass has no volume")
             return
-        colour = volume.inputs.get("Color")
-        density = volume.inputs.get("Density")
-        if colour is not None:
-            out.attenuation_color = tuple(colour.default_value[:3])
-        if density is not None and density.default_value > 0:
-            out.attenuation_distance = 1.0 / density.default_value
+        if volume.bl_idname == "ShaderNodeVolumePrincipled":
+            self.problem(volume, "scatters light, which snell does not draw; its Color absorbs as a Volume "
+                                 "Absorption's would")
+        colour = volume.inputs["Color"]
+        if colour.is_linked:
+            self.problem(_linked(colour)[0], "on Color is not read; the input's own colour is used")
+        density = self._value(volume.inputs["Density"], 1.0)
+        out.attenuation_color, out.attenuation_distance = cycles_absorption(colour.default_value[:3], density)
+        # snell's trace measures the distance each ray travels inside; the thickness factor only makes the
+        # material a volume rather than thin-walled. The exporter's group keeps its own value, for a glTF round trip.
         thickness = _gltf_settings_input(self.material, "Thickness")
-        out.thickness = float(thickness.default_value) if thickness is not None else 1.0
+        out.thickness = float(thickness.default_value) if thickness is not None and thickness.default_value > 0 else 1.0
+
+
+def cycles_absorption(colour, density: float) -> tuple:
+    """glTF's (attenuationColor, attenuationDistance) that absorb as Cycles' Volume Absorption of `colour` and
+    `density` does.
+
+    Cycles absorbs with the coefficient (1 - Color) x Density (svm_node_closure_volume), so light crossing a
+    length d keeps exp(-(1 - C) Density d) of each channel. KHR_materials_volume keeps
+    attenuationColor^(d / attenuationDistance); with the distance 1 / Density and the colour exp(C - 1) that is
+    exp(-(1 - C) Density d) for every d, exactly. (Blender's glTF exporter writes C itself, which keeps
+    C^(Density d): darker, 0.33 of red where Cycles keeps 0.55 through a slab of colour 0.25, density 1.6 and
+    half a unit thick.) A colour beyond [0, 1] is clamped, as glTF's is.
+    """
+    if not density > 0.0:
+        return (1.0, 1.0, 1.0), math.inf
+    return tuple(math.exp(min(max(float(c), 0.0), 1.0) - 1.0) for c in colour), 1.0 / density
 
 
 def material_of(material, textures: Textures, render_uv: str, problems: list):

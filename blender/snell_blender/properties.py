@@ -24,8 +24,10 @@ class SnellSceneSettings(bpy.types.PropertyGroup):
                                           description="Glass faces a ray may cross before it ends as a miss")
     fresnel: bpy.props.BoolProperty(name="Fresnel", default=True,
                                     description="Glass reflects as well as refracts: highlights, catch lights")
-    dispersion: bpy.props.BoolProperty(name="Dispersion", default=True,
-                                       description="Dispersive glass splits the colours")
+    dispersion: bpy.props.BoolProperty(
+        name="Dispersion", default=True,
+        description="Dispersive glass splits the colours. Blender's glass shaders have no dispersion input: a "
+                    "material disperses by the Dispersion input (20 / Abbe number) of its glTF Material Output node")
     volume: bpy.props.BoolProperty(name="Volume", default=True,
                                    description="Volume Absorption tints the light inside thick glass")
     display: bpy.props.EnumProperty(

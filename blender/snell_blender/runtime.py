@@ -61,8 +61,9 @@ def device():
         try:
             snell = _import_snell()
         except ImportError as error:
-            _problem = (f"the snell Python module is not found ({error}); install it with "
-                        "`cmake --install`, or set its folder in the add-on's preferences")
+            _problem = (f"the snell Python module is not found ({error}); install the extension that "
+                        "scripts/blender_extension builds (its wheels hold the module), or `cmake --install`, "
+                        "or set its folder in the add-on's preferences")
         else:
             prefs = _preferences()
             name = prefs.device if prefs is not None else ""

@@ -10,6 +10,9 @@ from .properties import PASSES
 from .runtime import AREA_LIGHT_NOTE
 
 MAX_PROBLEM_LINES = 8
+# Blender's Glass, Refraction and Principled BSDFs have no dispersion input (3.4 to 5.2), so the switch reads
+# the glTF add-on's group instead, which Blender 5.2's exporter writes as KHR_materials_dispersion.
+DISPERSION_NOTE = "Blender's glass has no dispersion: read from glTF Material Output's Dispersion"
 
 
 class SnellPropertiesPanel:
@@ -41,6 +44,8 @@ class SNELL_PT_render(SnellPropertiesPanel, bpy.types.Panel):
         column = layout.column(heading="Optics")
         column.prop(options, "fresnel")
         column.prop(options, "dispersion")
+        if options.dispersion:
+            column.label(text=DISPERSION_NOTE, icon="INFO")
         column.prop(options, "volume")
         layout.prop(options, "display")
         layout.prop(options, "overlay")

@@ -1,14 +1,18 @@
 """Shared by the add-on's tests, which run inside Blender (tests/CMakeLists.txt starts them).
 
 ctest sets SNELL_BINARY (the command line), SNELL_PYTHON_DIR (the built
-module's folder) and SNELL_TEST_DIR (a scratch folder of the test's own).
+module's folder, for Blender's CPython 3.11; empty in bpy 5.1 and later,
+whose 3.13 takes the extension's own wheel from SNELL_BLENDER_EXTENSION) and
+SNELL_TEST_DIR (a scratch folder of the test's own).
 """
 
 from __future__ import annotations
 
+import io
 import os
 import subprocess
 import sys
+import zipfile
 from pathlib import Path
 
 import bpy
@@ -22,13 +26,31 @@ sys.path.insert(0, str(SOURCE / "blender"))
 import demo_eye_rig  # noqa: E402  (from the checkout's blender/ folder, put on the path above)
 
 
+def module_folder() -> str:
+    """The snell module's folder: the build's, or where the build's is not for this Python, the wheel of this
+    Python from the extension zip, unpacked into the scratch folder."""
+    folder = os.environ.get("SNELL_PYTHON_DIR", "")
+    package = os.environ.get("SNELL_BLENDER_EXTENSION", "")
+    if folder or not package:
+        return folder
+    tag = f"-cp{sys.version_info.major}{sys.version_info.minor}-"
+    target = SCRATCH / "python"
+    if target.exists():  # once: rewriting a library this process has loaded would pull code from under it
+        return str(target)
+    with zipfile.ZipFile(package) as archive:
+        wheel = next(name for name in archive.namelist() if name.endswith(".whl") and tag in name)
+        with zipfile.ZipFile(io.BytesIO(archive.read(wheel))) as inner:
+            inner.extractall(target)
+    return str(target)
+
+
 def enable_addon(module_path: str | None = None) -> None:
     """The add-on from the checkout, with the snell module from the build (or `module_path`)."""
     import addon_utils
 
     addon_utils.enable("snell_blender", default_set=True)
     prefs = bpy.context.preferences.addons["snell_blender"].preferences
-    prefs.module_path = module_path if module_path is not None else os.environ.get("SNELL_PYTHON_DIR", "")
+    prefs.module_path = module_path if module_path is not None else module_folder()
     from snell_blender import runtime
 
     runtime.retry()
