@@ -9,6 +9,7 @@ SNELL_TEST_DIR (a scratch folder of the test's own).
 from __future__ import annotations
 
 import io
+import math
 import os
 import subprocess
 import sys
@@ -68,6 +69,30 @@ def demo_scene(width: int, height: int):
     scene.view_settings.look = "None"
     scene.render.dither_intensity = 0.0
     return scene, rig
+
+
+def cycles_comparison(scene, width: int, height: int, samples: int, background: float) -> None:
+    """What the tests against Cycles share: a camera at (0, -6, 0) looking down +Y, a world of one grey, a
+    width x height film in the 'Standard' view, snell's Fresnel off, and Cycles with `samples` a pixel, a
+    one-pixel box filter, no denoising, no caustics and a fixed seed."""
+    camera = bpy.data.objects.new("Camera", bpy.data.cameras.new("Camera"))
+    camera.location, camera.rotation_euler = (0, -6.0, 0), (math.radians(90), 0, 0)
+    camera.data.lens = 50.0
+    scene.collection.objects.link(camera)
+    scene.camera = camera
+    world = bpy.data.worlds.new("World")
+    world.use_nodes = True
+    world.node_tree.nodes["Background"].inputs["Color"].default_value = (background, background, background, 1)
+    scene.world = world
+    scene.render.resolution_x, scene.render.resolution_y, scene.render.resolution_percentage = width, height, 100
+    scene.view_settings.view_transform = "Standard"
+    scene.snell.fresnel = False
+    scene.cycles.samples = samples
+    scene.cycles.use_denoising = False
+    scene.cycles.pixel_filter_type = "BOX"
+    scene.cycles.filter_width = 1.0
+    scene.cycles.caustics_reflective = scene.cycles.caustics_refractive = False
+    scene.cycles.seed = 1
 
 
 def export_gltf(path: Path) -> Path:

@@ -20,7 +20,7 @@ import bpy
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).parent))  # Blender runs the script without its folder on the path
-from blender_support import SCRATCH, check, enable_addon, render_f12  # noqa: E402
+from blender_support import SCRATCH, check, cycles_comparison, enable_addon, render_f12  # noqa: E402
 
 WIDTH, HEIGHT = 64, 48
 COLOUR, DENSITY, THICKNESS, IOR = (0.25, 0.5, 0.85), 1.6, 0.5, 1.45
@@ -63,23 +63,7 @@ def build(tilt_degrees: float):
     bpy.ops.object.transform_apply(location=False, rotation=True, scale=True)
     slab.data.materials.append(glass)
 
-    camera = bpy.data.objects.new("Camera", bpy.data.cameras.new("Camera"))
-    camera.location, camera.rotation_euler = (0, -6.0, 0), (math.radians(90), 0, 0)
-    scene.collection.objects.link(camera)
-    scene.camera = camera
-    world = bpy.data.worlds.new("World")
-    world.use_nodes = True
-    world.node_tree.nodes["Background"].inputs["Color"].default_value = (0, 0, 0, 1)
-    scene.world = world
-    scene.render.resolution_x, scene.render.resolution_y, scene.render.resolution_percentage = WIDTH, HEIGHT, 100
-    scene.view_settings.view_transform = "Standard"
-    scene.snell.fresnel = False
-    scene.cycles.samples = 64
-    scene.cycles.use_denoising = False
-    scene.cycles.pixel_filter_type = "BOX"
-    scene.cycles.filter_width = 1.0
-    scene.cycles.caustics_reflective = scene.cycles.caustics_refractive = False
-    scene.cycles.seed = 1
+    cycles_comparison(scene, WIDTH, HEIGHT, samples=64, background=0.0)
     return scene, glass
 
 

@@ -21,7 +21,7 @@ import bpy
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).parent))  # Blender runs the script without its folder on the path
-from blender_support import SCRATCH, check, enable_addon, render_f12  # noqa: E402
+from blender_support import SCRATCH, check, cycles_comparison, enable_addon, render_f12  # noqa: E402
 from snell_blender import compat  # noqa: E402
 
 WIDTH, HEIGHT = 160, 120
@@ -202,30 +202,13 @@ def build(card, glass_material, pane: bool = False, lit: bool = False, backdrop:
         bpy.ops.object.shade_smooth()
     bpy.context.object.data.materials.append(glass_material)
     bpy.context.object.visible_shadow = False  # snell draws no shadows: Cycles' glass casts none either
-    camera = bpy.data.objects.new("Camera", bpy.data.cameras.new("Camera"))
-    camera.location, camera.rotation_euler = (0, -6.0, 0), (math.radians(90), 0, 0)
-    camera.data.lens = 50.0
-    scene.collection.objects.link(camera)
-    scene.camera = camera
+    cycles_comparison(scene, WIDTH, HEIGHT, samples=48, background=0.002)
     sun = bpy.data.objects.new("Sun", bpy.data.lights.new("Sun", "SUN"))
     # Lit: from behind the camera, for the diffuse card; else from behind the card, lighting nothing seen.
     sun.rotation_euler = (math.radians(70), 0, math.radians(20)) if lit else (math.radians(-90), 0, 0)
     sun.data.energy = 3.0 if lit else 0.1
     scene.collection.objects.link(sun)
-    world = bpy.data.worlds.new("World")
-    world.use_nodes = True
-    world.node_tree.nodes["Background"].inputs["Color"].default_value = (0.002, 0.002, 0.002, 1)
-    scene.world = world
-    scene.render.resolution_x, scene.render.resolution_y, scene.render.resolution_percentage = WIDTH, HEIGHT, 100
-    scene.view_settings.view_transform = "Standard"
-    scene.snell.fresnel = False
-    scene.cycles.samples = 48
-    scene.cycles.use_denoising = False
-    scene.cycles.pixel_filter_type = "BOX"
-    scene.cycles.filter_width = 1.0
     scene.cycles.max_bounces = scene.cycles.transmission_bounces = scene.cycles.transparent_max_bounces = 16
-    scene.cycles.caustics_reflective = scene.cycles.caustics_refractive = False
-    scene.cycles.seed = 1
     return scene
 
 
