@@ -20,7 +20,8 @@
 # of 100 at 4K. The table gives each build's median over the rounds, the spread (min-max) and the
 # ratio of the first build's time to each other's, and whether each build draws the three trace
 # scenes with the same pixels (`snell render --stats-json`'s image hash, first round);
-# $OUT/compare.json holds every measurement. BUILDS (names, space-separated) limits `run` to some of
+# $OUT/compare.json holds every measurement (ROWS=registers adds the driver's register and spill counts
+# of each build's trace pipelines, $OUT/registers.log). BUILDS (names, space-separated) limits `run` to some of
 # the carried builds, and NAME+VAR=VALUE runs build NAME with VAR=VALUE set (an experiment's switch);
 # ROWS limits it to some rows (same, trace, viewport).
 set -uo pipefail
@@ -96,6 +97,9 @@ run_all() {
   # Each build keeps its own warm pipeline caches: what is timed is the frames, not the compiles.
   export __GL_SHADER_DISK_CACHE_PATH=/tmp/compare-nv
   : >"$log"
+  # A warm-up run, not counted: the first run of a lease met a GPU still raising its clocks (15-45% slower).
+  snell_of "${builds[0]}" bench methods "$scenes/sphere-100k.gltf" --methods trace --no-reference --frames 8 \
+    --size 1920x1080 >/dev/null 2>&1
   for ((round = 0; round < rounds; ++round)); do
     local order=("${builds[@]}")
     if ((round % 2)); then
@@ -107,7 +111,7 @@ run_all() {
       mkdir -p "$SNELL_PIPELINE_CACHE"
       if [[ $rows == *trace* ]]; then
         for s in sphere-100k sphere-1m eye; do
-          local args=(--eye)
+          local args=()  # bench methods draws the procedural eye without a scene
           [[ $s != eye ]] && args=("$scenes/$s.gltf")
           echo "@@ round=$round build=$b row=$s"
           snell_of "$b" bench methods "${args[@]}" --methods trace,driver-rt --no-reference --frames 8 \
@@ -123,6 +127,15 @@ run_all() {
           echo "@@ round=$round build=$b row=pixels-$s"
           echo "image hash $(grep -o '"image_hash": *"[^"]*"' "/tmp/compare-$s-$b.json" | cut -d'"' -f4)"
         done
+      fi
+      if [[ $rows == *registers* ]] && ((round == 0)); then  # the driver's statistics of each trace pipeline
+        for s in sphere-100k eye; do
+          local args=()
+          [[ $s != eye ]] && args=("$scenes/$s.gltf")
+          echo "== $b, $s"
+          snell_of "$b" bench methods "${args[@]}" --methods trace,driver-rt --no-reference --frames 1 \
+            --size 640x360 --pipeline-stats 2>&1 | grep -iE "register|spill|stack|trace \(" | sort -u
+        done >>"$OUT/registers.log"
       fi
       if [[ $rows == *viewport* ]]; then
         local -A frame=([crowd-2]="--crowd 2" [eye-64]="" [eye-256]="--eye-resolution 256"
