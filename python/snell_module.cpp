@@ -152,7 +152,62 @@ struct PyMesh {
   py::object positions, normals, indices, uvs;
   int material = -1;
   std::string name;
+  std::optional<snell::Subdivision> subdivision;  ///< a subdivision cage's scheme and tags
 };
+
+// Names as USD spells the UsdGeomMesh tokens, for Subdivision's string properties.
+template <typename E>
+struct TokenNames {
+  std::vector<std::pair<E, const char*>> names;
+  E parse(const std::string& name, const char* what) const {
+    std::string known;
+    for (const auto& [value, token] : names) {
+      if (name == token) return value;
+      known += (known.empty() ? "" : ", ") + std::string(token);
+    }
+    throw snell::Error(std::string(what) + " '" + name + "' is not one of " + known);
+  }
+  std::string name(E value) const {
+    for (const auto& [v, token] : names) {
+      if (v == value) return token;
+    }
+    return "";
+  }
+};
+const TokenNames<snell::Subdivision::Scheme> kSchemes{{{snell::Subdivision::Scheme::None, "none"},
+                                                       {snell::Subdivision::Scheme::CatmullClark, "catmullClark"},
+                                                       {snell::Subdivision::Scheme::Loop, "loop"},
+                                                       {snell::Subdivision::Scheme::Bilinear, "bilinear"}}};
+const TokenNames<snell::Subdivision::Boundary> kBoundaries{{{snell::Subdivision::Boundary::None, "none"},
+                                                            {snell::Subdivision::Boundary::EdgeOnly, "edgeOnly"},
+                                                            {snell::Subdivision::Boundary::EdgeAndCorner, "edgeAndCorner"}}};
+const TokenNames<snell::Subdivision::FaceVarying> kFaceVarying{{{snell::Subdivision::FaceVarying::None, "none"},
+                                                                {snell::Subdivision::FaceVarying::CornersOnly, "cornersOnly"},
+                                                                {snell::Subdivision::FaceVarying::CornersPlus1, "cornersPlus1"},
+                                                                {snell::Subdivision::FaceVarying::CornersPlus2, "cornersPlus2"},
+                                                                {snell::Subdivision::FaceVarying::Boundaries, "boundaries"},
+                                                                {snell::Subdivision::FaceVarying::All, "all"}}};
+const TokenNames<snell::Subdivision::Normals> kNormals{{{snell::Subdivision::Normals::Limit, "limit"},
+                                                        {snell::Subdivision::Normals::Mesh, "mesh"}}};
+
+// A 1-D array of uint32 (or a sequence of ints) for Subdivision's index lists.
+std::vector<uint32_t> indexList(const py::handle& value, const char* what) {
+  auto a = py::array_t<int64_t, py::array::c_style | py::array::forcecast>::ensure(value);
+  if (!a || a.ndim() != 1) throw snell::Error(std::string("Subdivision.") + what + " must be a 1-D list of indices");
+  std::vector<uint32_t> out;
+  for (py::ssize_t i = 0; i < a.size(); ++i) {
+    if (a.data()[i] < 0 || a.data()[i] > int64_t(UINT32_MAX)) {
+      throw snell::Error(std::string("Subdivision.") + what + "[" + std::to_string(i) + "] is not an index");
+    }
+    out.push_back(uint32_t(a.data()[i]));
+  }
+  return out;
+}
+std::vector<float> floatList(const py::handle& value, const char* what) {
+  auto a = py::array_t<float, py::array::c_style | py::array::forcecast>::ensure(value);
+  if (!a || a.ndim() != 1) throw snell::Error(std::string("Subdivision.") + what + " must be a 1-D list of numbers");
+  return std::vector<float>(a.data(), a.data() + a.size());
+}
 
 struct PyInstance {
   int mesh = 0;
@@ -239,35 +294,40 @@ snell::Scene sceneFromArrays(const std::vector<PyMesh>& meshes, const std::vecto
   for (size_t i = 0; i < meshes.size(); ++i) {
     const PyMesh& m = meshes[i];
     std::string what = name + ": mesh " + std::to_string(i) + (m.name.empty() ? "" : " ('" + m.name + "')");
+    // A subdivision cage's indices are its faces' corners (1-D), its normals snell's to make.
+    const bool cage = m.subdivision && m.subdivision->scheme != snell::Subdivision::Scheme::None;
     auto positions = checked<float>(m.positions, what + " positions", 3, "float32");
-    auto normals = checked<float>(m.normals, what + " normals", 3, "float32");
-    auto indices = checked<uint32_t>(m.indices, what + " indices", 3, "uint32");
+    std::optional<py::array_t<float, py::array::c_style>> normals;
+    if (!(cage && m.normals.is_none())) normals = checked<float>(m.normals, what + " normals", 3, "float32");
+    auto indices = checked<uint32_t>(m.indices, what + " indices", cage ? 0 : 3, "uint32");
     size_t n = size_t(positions.shape(0));
-    if (size_t(normals.shape(0)) != n) {
-      throw snell::Error(what + ": " + std::to_string(normals.shape(0)) + " normals for " + std::to_string(n) +
+    if (normals && size_t(normals->shape(0)) != n) {
+      throw snell::Error(what + ": " + std::to_string(normals->shape(0)) + " normals for " + std::to_string(n) +
                          " positions");
     }
-    if (n == 0 || indices.shape(0) == 0) throw snell::Error(what + " has no vertices or no triangles");
+    if (n == 0 || indices.shape(0) == 0) throw snell::Error(what + " has no vertices or no " + (cage ? "faces" : "triangles"));
     snell::Mesh mesh;
     mesh.name = m.name;
     mesh.vertexCount = uint32_t(n);
     mesh.material = m.material;
     mesh.indices = flat(indices);
+    if (m.subdivision) mesh.subdivision = *m.subdivision;
     for (size_t k = 0; k < mesh.indices.size(); ++k) {
       if (mesh.indices[k] >= n) {
-        throw snell::Error(what + " indices: triangle " + std::to_string(k / 3) + " names vertex " +
-                           std::to_string(mesh.indices[k]) + " of " + std::to_string(n));
+        throw snell::Error(what + " indices: " + (cage ? "corner " + std::to_string(k) : "triangle " + std::to_string(k / 3)) +
+                           " names vertex " + std::to_string(mesh.indices[k]) + " of " + std::to_string(n));
       }
     }
     if (!m.uvs.is_none()) {
       auto uvs = checked<float>(m.uvs, what + " uvs", 2, "float32");
-      if (size_t(uvs.shape(0)) != n) {
+      const bool faceVarying = cage && !mesh.subdivision.uvIndices.empty();
+      if (!faceVarying && size_t(uvs.shape(0)) != n) {
         throw snell::Error(what + ": " + std::to_string(uvs.shape(0)) + " uvs for " + std::to_string(n) + " positions");
       }
       mesh.texcoords = flat(uvs);
     }
     host.meshes.push_back(std::move(mesh));
-    host.vertices.push_back(snell::MeshVertices{flat(positions), flat(normals)});
+    host.vertices.push_back(snell::MeshVertices{flat(positions), normals ? flat(*normals) : std::vector<float>{}});
   }
   if (instances) {
     for (size_t i = 0; i < instances->size(); ++i) {
@@ -301,6 +361,7 @@ py::dict frameDict(const snell::FrameInfo& f) {
   }
   return py::dict("frame"_a = f.frame, "method"_a = f.method, "skipped"_a = f.skipped,
                   "items_deformed"_a = f.itemsDeformed, "meshes_uploaded"_a = f.meshesUploaded,
+                  "meshes_refined"_a = f.meshesRefined, "vertices_refined"_a = f.verticesRefined,
                   "trees_built"_a = f.treesBuilt, "trees_refit"_a = f.treesRefit, "trees_skipped"_a = f.treesSkipped,
                   "top_level_built"_a = f.topLevelBuilt, "top_level_refit"_a = f.topLevelRefit,
                   "pixels_traced"_a = f.pixelsTraced, "dispatches"_a = f.dispatches, "draws"_a = f.draws,
@@ -534,14 +595,97 @@ PYBIND11_MODULE(_snell, m) {
       .def_readwrite("ymag", &snell::SceneCamera::ymag)
       .def_readwrite("name", &snell::SceneCamera::name);
 
+  py::class_<snell::Subdivision>(
+      m, "Subdivision",
+      "How a Mesh is a subdivision surface, with USD's UsdGeomMesh tags: its indices are a cage's\n"
+      "faces, which snell refines on the GPU whenever the vertices change (set_vertices).")
+      .def(py::init([](const std::string& scheme, uint32_t level, const py::object& faceVertexCounts,
+                       const std::string& boundary, const std::string& faceVarying, bool limitSurface,
+                       const std::string& normals) {
+             snell::Subdivision s;
+             s.scheme = kSchemes.parse(scheme, "scheme");
+             s.level = level;
+             if (!faceVertexCounts.is_none()) s.faceVertexCounts = indexList(faceVertexCounts, "face_vertex_counts");
+             s.interpolateBoundary = kBoundaries.parse(boundary, "interpolate_boundary");
+             s.faceVarying = kFaceVarying.parse(faceVarying, "face_varying_linear_interpolation");
+             s.limitSurface = limitSurface;
+             s.normals = kNormals.parse(normals, "normals");
+             return s;
+           }),
+           "scheme"_a = "catmullClark", "level"_a = 2, "face_vertex_counts"_a = py::none(),
+           "interpolate_boundary"_a = "edgeAndCorner", "face_varying_linear_interpolation"_a = "cornersPlus1",
+           "limit_surface"_a = false, "normals"_a = "mesh",
+           "scheme: catmullClark, loop, bilinear or none; level: refinement levels (1 to 8);\n"
+           "face_vertex_counts: vertices of each face (the Mesh's indices hold them, face after face);\n"
+           "limit_surface: vertices on the limit surface (Blender's 'Use Limit Surface'), else refined;\n"
+           "normals: mesh (the refined triangles', as Blender and usdview shade) or limit (the limit\n"
+           "surface's tangents').")
+      .def_property(
+          "scheme", [](const snell::Subdivision& s) { return kSchemes.name(s.scheme); },
+          [](snell::Subdivision& s, const std::string& v) { s.scheme = kSchemes.parse(v, "scheme"); })
+      .def_readwrite("level", &snell::Subdivision::level)
+      .def_property(
+          "face_vertex_counts", [](const snell::Subdivision& s) { return s.faceVertexCounts; },
+          [](snell::Subdivision& s, const py::object& v) { s.faceVertexCounts = indexList(v, "face_vertex_counts"); })
+      .def_readwrite("left_handed", &snell::Subdivision::leftHanded)
+      .def_property(
+          "hole_indices", [](const snell::Subdivision& s) { return s.holeIndices; },
+          [](snell::Subdivision& s, const py::object& v) { s.holeIndices = indexList(v, "hole_indices"); })
+      .def_property(
+          "crease_indices", [](const snell::Subdivision& s) { return s.creaseIndices; },
+          [](snell::Subdivision& s, const py::object& v) { s.creaseIndices = indexList(v, "crease_indices"); })
+      .def_property(
+          "crease_lengths", [](const snell::Subdivision& s) { return s.creaseLengths; },
+          [](snell::Subdivision& s, const py::object& v) { s.creaseLengths = indexList(v, "crease_lengths"); })
+      .def_property(
+          "crease_sharpnesses", [](const snell::Subdivision& s) { return s.creaseSharpnesses; },
+          [](snell::Subdivision& s, const py::object& v) { s.creaseSharpnesses = floatList(v, "crease_sharpnesses"); },
+          "One per crease, or one per edge of every crease; 10 or more: infinitely sharp.")
+      .def_property(
+          "corner_indices", [](const snell::Subdivision& s) { return s.cornerIndices; },
+          [](snell::Subdivision& s, const py::object& v) { s.cornerIndices = indexList(v, "corner_indices"); })
+      .def_property(
+          "corner_sharpnesses", [](const snell::Subdivision& s) { return s.cornerSharpnesses; },
+          [](snell::Subdivision& s, const py::object& v) { s.cornerSharpnesses = floatList(v, "corner_sharpnesses"); })
+      .def_property(
+          "interpolate_boundary", [](const snell::Subdivision& s) { return kBoundaries.name(s.interpolateBoundary); },
+          [](snell::Subdivision& s, const std::string& v) {
+            s.interpolateBoundary = kBoundaries.parse(v, "interpolate_boundary");
+          })
+      .def_property(
+          "face_varying_linear_interpolation", [](const snell::Subdivision& s) { return kFaceVarying.name(s.faceVarying); },
+          [](snell::Subdivision& s, const std::string& v) {
+            s.faceVarying = kFaceVarying.parse(v, "face_varying_linear_interpolation");
+          })
+      .def_readwrite("smooth_triangles", &snell::Subdivision::smoothTriangles,
+                     "triangleSubdivisionRule 'smooth' (Catmull-Clark only).")
+      .def_readwrite("limit_surface", &snell::Subdivision::limitSurface)
+      .def_property(
+          "normals", [](const snell::Subdivision& s) { return kNormals.name(s.normals); },
+          [](snell::Subdivision& s, const std::string& v) { s.normals = kNormals.parse(v, "normals"); })
+      .def_property(
+          "uv_indices", [](const snell::Subdivision& s) { return s.uvIndices; },
+          [](snell::Subdivision& s, const py::object& v) { s.uvIndices = indexList(v, "uv_indices"); },
+          "Face-varying uvs: one index per face corner into the Mesh's uvs (empty: uvs per vertex).")
+      .def("__repr__", [](const snell::Subdivision& s) {
+        return "<snell.Subdivision " + kSchemes.name(s.scheme) + " level " + std::to_string(s.level) + ", " +
+               std::to_string(s.faceVertexCounts.size()) + " faces>";
+      });
+
   py::class_<PyMesh>(m, "Mesh", "A triangle mesh from numpy arrays, for Scene.from_arrays.")
       .def(py::init([](py::object positions, py::object normals, py::object indices, py::object uvs, int material,
-                       const std::string& name) {
-             return PyMesh{std::move(positions), std::move(normals), std::move(indices), std::move(uvs), material, name};
+                       const std::string& name, std::optional<snell::Subdivision> subdivision) {
+             return PyMesh{std::move(positions), std::move(normals), std::move(indices), std::move(uvs), material, name,
+                           std::move(subdivision)};
            }),
            "positions"_a, "normals"_a, "indices"_a, "uvs"_a = py::none(), "material"_a = -1, "name"_a = "",
+           "subdivision"_a = py::none(),
            "positions and normals: (n, 3) float32; indices: (m, 3) uint32, counted from 0;\n"
-           "uvs: (n, 2) float32 or None; material: an index into the scene's materials (-1: grey).")
+           "uvs: (n, 2) float32 or None; material: an index into the scene's materials (-1: grey).\n"
+           "subdivision: a Subdivision, making the mesh a cage: indices are then its faces' corners (1-D\n"
+           "uint32, subdivision.face_vertex_counts says how many each face has), normals may be None,\n"
+           "and uvs are per vertex or, with subdivision.uv_indices, face-varying values.")
+      .def_readonly("subdivision", &PyMesh::subdivision)
       .def_readonly("positions", &PyMesh::positions)
       .def_readonly("normals", &PyMesh::normals)
       .def_readonly("indices", &PyMesh::indices)
@@ -602,7 +746,14 @@ PYBIND11_MODULE(_snell, m) {
       .def_property_readonly("camera_count", [](const PyScene& s) { return s.get().cameraCount(); })
       .def_property_readonly("duration", [](const PyScene& s) { return s.get().duration(); },
                              "The longest animation in seconds (0: static).")
-      .def("vertex_count", [](const PyScene& s, int mesh) { return s.get().vertexCount(mesh); }, "mesh"_a)
+      .def("vertex_count", [](const PyScene& s, int mesh) { return s.get().vertexCount(mesh); }, "mesh"_a,
+           "The vertices the mesh's arrays hold (a subdivision cage's).")
+      .def("drawn_vertex_count", [](const PyScene& s, int mesh) { return s.get().drawnVertexCount(mesh); }, "mesh"_a,
+           "The vertices it is drawn with (a subdivision surface's refined ones).")
+      .def("drawn_triangle_count", [](const PyScene& s, int mesh) { return s.get().drawnTriangleCount(mesh); },
+           "mesh"_a)
+      .def_property_readonly("warnings", [](const PyScene& s) { return s.get().warnings(); },
+                             "What loading repaired or left out, each naming its file or mesh.")
       .def("close", [](PyScene& s) { s.scene.reset(); })
       .def("__enter__", [](PyScene& s) -> PyScene& { return s; })
       .def("__exit__", [](PyScene& s, const py::args&) { s.scene.reset(); })

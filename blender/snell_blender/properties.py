@@ -1,5 +1,6 @@
 # SPDX-License-Identifier: GPL-3.0-or-later
-"""The add-on's settings: per scene (how glass is drawn), per view layer (which passes), per user (where snell is)."""
+"""The add-on's settings: per scene (how glass is drawn), per view layer (which passes), per object (who
+subdivides it), per user (where snell is)."""
 
 from __future__ import annotations
 
@@ -37,6 +38,15 @@ class SnellSceneSettings(bpy.types.PropertyGroup):
         description="How the viewport gets snell's image")
     overlay: bpy.props.BoolProperty(name="Overlay", default=True,
                                     description="A line in the viewport says how the image was drawn and what it cost")
+
+
+class SnellObjectSettings(bpy.types.PropertyGroup):
+    """How snell takes an object (Object Properties > snell)."""
+
+    gpu_subdivision: bpy.props.BoolProperty(
+        name="Subdivide on the GPU", default=True,
+        description="When the last modifier is a Catmull-Clark Subdivision Surface, send its cage and let snell "
+                    "refine it on the GPU each frame (off: Blender subdivides on the CPU, as it does for Cycles)")
 
 
 # snell's AOVs as render passes: (property, pass name, channel ids, type, description). Depth and
@@ -101,14 +111,18 @@ def settings(scene) -> SnellSceneSettings:
 def register() -> None:
     bpy.utils.register_class(SnellSceneSettings)
     bpy.utils.register_class(SnellViewLayerSettings)
+    bpy.utils.register_class(SnellObjectSettings)
     bpy.utils.register_class(SnellPreferences)
     bpy.types.Scene.snell = bpy.props.PointerProperty(type=SnellSceneSettings)
     bpy.types.ViewLayer.snell = bpy.props.PointerProperty(type=SnellViewLayerSettings)
+    bpy.types.Object.snell = bpy.props.PointerProperty(type=SnellObjectSettings)
 
 
 def unregister() -> None:
+    del bpy.types.Object.snell
     del bpy.types.ViewLayer.snell
     del bpy.types.Scene.snell
     bpy.utils.unregister_class(SnellPreferences)
+    bpy.utils.unregister_class(SnellObjectSettings)
     bpy.utils.unregister_class(SnellViewLayerSettings)
     bpy.utils.unregister_class(SnellSceneSettings)

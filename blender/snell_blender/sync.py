@@ -12,6 +12,11 @@ Vertices are Blender's face corners (loops), as the glTF exporter splits
 them: a corner carries its vertex's position, its split normal (smooth,
 flat or custom, what the viewport shows) and its UV. Each material slot of
 an object is one snell mesh.
+
+An object whose last modifier is a Subdivision Surface snell refines
+(subdivision.py) sends its cage instead: Blender's vertices, its faces and
+the modifier's settings; each frame its cage's positions, which snell
+refines on the GPU.
 """
 
 from __future__ import annotations
@@ -22,7 +27,7 @@ from typing import Optional
 
 import numpy as np
 
-from . import compat, convert, runtime
+from . import compat, convert, runtime, subdivision
 
 
 @dataclass
@@ -47,6 +52,7 @@ class ObjectGeometry:
     co: Optional[np.ndarray] = None           # (vertices, 3) scratch for foreach_get
     loop_normals: Optional[np.ndarray] = None  # (loops, 3) scratch
     sent: Optional[tuple] = None               # the (co, loop normals) last sent
+    cage: bool = False  # its meshes are a subdivision cage's (vertices are Blender's, normals snell's)
 
 
 class TopologyChanged(Exception):
@@ -124,7 +130,7 @@ class SceneSync:
             name = obj.original.name
             geometry = self.geometry.get(name)
             if geometry is None:
-                geometry = self._topology(obj, meshes, materials, material_index, textures)
+                geometry = self._topology(obj, depsgraph, meshes, materials, material_index, textures)
                 if geometry is None:
                     continue
                 self.geometry[name] = geometry
@@ -159,8 +165,60 @@ class SceneSync:
                 part.normals = self.renderer.normals(part.mesh)
         self.build_seconds = time.perf_counter() - started
 
-    def _topology(self, obj, meshes, materials, material_index, textures) -> Optional[ObjectGeometry]:
+    def _cage_of(self, obj, depsgraph):
+        """The object's cage and its GpuModifier where snell refines it, else (None, None)."""
+        gpu = subdivision.gpu_modifier(obj, depsgraph)
+        if gpu is None:
+            return None, None
+        mesh = subdivision.cage_mesh(obj, depsgraph, gpu)
+        why = subdivision.shading_keeps_blender(mesh) if mesh is not None else "it has no mesh"
+        if why is not None:
+            obj.to_mesh_clear()
+            self.notes.add(f"{obj.original.name} is subdivided by Blender: {why}")
+            return None, None
+        return mesh, gpu
+
+    def _topology(self, obj, depsgraph, meshes, materials, material_index, textures) -> Optional[ObjectGeometry]:
         """Adds an object's meshes (one per material slot it uses) with their current vertices."""
+        mesh, gpu = self._cage_of(obj, depsgraph)
+        if mesh is not None:
+            try:
+                return self._cage_topology(obj, mesh, gpu, meshes, materials, material_index, textures)
+            finally:
+                obj.to_mesh_clear()
+        return self._triangle_topology(obj, meshes, materials, material_index, textures)
+
+    def _material_index(self, obj, slot: int, material_index, materials, textures, uv_layer) -> tuple:
+        """The snell material of an object's material slot (made once per Blender material), and its key."""
+        blender_material = obj.material_slots[slot].material if slot < len(obj.material_slots) else None
+        key = blender_material.name if blender_material is not None else ""
+        if key not in material_index:
+            materials.append(convert.material_of(blender_material, textures,
+                                                 uv_layer.name if uv_layer is not None else "", self.problems))
+            material_index[key] = len(materials) - 1
+        return material_index[key], key
+
+    def _cage_topology(self, obj, mesh, gpu, meshes, materials, material_index, textures) -> ObjectGeometry:
+        """An object's subdivision cage: each material slot's part carries the whole cage, the other slots'
+        faces as holes, so that every part refines the one surface."""
+        import snell
+
+        uv_layer = _render_uv_layer(mesh)
+        cage = subdivision.read_cage(mesh, gpu, uv_layer)
+        geometry = ObjectGeometry(obj.original.name, len(mesh.vertices), len(mesh.loops), cage=True)
+        co, _ = self._read_vertices(mesh, geometry)
+        geometry.sent = (co.copy(), None)
+        for slot in np.unique(cage.face_material):
+            index, key = self._material_index(obj, int(slot), material_index, materials, textures, uv_layer)
+            part = MeshPart(len(meshes), np.zeros(0, np.int32), np.arange(geometry.vertex_count, dtype=np.int32))
+            meshes.append(snell.Mesh(np.ascontiguousarray(co), None, cage.face_points, cage.uvs, material=index,
+                                     name=f"{obj.original.name}/{key}",
+                                     subdivision=subdivision.part_subdivision(cage, int(slot))))
+            geometry.parts.append(part)
+        return geometry
+
+    def _triangle_topology(self, obj, meshes, materials, material_index, textures) -> Optional[ObjectGeometry]:
+        """An object's evaluated triangles, a snell mesh per material slot, over its loops."""
         import snell
 
         mesh = _read_mesh(obj)
@@ -189,18 +247,13 @@ class SceneSync:
             geometry.sent = (co.copy(), loop_normals.copy())
             for slot in np.unique(tri_material):
                 loops, remapped = np.unique(tri_loops[tri_material == slot], return_inverse=True)
-                blender_material = obj.material_slots[slot].material if slot < len(obj.material_slots) else None
-                key = blender_material.name if blender_material is not None else ""
-                if key not in material_index:
-                    materials.append(convert.material_of(blender_material, textures,
-                                                         uv_layer.name if uv_layer is not None else "", self.problems))
-                    material_index[key] = len(materials) - 1
+                index, key = self._material_index(obj, int(slot), material_index, materials, textures, uv_layer)
                 part = MeshPart(len(meshes), loops.astype(np.int32), loop_vertex[loops])
                 meshes.append(snell.Mesh(
                     np.ascontiguousarray(co[part.vertex_of_loop]), np.ascontiguousarray(loop_normals[loops]),
                     remapped.reshape(-1, 3).astype(np.uint32),
                     None if uvs is None else np.ascontiguousarray(uvs[loops]),
-                    material=material_index[key], name=f"{obj.original.name}/{key}"))
+                    material=index, name=f"{obj.original.name}/{key}"))
                 geometry.parts.append(part)
             return geometry
         finally:
@@ -208,18 +261,25 @@ class SceneSync:
 
     @staticmethod
     def _read_vertices(mesh, geometry: ObjectGeometry) -> tuple:
-        """The mesh's vertex positions and loop normals into the object's scratch arrays."""
+        """The mesh's vertex positions and loop normals (a cage's: None) into the object's scratch arrays."""
         if geometry.co is None:
             geometry.co = np.empty((geometry.vertex_count, 3), np.float32)
-            geometry.loop_normals = np.empty((geometry.loop_count, 3), np.float32)
+            geometry.loop_normals = None if geometry.cage else np.empty((geometry.loop_count, 3), np.float32)
         mesh.vertices.foreach_get("co", geometry.co.reshape(-1))
+        if geometry.cage:
+            return geometry.co, None
         compat.read_corner_normals(mesh, geometry.loop_normals.reshape(-1))
         return geometry.co, geometry.loop_normals
 
-    def _evaluated_vertices(self, obj) -> tuple:
+    def _evaluated_vertices(self, obj, depsgraph) -> tuple:
         """An evaluated object's (positions, loop normals), in the object's scratch arrays."""
         geometry = self.geometry[obj.original.name]
-        mesh = _read_mesh(obj)
+        if geometry.cage:
+            mesh, gpu = self._cage_of(obj, depsgraph)
+            if mesh is None:
+                raise TopologyChanged(f"{obj.original.name} is no longer subdivided by snell")
+        else:
+            mesh = _read_mesh(obj)
         try:
             if mesh is None or len(mesh.vertices) != geometry.vertex_count or len(mesh.loops) != geometry.loop_count:
                 raise TopologyChanged(f"{obj.original.name}'s topology changed")
@@ -235,16 +295,17 @@ class SceneSync:
             raise TopologyChanged("a light changed")
         vertices = {}
         for obj in self._mesh_objects(depsgraph):
-            co, loop_normals = self._evaluated_vertices(obj)
+            co, loop_normals = self._evaluated_vertices(obj, depsgraph)
             for part in self.geometry[obj.original.name].parts:
-                vertices[part.mesh] = (co[part.vertex_of_loop], loop_normals[part.loops])
+                normals = np.zeros_like(co) if loop_normals is None else loop_normals[part.loops]
+                vertices[part.mesh] = (co[part.vertex_of_loop], normals)
         transforms = {}
         for key, matrix in self._transforms_of(depsgraph).items():
             for index in self.instances[key][1]:
                 transforms[index] = matrix
         return vertices, transforms
 
-    def send_vertices(self, obj, only_if_changed: bool = False) -> bool:
+    def send_vertices(self, obj, depsgraph, only_if_changed: bool = False) -> bool:
         """Writes an evaluated object's vertices into snell's memory and marks its meshes dirty.
 
         With only_if_changed, vertices equal to those sent last are not sent
@@ -252,14 +313,18 @@ class SceneSync:
         Returns whether they were sent.
         """
         geometry = self.geometry[obj.original.name]
-        co, loop_normals = self._evaluated_vertices(obj)
+        co, loop_normals = self._evaluated_vertices(obj, depsgraph)
         if only_if_changed and geometry.sent is not None:
-            if np.array_equal(geometry.sent[0], co) and np.array_equal(geometry.sent[1], loop_normals):
+            if np.array_equal(geometry.sent[0], co) and (loop_normals is None or
+                                                         np.array_equal(geometry.sent[1], loop_normals)):
                 return False
-        geometry.sent = (co.copy(), loop_normals.copy())
+        geometry.sent = (co.copy(), None if loop_normals is None else loop_normals.copy())
         for part in geometry.parts:
-            np.take(co, part.vertex_of_loop, axis=0, out=part.positions)
-            np.take(loop_normals, part.loops, axis=0, out=part.normals)
+            if geometry.cage:  # the cage's vertices are Blender's, in order; snell makes the normals
+                np.copyto(part.positions, co)
+            else:
+                np.take(co, part.vertex_of_loop, axis=0, out=part.positions)
+                np.take(loop_normals, part.loops, axis=0, out=part.normals)
             self.renderer.mark_dirty(part.mesh)
         return True
 
@@ -279,7 +344,7 @@ class SceneSync:
         for done, obj in enumerate(objects):
             if stop():
                 return None
-            if self.send_vertices(obj, only_if_changed=True):
+            if self.send_vertices(obj, depsgraph, only_if_changed=True):
                 sent.append(obj.original.name)
             progress(done + 1, len(objects))
         moved = self._update_transforms(depsgraph)
@@ -290,7 +355,7 @@ class SceneSync:
         """Sends every object's evaluated vertices, whatever changed (bench/record_blender_feed.py's feed)."""
         sent = []
         for obj in self._mesh_objects(depsgraph):
-            self.send_vertices(obj)
+            self.send_vertices(obj, depsgraph)
             sent.append(obj.original.name)
         self._update_transforms(depsgraph)
         return sent
@@ -336,7 +401,7 @@ class SceneSync:
             if kind == "Object" and update.is_updated_geometry:
                 obj = data
                 if obj.original.name in self.geometry:
-                    self.send_vertices(obj)
+                    self.send_vertices(obj, depsgraph)
                     sent.append(obj.original.name)
         moved = self._update_transforms(depsgraph)
         return {"meshes_sent": sent, "instances_moved": moved, "feed_ms": (time.perf_counter() - started) * 1000}

@@ -78,6 +78,29 @@ class SNELL_PT_passes(SnellPropertiesPanel, bpy.types.Panel):
         layout.label(text="From the trace: methods trace, trace-1 and auto", icon="INFO")
 
 
+class SNELL_PT_object(SnellPropertiesPanel, bpy.types.Panel):
+    """Object Properties > snell: whether snell refines the object's subdivision surface."""
+
+    bl_label = "snell"
+    bl_context = "object"
+
+    @classmethod
+    def poll(cls, context) -> bool:
+        return super().poll(context) and context.object is not None and context.object.type == "MESH"
+
+    def draw(self, context) -> None:
+        layout = self.layout
+        layout.use_property_split = True
+        obj = context.object
+        layout.prop(obj.snell, "gpu_subdivision")
+        last = obj.modifiers[-1] if obj.modifiers else None
+        if last is None or last.type != "SUBSURF":
+            layout.label(text="Applies when the last modifier is a Subdivision Surface", icon="INFO")
+        elif obj.snell.gpu_subdivision:
+            layout.label(text=f"snell refines {last.name} on the GPU (render levels {last.render_levels})",
+                         icon="MOD_SUBSURF")
+
+
 class SNELL_OT_retry(bpy.types.Operator):
     """Look for the snell module and a Vulkan device again"""
 
@@ -93,7 +116,7 @@ class SNELL_OT_retry(bpy.types.Operator):
         return {"FINISHED"}
 
 
-classes = (SNELL_PT_render, SNELL_PT_passes, SNELL_OT_retry)
+classes = (SNELL_PT_render, SNELL_PT_passes, SNELL_PT_object, SNELL_OT_retry)
 
 
 def register() -> None:

@@ -173,17 +173,57 @@ struct Texture {
   bool nearest = false;  ///< the nearest texel of the full size, not filtered
 };
 
+/// How a Mesh is a subdivision surface, with USD's UsdGeomMesh tags: its
+/// faces are then a cage, which snell refines once on the CPU (OpenSubdiv)
+/// into stencil tables, and on the GPU every frame its vertices change. The
+/// host writes the cage's vertices (Mesh::vertexCount of them); snell draws,
+/// traces and reads back the refined surface.
+struct Subdivision {
+  /// None: Mesh::indices are triangles, and the rest of this is unread.
+  enum class Scheme { None, CatmullClark, Loop, Bilinear } scheme = Scheme::None;
+  uint32_t level = 2;  ///< uniform refinement levels (each splits a quad in four), 1 to 8
+  /// The cage's faces: Mesh::indices holds their vertices, face after face
+  /// (USD's faceVertexCounts and faceVertexIndices), counter-clockwise seen
+  /// from the front unless `leftHanded`.
+  std::vector<uint32_t> faceVertexCounts;
+  bool leftHanded = false;
+  std::vector<uint32_t> holeIndices;  ///< faces left out
+  /// Runs of creaseLengths[i] vertices in creaseIndices, each with one
+  /// sharpness or one per edge (10 or more: infinitely sharp).
+  std::vector<uint32_t> creaseIndices, creaseLengths;
+  std::vector<float> creaseSharpnesses;
+  std::vector<uint32_t> cornerIndices;
+  std::vector<float> cornerSharpnesses;
+  enum class Boundary { None, EdgeOnly, EdgeAndCorner } interpolateBoundary = Boundary::EdgeAndCorner;
+  /// USD's faceVaryingLinearInterpolation, for face-varying texcoords.
+  enum class FaceVarying { None, CornersOnly, CornersPlus1, CornersPlus2, Boundaries, All } faceVarying =
+      FaceVarying::CornersPlus1;
+  bool smoothTriangles = false;  ///< triangleSubdivisionRule "smooth" (Catmull-Clark)
+  /// Vertices on the limit surface (Blender's "Use Limit Surface"); else the
+  /// refined vertices themselves, as usdview draws a uniform refinement.
+  bool limitSurface = false;
+  /// Normals from the refined triangles (area weighted, as Blender and
+  /// usdview shade), or from the limit surface's tangents. A mesh in the
+  /// host's buffers, whose rest pose snell never sees, shades with the triangles'.
+  enum class Normals { Limit, Mesh } normals = Normals::Mesh;
+  /// Face-varying texcoords: one index per face corner into Mesh::texcoords,
+  /// which then holds 2 floats a value; empty: Mesh::texcoords is per vertex.
+  std::vector<uint32_t> uvIndices;
+};
+
 /// A triangle mesh whose vertices live in the host's buffers (HostScene::positions and normals).
 struct Mesh {
   std::string name;
   uint32_t firstVertex = 0;  ///< where its vertices start in the host's buffers
-  uint32_t vertexCount = 0;
-  std::vector<uint32_t> indices;  ///< 3 per triangle, counted from firstVertex
+  uint32_t vertexCount = 0;  ///< its vertices (a subdivision surface's: the cage's)
+  std::vector<uint32_t> indices;  ///< 3 per triangle, counted from firstVertex (a subdivision surface's: its faces')
   std::vector<float> texcoords;   ///< 2 per vertex (u, v), or empty
   int material = -1;              ///< index into HostScene::materials; -1: a grey default
   /// A box, in the mesh's space, the host promises its vertices stay in; the
   /// default (empty) promises nothing, and the mesh is then never culled.
   Vec3 boundsLo{INFINITY, INFINITY, INFINITY}, boundsHi{-INFINITY, -INFINITY, -INFINITY};
+  /// A subdivision surface's scheme and tags; by default none.
+  Subdivision subdivision;
 };
 
 /// A mesh placed in the world. Renderer::setTransform moves it.
@@ -214,7 +254,7 @@ struct SceneCamera {
 /// One mesh's vertices, for a HostScene whose vertices snell keeps.
 struct MeshVertices {
   std::vector<float> positions;  ///< 3 floats a vertex
-  std::vector<float> normals;    ///< 3 floats a vertex, unit length
+  std::vector<float> normals;    ///< 3 floats a vertex, unit length (a subdivision cage's may be empty: snell makes its own)
 };
 
 /// A scene built from the host's own data, with its vertices in one of two places:
@@ -259,8 +299,15 @@ class Scene {
   size_t meshCount() const;
   /// Cameras the file (or HostScene::cameras) defines (View::sceneCamera).
   size_t cameraCount() const;
-  /// Mesh `mesh`'s vertex count (Scene::meshCount meshes).
+  /// Mesh `mesh`'s vertex count (Scene::meshCount meshes): the cage's, of a subdivision surface.
   uint32_t vertexCount(int mesh) const;
+  /// The vertices and triangles mesh `mesh` is drawn with: a subdivision
+  /// surface's refined ones, else its own.
+  uint32_t drawnVertexCount(int mesh) const;
+  uint32_t drawnTriangleCount(int mesh) const;
+  /// What loading repaired or left out, and what a subdivision cage could not
+  /// be (each names the file or mesh): what a host shows its user as warnings.
+  std::vector<std::string> warnings() const;
   /// Whether snell keeps the vertices (a HostScene without buffers: Renderer::vertices).
   bool keepsVertices() const;
   /// The longest animation, in seconds (0: static).
@@ -402,6 +449,8 @@ struct FrameInfo {
   bool skipped = false;  ///< nothing changed since the view was last drawn: the image was reused
   uint32_t itemsDeformed = 0;   ///< glTF items whose morphs or skin snell deformed
   uint32_t meshesUploaded = 0;  ///< kept meshes (Renderer::vertices) copied to the GPU
+  uint32_t meshesRefined = 0;   ///< subdivision surfaces whose moved cage the GPU refined
+  uint32_t verticesRefined = 0; ///< the vertices those became
   bool topLevelBuilt = false, topLevelRefit = false;
   uint32_t dispatches = 0, draws = 0;
   std::string method;            ///< how glass was drawn

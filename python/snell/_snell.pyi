@@ -148,20 +148,54 @@ class Camera:
     @property
     def transform(self) -> npt.NDArray[np.float64]: ...
 
+class Subdivision:
+    """How a Mesh is a subdivision surface, with USD's UsdGeomMesh tags: its indices are a cage's faces, which
+    snell refines on the GPU whenever the vertices change (set_vertices)."""
+
+    scheme: str  #: catmullClark, loop, bilinear or none
+    level: int
+    face_vertex_counts: list[int]
+    left_handed: bool
+    hole_indices: list[int]
+    crease_indices: list[int]
+    crease_lengths: list[int]
+    crease_sharpnesses: list[float]
+    corner_indices: list[int]
+    corner_sharpnesses: list[float]
+    interpolate_boundary: str  #: none, edgeOnly or edgeAndCorner
+    face_varying_linear_interpolation: str  #: none, cornersOnly, cornersPlus1, cornersPlus2, boundaries or all
+    smooth_triangles: bool
+    limit_surface: bool
+    normals: str  #: mesh or limit
+    uv_indices: list[int]
+    def __init__(
+        self,
+        scheme: str = "catmullClark",
+        level: int = 2,
+        face_vertex_counts: Optional[npt.ArrayLike] = None,
+        interpolate_boundary: str = "edgeAndCorner",
+        face_varying_linear_interpolation: str = "cornersPlus1",
+        limit_surface: bool = False,
+        normals: str = "mesh",
+    ) -> None: ...
+
 class Mesh:
-    """A triangle mesh from numpy arrays, for Scene.from_arrays."""
+    """A triangle mesh from numpy arrays, for Scene.from_arrays (or, with a Subdivision, a subdivision cage)."""
 
     material: int
     name: str
     def __init__(
         self,
         positions: npt.NDArray[np.float32],
-        normals: npt.NDArray[np.float32],
+        normals: Optional[npt.NDArray[np.float32]],
         indices: npt.NDArray[np.uint32],
         uvs: Optional[npt.NDArray[np.float32]] = None,
         material: int = -1,
         name: str = "",
+        subdivision: Optional[Subdivision] = None,
     ) -> None: ...
+    @property
+    def subdivision(self) -> Optional[Subdivision]: ...
     @property
     def positions(self) -> npt.NDArray[np.float32]: ...
     @property
@@ -220,7 +254,11 @@ class Scene:
     def camera_count(self) -> int: ...
     @property
     def duration(self) -> float: ...
+    @property
+    def warnings(self) -> list[str]: ...
     def vertex_count(self, mesh: int) -> int: ...
+    def drawn_vertex_count(self, mesh: int) -> int: ...
+    def drawn_triangle_count(self, mesh: int) -> int: ...
     def close(self) -> None: ...
     def __enter__(self) -> "Scene": ...
     def __exit__(self, *args: Any) -> None: ...

@@ -14,6 +14,7 @@
 #include "scene/evaluate.h"
 #include "scene/gltf_loader.h"
 #include "scene/optics.h"
+#include "scene/subdivision.h"
 #include "scene/view.h"
 #include "vk/commands.h"
 #include "vk/context.h"
@@ -226,10 +227,13 @@ scene::Material toMaterial(const Material& m, size_t textures, const std::string
 }
 
 scene::Shape toShape(const Mesh& m, int index, size_t materials, const std::string& where) {
-  if (m.indices.empty() || m.indices.size() % 3 != 0) {
+  const bool cage = m.subdivision.scheme != Subdivision::Scheme::None;
+  if (!cage && (m.indices.empty() || m.indices.size() % 3 != 0)) {
     throw Error(where + ": needs a whole number of triangles (" + std::to_string(m.indices.size()) + " indices)");
   }
-  if (!m.texcoords.empty() && m.texcoords.size() != size_t(m.vertexCount) * 2) {
+  if (!cage && !m.subdivision.uvIndices.empty()) throw Error(where + ": face-varying texcoords are for subdivision surfaces");
+  const bool faceVarying = !m.subdivision.uvIndices.empty();
+  if (faceVarying ? m.texcoords.size() % 2 != 0 : !m.texcoords.empty() && m.texcoords.size() != size_t(m.vertexCount) * 2) {
     throw Error(where + ": " + std::to_string(m.texcoords.size()) + " texcoord floats for " +
                 std::to_string(m.vertexCount) + " vertices");
   }
@@ -244,6 +248,52 @@ scene::Shape toShape(const Mesh& m, int index, size_t materials, const std::stri
   for (size_t v = 0; v + 1 < m.texcoords.size(); v += 2) shape.texcoords0.emplace_back(m.texcoords[v], m.texcoords[v + 1]);
   shape.host = scene::HostVertices{m.firstVertex, m.vertexCount, toVec(m.boundsLo), toVec(m.boundsHi)};
   return shape;
+}
+
+// A subdivision surface's cage, at rest at `positions` (3 floats a vertex;
+// null for a mesh in the host's buffers, which snell never sees at rest).
+scene::SubdivisionCage toCage(const Mesh& m, const float* positions) {
+  const Subdivision& d = m.subdivision;
+  scene::SubdivisionCage cage;
+  cage.scheme = d.scheme == Subdivision::Scheme::Loop       ? scene::SubdivisionScheme::Loop
+                : d.scheme == Subdivision::Scheme::Bilinear ? scene::SubdivisionScheme::Bilinear
+                                                            : scene::SubdivisionScheme::CatmullClark;
+  cage.level = d.level;
+  cage.limitSurface = d.limitSurface;
+  cage.normals = d.normals == Subdivision::Normals::Limit && positions ? scene::SubdivisionNormals::Limit
+                                                                       : scene::SubdivisionNormals::Mesh;
+  cage.positions.assign(m.vertexCount, glm::vec3(0.0f));
+  if (positions) std::memcpy(cage.positions.data(), positions, size_t(m.vertexCount) * 12);
+  cage.faceVertexCounts = d.faceVertexCounts;
+  cage.faceVertexIndices = m.indices;
+  cage.leftHanded = d.leftHanded;
+  cage.holeIndices = d.holeIndices;
+  cage.creaseIndices = d.creaseIndices;
+  cage.creaseLengths = d.creaseLengths;
+  cage.creaseSharpnesses = d.creaseSharpnesses;
+  cage.cornerIndices = d.cornerIndices;
+  cage.cornerSharpnesses = d.cornerSharpnesses;
+  cage.boundary = scene::BoundaryInterpolation(int(d.interpolateBoundary));
+  cage.faceVarying = scene::FaceVaryingInterpolation(int(d.faceVarying));
+  cage.smoothTriangles = d.smoothTriangles;
+  for (size_t i = 0; i + 1 < m.texcoords.size(); i += 2) cage.uvs.emplace_back(m.texcoords[i], m.texcoords[i + 1]);
+  cage.uvIndices = d.uvIndices;
+  return cage;
+}
+
+// Refines mesh `m`'s cage into `shape` (its warnings into the scene's); SceneError becomes Error.
+void refineCage(const Mesh& m, const float* positions, scene::Shape& shape, scene::Scene& s, const std::string& where) {
+  try {
+    std::optional<scene::HostVertices> host = shape.host;
+    scene::subdivide(toCage(m, positions), shape, where, s.warnings);
+    if (host) {  // its vertices are the host's: only the refined triangles and texcoords are snell's
+      shape.host = host;
+      shape.positions.clear();
+      shape.normals.clear();
+    }
+  } catch (const scene::SceneError& e) {
+    throw Error(e.what());
+  }
 }
 
 // Gives each mesh its vertices from HostScene::vertices: the scene's shapes
@@ -261,12 +311,18 @@ void keepVertices(const HostScene& host, Scene::Impl& impl) {
     const MeshVertices& v = host.vertices[i];
     std::string where = host.name + ": mesh " + std::to_string(i) + (m.name.empty() ? "" : " ('" + m.name + "')");
     if (m.vertexCount == 0) throw Error(where + " has no vertices");
-    if (v.positions.size() != size_t(m.vertexCount) * 3 || v.normals.size() != size_t(m.vertexCount) * 3) {
+    const bool cage = m.subdivision.scheme != Subdivision::Scheme::None;
+    if (v.positions.size() != size_t(m.vertexCount) * 3 ||
+        (v.normals.size() != size_t(m.vertexCount) * 3 && !(cage && v.normals.empty()))) {
       throw Error(where + ": " + std::to_string(v.positions.size()) + " position and " + std::to_string(v.normals.size()) +
                   " normal floats for " + std::to_string(m.vertexCount) + " vertices (3 each)");
     }
     scene::Shape& shape = impl.scene.shapes[i];
     shape.host.reset();
+    if (m.subdivision.scheme != Subdivision::Scheme::None) {
+      refineCage(m, v.positions.data(), shape, impl.scene, where);
+      continue;
+    }
     shape.positions.resize(m.vertexCount);
     shape.normals.resize(m.vertexCount);
     std::memcpy(shape.positions.data(), v.positions.data(), v.positions.size() * sizeof(float));
@@ -375,6 +431,10 @@ Scene Scene::fromHost(const HostScene& host) {
       keepVertices(host, *impl);
     } else {
       impl->host = {host.positions, host.normals, host.vertexCapacity};
+      for (size_t i = 0; i < host.meshes.size(); ++i) {
+        if (host.meshes[i].subdivision.scheme == Subdivision::Scheme::None) continue;
+        refineCage(host.meshes[i], nullptr, s.shapes[i], s, host.name + ": mesh " + std::to_string(i));
+      }
     }
     return Scene(std::move(impl));
   });
@@ -387,8 +447,17 @@ uint32_t Scene::vertexCount(int mesh) const {
   if (mesh < 0 || size_t(mesh) >= impl_->scene.shapes.size()) {
     throw Error("vertexCount: no mesh " + std::to_string(mesh) + " of " + std::to_string(impl_->scene.shapes.size()));
   }
+  return uint32_t(impl_->scene.shapes[size_t(mesh)].writtenVertexCount());
+}
+uint32_t Scene::drawnVertexCount(int mesh) const {
+  vertexCount(mesh);  // the same check
   return uint32_t(impl_->scene.shapes[size_t(mesh)].vertexCount());
 }
+uint32_t Scene::drawnTriangleCount(int mesh) const {
+  vertexCount(mesh);
+  return uint32_t(impl_->scene.shapes[size_t(mesh)].triangleCount());
+}
+std::vector<std::string> Scene::warnings() const { return impl_->scene.warnings; }
 bool Scene::keepsVertices() const { return impl_->keep; }
 double Scene::duration() const { return scene::animationDuration(impl_->scene); }
 
@@ -570,6 +639,8 @@ struct Renderer::Impl {
     last.skipped = s.viewsSkipped > 0;
     last.itemsDeformed = s.itemsDeformed;
     last.meshesUploaded = s.shapesCopied;
+    last.meshesRefined = s.shapesRefined;
+    last.verticesRefined = s.verticesRefined;
     last.topLevelBuilt = s.topLevelBuilt > 0, last.topLevelRefit = s.topLevelRefit > 0;
     last.dispatches = s.dispatches, last.draws = s.draws;
     last.method = render::methodName(drawn);

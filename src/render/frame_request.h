@@ -57,6 +57,8 @@ struct FrameStats {
   uint64_t frame = 0;
   uint32_t itemsDeformed = 0, itemsDeformSkipped = 0;
   uint32_t shapesCopied = 0;  ///< kept shapes whose rewritten vertices went to the GPU
+  uint32_t shapesRefined = 0;  ///< subdivision surfaces whose moved cage the refine pass refined
+  uint32_t verticesRefined = 0;  ///< the vertices those became
   uint32_t treesBuilt = 0, treesRefit = 0, treesSkipped = 0;  ///< bottom level
   uint64_t trianglesBuilt = 0, trianglesRefit = 0;
   uint32_t topLevelBuilt = 0, topLevelRefit = 0, topLevelSkipped = 0;

@@ -1,9 +1,11 @@
 // The host's copy of a scene's vertices, for a caller that rewrites them
 // between frames (the embedding API's scenes without host buffers): kept in
 // mapped host memory, and copied into the scene's buffers at the head of the
-// next frame, for the shapes marked dirty.
+// next frame, for the shapes marked dirty. A subdivision surface keeps its
+// cage, which goes to the refine pass instead.
 #pragma once
 
+#include "render/refine_pass.h"
 #include "render/scene_gpu.h"
 #include "scene/scene.h"
 #include "vk/buffer.h"
@@ -34,8 +36,9 @@ class KeptVertexCopy {
   /// The shape's kept vertices changed: the next recordCopies copies them.
   void markDirty(int shape) { dirty_.at(size_t(shape)) = 1; }
   /// Records the copies of the shapes marked dirty into every geometry of
-  /// theirs in `gpu`'s buffers; returns how many shapes were copied.
-  uint32_t recordCopies(vk::Commands& commands, const SceneGpu& gpu);
+  /// theirs in `gpu`'s buffers, and a subdivision surface's cage into
+  /// `refine`'s (marking it dirty there); returns how many shapes were copied.
+  uint32_t recordCopies(vk::Commands& commands, const SceneGpu& gpu, RefinePass& refine);
   uint64_t bytes() const { return buffer_.size(); }
 
  private:

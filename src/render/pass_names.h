@@ -9,6 +9,7 @@
 namespace snell::pass {
 
 inline constexpr const char* kDeform = "deform";
+inline constexpr const char* kRefine = "refine";
 inline constexpr const char* kBlasBuild = "blas build";
 inline constexpr const char* kBlasRefit = "blas refit";
 inline constexpr const char* kTlas = "tlas";

@@ -8,6 +8,7 @@
 #include "vk/error.h"
 
 #include <algorithm>
+#include <utility>
 #include <cstring>
 #include <stdexcept>
 
@@ -103,6 +104,9 @@ Renderer::Renderer(vk::Context& context, const scene::Scene& scene, const scene:
     }
     throw std::logic_error("deforming item without a geometry");
   });
+  refine_ = std::make_unique<RefinePass>(context, scene, scene_);
+  // A copied host scene's vertices are the host's to give: the first frame takes them all.
+  if (scene_.copiesHost()) hostDirty_.assign(scene.shapes.size(), 1);
   raster_ = std::make_unique<RasterPass>(context);
   trace_ = std::make_unique<TracePass>(context, scene, scene_);
   std::string name = scene.source.empty() ? std::string("scene") : scene.source;
@@ -184,10 +188,13 @@ uint64_t Renderer::submit(const FrameRequest& request) {
   vk::Commands& commands = slot.commands;
   commands.setTimed(options_.passTimes);
   commands.begin();
-  if (kept_) stats.shapesCopied = kept_->recordCopies(commands, scene_);
   // Frames in flight share the scene's GPU data: what this frame rewrites,
   // the one before may still be reading.
   commands.fullBarrier();
+  if (kept_) stats.shapesCopied = kept_->recordCopies(commands, scene_, *refine_);
+  recordHostCopies(commands, stats);
+  if (stats.shapesCopied) commands.fullBarrier();
+  recordRefine(commands, slot);
   for (const vk::Image* image : targets_.takeNewImages()) {
     commands.imageLayout(*image, VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_GENERAL);
   }
@@ -258,6 +265,28 @@ void Renderer::planDeform(const scene::Pose& pose, Update& u, FrameStats& stats)
       if (scene_.geometries[g].item == int(i)) noteMoved(g);
     }
   }
+}
+
+void Renderer::recordHostCopies(vk::Commands& commands, FrameStats& stats) {
+  for (size_t shape = 0; shape < hostDirty_.size(); ++shape) {
+    if (!std::exchange(hostDirty_[shape], 0)) continue;
+    ++stats.shapesCopied;
+    if (sceneModel_.shapes[shape].subdivided()) {
+      refine_->markDirty(int(shape));  // read in place by the refine pass
+    } else {
+      scene_.copyHostShape(commands, sceneModel_, int(shape));
+    }
+  }
+}
+
+void Renderer::recordRefine(vk::Commands& commands, Slot& slot) {
+  if (!refine_->pending()) return;
+  commands.beginPass(pass::kRefine);
+  for (int shape : refine_->record(commands, scene_, slot.arena)) {
+    ++slot.result.stats.shapesRefined;
+    slot.result.stats.verticesRefined += static_cast<uint32_t>(sceneModel_.shapes[size_t(shape)].vertexCount());
+  }
+  commands.endPass();
 }
 
 void Renderer::recordUpdate(vk::Commands& commands, Slot& slot, const scene::Pose& pose, const Update& u) {
@@ -444,6 +473,7 @@ void Renderer::markDirty(int shape) {
     if (scene_.geometries[g].shape == shape) noteMoved(g);
   }
   if (kept_) kept_->markDirty(shape);
+  if (!hostDirty_.empty()) hostDirty_[size_t(shape)] = 1;
   // A host's promised box still holds; any other is unknown until a refit measures it.
   if (!sceneModel_.shapes[size_t(shape)].host) {
     bounds_.setShapeBox(shape, glm::dvec3(INFINITY), glm::dvec3(-INFINITY));
@@ -477,7 +507,7 @@ void Renderer::noteMoved(uint32_t geometry) {
 }
 
 uint64_t Renderer::memoryBytes() const {
-  return scene_.bytes + deform_->bytes() + instances_.size() + lights_.size() + (kept_ ? kept_->bytes() : 0) +
+  return scene_.bytes + deform_->bytes() + refine_->bytes() + instances_.size() + lights_.size() + (kept_ ? kept_->bytes() : 0) +
          trees_.bytes() + trace_->bytes();
 }
 

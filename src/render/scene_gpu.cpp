@@ -222,9 +222,9 @@ static void checkHostShapes(const scene::Scene& scene, const HostBuffers& host) 
                                   ", past the host buffers' " + std::to_string(host.vertexCapacity));
     }
     for (uint32_t index : shape.indices) {
-      if (index >= shape.host->count) {
+      if (index >= shape.vertexCount()) {
         throw std::invalid_argument(scene.source + ": shape '" + shape.name + "' has index " + std::to_string(index) +
-                                    " for " + std::to_string(shape.host->count) + " vertices");
+                                    " for " + std::to_string(shape.vertexCount()) + " vertices");
       }
     }
     if (shape.morphed() || shape.skinned()) {
@@ -243,7 +243,10 @@ SceneGpu uploadScene(vk::Context& context, const scene::Scene& scene, const scen
                                                std::to_string(estimate.triangles) + " triangles)");
   SceneGpu gpu;
   std::vector<int> shapeGeometry(scene.shapes.size(), -1);
-  uint64_t vertices = 0, triangles = 0;
+  // A host's subdivision surfaces refine into snell's buffers, past the host's numbering.
+  bool hostCopies = false;
+  for (const scene::Shape& shape : scene.shapes) hostCopies = hostCopies || (host && shape.subdivided());
+  uint64_t vertices = hostCopies ? host->vertexCapacity : 0, triangles = 0;
   for (size_t i = 0; i < pose.items.size(); ++i) {
     const scene::DrawItem& item = pose.items[i];
     const scene::Shape& shape = scene.shapes[size_t(item.shape)];
@@ -253,11 +256,12 @@ SceneGpu uploadScene(vk::Context& context, const scene::Scene& scene, const scen
       GeometryRange range;
       range.shape = item.shape;
       range.item = item.deforms() ? static_cast<int>(i) : -1;
-      range.firstVertex = host ? shape.host->first : static_cast<uint32_t>(vertices);
+      const bool inPlace = host && !shape.subdivided();
+      range.firstVertex = inPlace ? shape.host->first : static_cast<uint32_t>(vertices);
       range.vertexCount = static_cast<uint32_t>(shape.vertexCount());
       range.firstTriangle = static_cast<uint32_t>(triangles);
       range.triangleCount = static_cast<uint32_t>(shape.triangleCount());
-      vertices += shape.vertexCount();
+      if (!inPlace) vertices += shape.vertexCount();
       triangles += shape.triangleCount();
       if (vertices >= (1ull << 31) || triangles >= (1ull << 31)) {
         throw std::runtime_error(scene.source + ": more than 2^31 vertices or triangles in view");
@@ -273,7 +277,7 @@ SceneGpu uploadScene(vk::Context& context, const scene::Scene& scene, const scen
     gpu.itemRefractive.push_back(material && material->refractive() ? 1 : 0);
     gpu.itemSeeThrough.push_back(material && (material->refractive() || material->alphaMode != scene::AlphaMode::Opaque));
   }
-  if (host) vertices = host->vertexCapacity;  // the host's numbering, gaps and all
+  if (host && !hostCopies) vertices = host->vertexCapacity;  // the host's numbering, gaps and all
   gpu.vertexCount = static_cast<uint32_t>(vertices);
   gpu.triangleCount = static_cast<uint32_t>(triangles);
 
@@ -285,6 +289,8 @@ SceneGpu uploadScene(vk::Context& context, const scene::Scene& scene, const scen
   texcoords.reserve(vertices);
   indices.reserve(triangles * 3);
   if (host) texcoords.assign(vertices, glm::vec4(0.0f));
+  // Until the first frame copies and refines the host's, its vertices here are zero.
+  if (hostCopies) positions.assign(vertices * 3, 0.0f), normals.assign(vertices * 3, 0.0f);
   for (const GeometryRange& range : gpu.geometries) {
     const scene::Shape& shape = scene.shapes[size_t(range.shape)];
     for (size_t v = 0; host && v < shape.vertexCount(); ++v) {
@@ -321,7 +327,13 @@ SceneGpu uploadScene(vk::Context& context, const scene::Scene& scene, const scen
   }
 
   const std::string& name = scene.source.empty() ? std::string("scene") : scene.source;
-  if (host) {
+  if (hostCopies) {
+    const VkDeviceSize hostBytes = VkDeviceSize(host->vertexCapacity) * 12;
+    gpu.hostPositions = vk::Buffer::borrow(context, host->positions, hostBytes, name + " host positions");
+    gpu.hostNormals = vk::Buffer::borrow(context, host->normals, hostBytes, name + " host normals");
+    gpu.positions = uploaded(context, positions, name + " positions", gpu.bytes, true);
+    gpu.normals = uploaded(context, normals, name + " normals", gpu.bytes);
+  } else if (host) {
     gpu.positions = vk::Buffer::borrow(context, host->positions, vertices * 12, name + " host positions");
     gpu.normals = vk::Buffer::borrow(context, host->normals, vertices * 12, name + " host normals");
   } else {
@@ -385,6 +397,18 @@ std::vector<gpu::GpuLight> SceneGpu::packLights(const scene::Scene& scene, const
     lights.push_back(g);
   }
   return lights;
+}
+
+void SceneGpu::copyHostShape(vk::Commands& commands, const scene::Scene& scene, int shape) const {
+  const scene::Shape& s = scene.shapes.at(size_t(shape));
+  if (!copiesHost() || !s.host || s.subdivided()) return;
+  for (const GeometryRange& range : geometries) {
+    if (range.shape != shape) continue;
+    const VkDeviceSize from = VkDeviceSize(s.host->first) * 12, to = VkDeviceSize(range.firstVertex) * 12;
+    const VkDeviceSize bytes = VkDeviceSize(range.vertexCount) * 12;
+    commands.copyBuffer(hostPositions, positions, bytes, from, to);
+    commands.copyBuffer(hostNormals, normals, bytes, from, to);
+  }
 }
 
 void SceneGpu::appendBindings(std::vector<vk::BufferBinding>& out, const vk::Buffer& instances,

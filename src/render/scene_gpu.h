@@ -9,6 +9,7 @@
 #include "shared/bvh.h"
 #include "shared/trace.h"
 #include "vk/buffer.h"
+#include "vk/commands.h"
 #include "vk/context.h"
 #include "vk/descriptors.h"
 
@@ -41,6 +42,11 @@ struct SceneGpu {
   uint32_t surface = 0;
   uint32_t vertexCount = 0, triangleCount = 0;
   vk::Buffer positions, normals;  ///< float[3 * vertexCount]; rest pose, deformed slices rewritten per frame
+  /// A host scene with subdivision surfaces: the host's own buffers, which
+  /// hold their cages; `positions` and `normals` are then snell's, holding
+  /// the refined vertices past the host's and a copy of every other mesh's,
+  /// taken when the host marks it dirty (copyHostShape).
+  vk::Buffer hostPositions, hostNormals;
   vk::Buffer texcoords;           ///< vec4 per vertex: uv0, uv1
   vk::Buffer indices;             ///< uint[3 * triangleCount], absolute
   vk::Buffer materials;           ///< gpu::GpuMaterial[], the scene's then a default one
@@ -62,6 +68,12 @@ struct SceneGpu {
   /// `instances` and `lights`: every pass that reads the scene binds these.
   void appendBindings(std::vector<vk::BufferBinding>& out, const vk::Buffer& instances, const vk::Buffer& lights) const;
   uint64_t bytes = 0;             ///< GPU memory the buffers above take
+
+  /// Whether the scene's vertices are copies of a host's (hostPositions set).
+  bool copiesHost() const { return hostPositions.handle() != VK_NULL_HANDLE; }
+  /// Records the copy of a host shape's vertices from the host's buffers into
+  /// every geometry of its in `positions` and `normals` (copiesHost scenes).
+  void copyHostShape(vk::Commands& commands, const scene::Scene& scene, int shape) const;
 };
 
 /// Level 0 of the textures goes to the GPU through one staging ring of at most this many bytes.

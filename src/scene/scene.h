@@ -11,6 +11,7 @@
 #include <cstdio>
 #include <cstdint>
 #include <limits>
+#include <memory>
 #include <optional>
 #include <stdexcept>
 #include <string>
@@ -130,6 +131,8 @@ struct HostVertices {
   glm::vec3 lo{INFINITY}, hi{-INFINITY};
 };
 
+struct Refinement;  // subdivision.h
+
 /// One glTF triangle primitive: topology and rest pose. Normals are generated
 /// (area-weighted) when the file has none.
 struct Shape {
@@ -146,8 +149,17 @@ struct Shape {
   uint32_t maxJoint = 0;           ///< the largest joint index used, checked against the skin
   /// Set for a host's shape: its vertices live on the GPU only (positions and normals stay empty).
   std::optional<HostVertices> host;
+  /// Set for a subdivision surface (subdivision.h): the vertices above are
+  /// then its refined ones at rest, `refinedVertexCount` of them, made from
+  /// a cage of `cageVertices`, which is what a host writes (host->count).
+  std::shared_ptr<const Refinement> refinement;
+  uint32_t cageVertices = 0, refinedVertexCount = 0;
 
-  size_t vertexCount() const { return host ? host->count : positions.size(); }
+  /// The vertices its triangles index.
+  size_t vertexCount() const { return refinement ? refinedVertexCount : host ? host->count : positions.size(); }
+  /// The vertices a host writes: the cage's of a subdivision surface.
+  size_t writtenVertexCount() const { return refinement ? cageVertices : vertexCount(); }
+  bool subdivided() const { return refinement != nullptr; }
   size_t triangleCount() const { return indices.size() / 3; }
   bool morphed() const { return !targets.empty(); }
   bool skinned() const { return !joints.empty(); }

@@ -1,6 +1,7 @@
 // Scene counts and the per-frame GPU memory estimate behind `snell info`.
 #include "scene/scene_summary.h"
 
+#include "scene/subdivision.h"
 #include "scene/texture_mips.h"
 #include "shared/bvh.h"
 
@@ -46,6 +47,11 @@ SceneSummary summarize(const Scene& scene, uint32_t width, uint32_t height) {
     if (shape.skinned()) s.deformBytes += shape.vertexCount() * kSkinBytesPerVertex;
     s.morphedShapes += shape.morphed();
     s.skinnedShapes += shape.skinned();
+    if (shape.refinement) {
+      ++s.subdividedShapes;
+      // The tables, the cage and its refined vertices.
+      s.refineBytes += shape.refinement->bytes() + 12ull * (shape.cageVertices + shape.refinement->refinedVertices);
+    }
   }
   forEachNode(scene, [&](const Node& node, size_t copies) {
     ++s.nodes;
@@ -90,6 +96,19 @@ std::string describe(const Scene& scene, uint32_t width, uint32_t height) {
     if (undrawn) out << "; " << undrawn << " not uploaded (normal, occlusion or metallic-roughness maps: not drawn)";
     out << "\n";
   }
+  if (s.subdividedShapes) {
+    out << "  subdivision surfaces " << s.subdividedShapes << " (refined on the GPU when their cage moves)\n";
+    for (const Shape& shape : scene.shapes) {
+      if (!shape.refinement) continue;
+      const Refinement& r = *shape.refinement;
+      out << "    " << (shape.name.empty() ? "(unnamed)" : "'" + shape.name + "'") << ": " << schemeName(r.scheme)
+          << " level " << r.level << ", cage " << r.cageVertices << " vertices and " << r.cageFaces << " faces -> "
+          << shape.vertexCount() << " vertices and " << shape.triangleCount() << " triangles"
+          << (r.limitSurface ? ", on the limit surface" : "")
+          << (r.normals == SubdivisionNormals::Limit ? ", limit normals" : ", mesh normals") << ", tables "
+          << mebibytes(r.bytes()) << "\n";
+    }
+  }
   out << "  materials " << scene.materials.size() << ", refractive " << s.refractiveMaterials << "\n";
   for (size_t m = 0; m < scene.materials.size(); ++m) {
     const Material& material = scene.materials[m];
@@ -132,7 +151,8 @@ std::string describe(const Scene& scene, uint32_t width, uint32_t height) {
     out << "    '" << a.name << "': " << a.duration << " s, " << a.channels.size() << " channels\n";
   }
   out << "  GPU memory per frame at " << width << "x" << height << " (estimate): " << mebibytes(s.totalBytes())
-      << " = geometry " << mebibytes(s.geometryBytes) << " + deformation " << mebibytes(s.deformBytes) << " + BVH "
+      << " = geometry " << mebibytes(s.geometryBytes) << " + deformation " << mebibytes(s.deformBytes)
+      << (s.refineBytes ? " + subdivision " + mebibytes(s.refineBytes) : std::string()) << " + BVH "
       << mebibytes(s.bvhBytes) << " + textures " << mebibytes(s.textureBytes) << " + images " << mebibytes(s.imageBytes)
       << "\n";
   for (const std::string& w : scene.warnings) out << "  note: " << w << "\n";

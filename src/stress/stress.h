@@ -7,6 +7,7 @@
 #include "scene/evaluate.h"
 #include "scene/optics.h"
 #include "scene/scene.h"
+#include "scene/subdivision.h"
 #include "scene/view.h"
 #include "vk/context.h"
 
@@ -51,6 +52,15 @@ scene::Scene gridScene(uint64_t count);
 /// A sphere with two morph targets: the first at weight 1 squashes it to 1% of
 /// its depth, the second at weight 1 turns it inside out (every vertex through the centre).
 scene::Scene morphingSphereScene(float ior);
+/// A plano-convex lens shaped as a cornea: a spherical cap of radius `radius`
+/// and height `height` over the disc it stands on in z = 0 (its base), as a
+/// coarse Catmull-Clark cage of `rings` rings of `segments` quads (the rim an
+/// infinitely sharp crease) fitted so that its limit surface lies on the cap
+/// and the disc; refined `level` times (0: the cage itself, as a mesh).
+scene::SubdivisionCage corneaCage(uint32_t rings, uint32_t segments, float radius, float height, uint32_t level);
+/// corneaCage(3, 8, 1, 0.5, level) of IOR 1.376, refined, in front of the backdrop; without `creased`
+/// its rim is smooth (no crease: a rounded dome, convex all over, for rays aimed at its edges).
+scene::Scene subdividedCorneaScene(uint32_t level, bool creased = true);
 /// A sphere whose one morph target (at weight 1) sends a band of vertices to NaN
 /// and one to infinity; `poisonedTriangles` says how many triangles that spoils.
 scene::Scene nonFiniteMorphScene(uint32_t& poisonedTriangles);

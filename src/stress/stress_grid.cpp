@@ -300,10 +300,11 @@ std::vector<Case> grid(const GridOptions& o) {
                         [] { return slabScene(0.5f, 0.75f); }, lookAt({2.2, 0.3, 1.7}, {0.0, 0.0, 0.25}, 0.9), o, 8));
 
   // Watertightness: rays aimed at shared edges and vertices of closed meshes (IOR 1 and glass).
-  auto aimAt = [](double distance) {
+  // From outside, towards a point inside the (convex) mesh: every aimed ray crosses its surface.
+  auto aimAt = [](double distance, glm::dvec3 inside = glm::dvec3(0.0)) {
     return [=](const scene::Scene& s, const scene::Pose& pose, std::vector<scene::Ray>& rays, std::vector<double>& d) {
       auto tris = worldTriangles(s, pose, [](const std::string& n) { return n.rfind("backdrop", 0) != 0; });
-      aimAtEdges(tris, rays.size(), fromCentre(glm::dvec3(0.0), distance), rays, d);
+      aimAtEdges(tris, rays.size(), fromCentre(inside, distance), rays, d);
     };
   };
   ViewFn sphereView = lookAt({0.0, 0.3, 4.0}, {0.0, 0.0, 0.0}, 0.8);
@@ -315,6 +316,14 @@ std::vector<Case> grid(const GridOptions& o) {
                           aimAt(3.0), ior == 1.0f));
     cases.back().countSelfHits = ior == 1.0f;
   }
+  // A cornea refined from a coarse Catmull-Clark cage (two levels on the GPU's
+  // tables): its refined triangles are as watertight as any mesh, and it
+  // draws as the reference draws it.
+  cases.push_back(aimed("watertight: a dome refined from its subdivision cage, rim uncreased (IOR 1)", "watertight",
+                        [] { return withGlass(subdividedCorneaScene(2, false), [](scene::Material& m) { m.ior = 1.0f; }); },
+                        sphereView, o, aimAt(3.0, {0.0, 0.0, 0.2}), true));
+  cases.push_back(image("subdivided: a cornea refined twice from a Catmull-Clark cage of 48 faces", "subdivided",
+                        [] { return subdividedCorneaScene(2); }, lookAt({0.6, 0.5, 2.4}, {0.0, 0.0, 0.25}, 0.9), o, 8));
   cases.push_back(aimed("watertight: the eye's surfaces from the camera", "watertight",
                         [] { return eyeScene(1.376f); }, eyeView(20.0), o,
                         [](const scene::Scene& s, const scene::Pose& pose, std::vector<scene::Ray>& rays,

@@ -1,5 +1,6 @@
 // Scenes for the stability grid, built in code so every case is exact and
 // small enough to trace on the CPU in double.
+#include "ref/refine.h"
 #include "scene/procedural_eye.h"
 #include "scene/scene_builder.h"
 #include "stress/stress.h"
@@ -253,6 +254,144 @@ scene::Scene morphingSphereScene(float ior) {
   shape.targets = {squash, insideOut};
   scene::addRootShape(s, shape);
   addBackdrop(s, 3.0f, -3.0f);
+  return s;
+}
+
+scene::SubdivisionCage corneaCage(uint32_t rings, uint32_t segments, float radius, float height, uint32_t level) {
+  scene::SubdivisionCage cage;
+  cage.level = level;
+  cage.limitSurface = true;
+  const double pi = 3.14159265358979323846, R = radius, h = height;
+  const double rim = std::sqrt(2.0 * R * h - h * h), centreZ = h - R;  // the sphere's centre is below the base
+  const double rimAngle = std::asin(rim / R);                          // from the apex, about the centre
+  // Vertices: the apex, then `rings` rings on the cap down to the rim, then
+  // the base's rings inwards, then the base's centre.
+  auto at = [&](uint32_t ring, uint32_t k) { return 1 + (ring - 1) * segments + k % segments; };
+  cage.positions.push_back({0.0f, 0.0f, float(h)});
+  for (uint32_t r = 1; r <= rings; ++r) {
+    double a = rimAngle * double(r) / double(rings);
+    for (uint32_t k = 0; k < segments; ++k) {
+      double phi = 2.0 * pi * double(k) / double(segments);
+      cage.positions.push_back(glm::vec3(glm::dvec3(R * std::sin(a) * std::cos(phi), R * std::sin(a) * std::sin(phi),
+                                                    centreZ + R * std::cos(a))));
+    }
+  }
+  const uint32_t baseRings = 2;
+  for (uint32_t r = 1; r <= baseRings; ++r) {
+    double radiusHere = rim * double(baseRings + 1 - r) / double(baseRings + 1);
+    for (uint32_t k = 0; k < segments; ++k) {
+      double phi = 2.0 * pi * double(k) / double(segments);
+      cage.positions.push_back(glm::vec3(glm::dvec3(radiusHere * std::cos(phi), radiusHere * std::sin(phi), 0.0)));
+    }
+  }
+  const uint32_t centre = uint32_t(cage.positions.size());
+  cage.positions.push_back({0.0f, 0.0f, 0.0f});
+  // Faces, counter-clockwise seen from outside: the apex fan, the cap's quads, the base's quads and fan.
+  for (uint32_t k = 0; k < segments; ++k) {
+    cage.faceVertexIndices.insert(cage.faceVertexIndices.end(), {0, at(1, k), at(1, k + 1)});
+    cage.faceVertexCounts.push_back(3);
+  }
+  for (uint32_t r = 1; r < rings + baseRings; ++r) {
+    for (uint32_t k = 0; k < segments; ++k) {
+      cage.faceVertexIndices.insert(cage.faceVertexIndices.end(), {at(r, k), at(r + 1, k), at(r + 1, k + 1), at(r, k + 1)});
+      cage.faceVertexCounts.push_back(4);
+    }
+  }
+  for (uint32_t k = 0; k < segments; ++k) {
+    cage.faceVertexIndices.insert(cage.faceVertexIndices.end(),
+                                  {at(rings + baseRings, k), centre, at(rings + baseRings, k + 1)});
+    cage.faceVertexCounts.push_back(3);
+  }
+  for (uint32_t k = 0; k <= segments; ++k) cage.creaseIndices.push_back(at(rings, k));
+  cage.creaseLengths = {segments + 1};
+  cage.creaseSharpnesses = {10.0f};  // infinitely sharp: the rim stays a circle, the base flat
+  if (level == 0) return cage;
+
+  // Fit: the cage whose limit surface lies closest to the lens, in least
+  // squares over every refined vertex. The refined vertices are a linear map
+  // A of the cage (its columns: the refinement of a cage of one unit
+  // vertex), so each round projects them onto the lens (the cap, the rim
+  // circle or the base, by where they lie) and solves A^T A c = A^T target.
+  scene::Shape shape;
+  std::vector<std::string> warnings;
+  scene::subdivide(cage, shape, "cornea cage", warnings);
+  const scene::Refinement& r = *shape.refinement;
+  const size_t n = cage.positions.size(), m = r.vertexOf.size();
+  std::vector<double> columns(n * m);  // A, column after column
+  std::vector<glm::dvec3> unitCage(n, glm::dvec3(0.0)), refined, normals;
+  for (size_t i = 0; i < n; ++i) {
+    unitCage[i].x = 1.0;
+    ref::refineOnCpu(r, unitCage, refined, normals);
+    for (size_t j = 0; j < m; ++j) columns[i * m + j] = refined[j].x;
+    unitCage[i].x = 0.0;
+  }
+  std::vector<double> normal(n * n, 0.0);  // A^T A, then its Cholesky factor
+  for (size_t i = 0; i < n; ++i) {
+    for (size_t k = 0; k <= i; ++k) {
+      double sum = 0.0;
+      for (size_t j = 0; j < m; ++j) sum += columns[i * m + j] * columns[k * m + j];
+      normal[i * n + k] = normal[k * n + i] = sum;
+    }
+  }
+  for (size_t i = 0; i < n; ++i) {
+    for (size_t k = 0; k <= i; ++k) {
+      double sum = normal[i * n + k];
+      for (size_t q = 0; q < k; ++q) sum -= normal[i * n + q] * normal[k * n + q];
+      normal[i * n + k] = i == k ? std::sqrt(sum) : sum / normal[k * n + k];
+    }
+  }
+  // Each refined vertex's part of the lens, from the cage as built (the base
+  // is flat, z = 0, and the cap above it): the rim is the base's vertices
+  // that share a triangle with the cap's.
+  enum Part { kCap, kBase, kRim };
+  std::vector<Part> part(m);
+  for (size_t j = 0; j < m; ++j) part[j] = shape.positions[j].z > 1e-6f ? kCap : kBase;
+  for (size_t t = 0; t + 2 < shape.indices.size(); t += 3) {
+    const uint32_t* c = &shape.indices[t];
+    bool cap = part[c[0]] == kCap || part[c[1]] == kCap || part[c[2]] == kCap;
+    for (int k = 0; k < 3 && cap; ++k) part[c[k]] = part[c[k]] == kCap ? kCap : kRim;
+  }
+  auto onLens = [&](size_t j, const glm::dvec3& p) {
+    const double planar = std::max(std::hypot(p.x, p.y), 1e-30);
+    if (part[j] == kBase) return glm::dvec3(p.x, p.y, 0.0);
+    if (part[j] == kRim) return glm::dvec3(p.x * rim / planar, p.y * rim / planar, 0.0);
+    glm::dvec3 c(0.0, 0.0, centreZ);
+    return c + R * glm::normalize(p - c);
+  };
+  std::vector<glm::dvec3> points(cage.positions.begin(), cage.positions.end());
+  for (int round = 0; round < 12; ++round) {
+    ref::refineOnCpu(r, points, refined, normals);
+    std::vector<glm::dvec3> rhs(n, glm::dvec3(0.0));  // A^T target
+    for (size_t j = 0; j < m; ++j) {
+      glm::dvec3 target = onLens(j, refined[j]);
+      for (size_t i = 0; i < n; ++i) rhs[i] += columns[i * m + j] * target;
+    }
+    for (size_t i = 0; i < n; ++i) {  // L y = rhs, then L^T c = y
+      for (size_t k = 0; k < i; ++k) rhs[i] -= normal[i * n + k] * rhs[k];
+      rhs[i] /= normal[i * n + i];
+    }
+    for (size_t i = n; i-- > 0;) {
+      for (size_t k = i + 1; k < n; ++k) rhs[i] -= normal[k * n + i] * rhs[k];
+      rhs[i] /= normal[i * n + i];
+    }
+    points = rhs;
+  }
+  for (size_t v = 0; v < points.size(); ++v) cage.positions[v] = glm::vec3(points[v]);
+  return cage;
+}
+
+scene::Scene subdividedCorneaScene(uint32_t level, bool creased) {
+  scene::Scene s;
+  s.source = "stress subdivided cornea";
+  scene::Shape shape;
+  shape.name = "cornea";
+  std::vector<std::string> warnings;
+  scene::SubdivisionCage cage = corneaCage(3, 8, 1.0f, 0.5f, level);
+  if (!creased) cage.creaseIndices.clear(), cage.creaseLengths.clear(), cage.creaseSharpnesses.clear();
+  scene::subdivide(cage, shape, "cornea", warnings);
+  shape.material = scene::addMaterial(s, glass(1.376f));
+  scene::addRootShape(s, shape);
+  addBackdrop(s, 2.0f, -1.0f);
   return s;
 }
 

@@ -40,7 +40,8 @@ PathLike = Union[str, os.PathLike]
 
 def read(path: PathLike, *, time: Optional[float] = None, purpose: str = "preview",
          geometry_purpose: str = "render", meters_per_unit: Optional[float] = None, strict: bool = False,
-         load_textures: bool = True, missing_textures_fail: Optional[bool] = None) -> StageContents:
+         load_textures: bool = True, missing_textures_fail: Optional[bool] = None,
+         subdivision_level: int = 2) -> StageContents:
     """Reads a stage for snell without a GPU: its meshes, materials, lights, cameras and warnings.
 
     time: the time code (default: the stage's start); purpose: the material
@@ -51,17 +52,22 @@ def read(path: PathLike, *, time: Optional[float] = None, purpose: str = "previe
     texture file) raises StageError instead of warning;
     missing_textures_fail: a missing texture file is an error (default:
     as strict; otherwise a warning, and the texture's fallback is drawn, as
-    usdview draws it).
+    usdview draws it); subdivision_level: the levels a subdivision surface
+    (subdivisionScheme other than none) is refined by, on the GPU (0: its
+    cage is drawn as it is).
     """
+    if not 0 <= subdivision_level <= 8:
+        raise ValueError(f"subdivision level must be 0 to 8, got {subdivision_level}")
     options = ReadOptions(purpose=purpose, geometry_purpose=geometry_purpose, meters_per_unit=meters_per_unit,
                           load_textures=load_textures, strict=strict,
-                          missing_textures_fail=strict if missing_textures_fail is None else missing_textures_fail)
+                          missing_textures_fail=strict if missing_textures_fail is None else missing_textures_fail,
+                          subdivision_level=subdivision_level)
     return StageContents(path, time, options)
 
 
 def open(path: PathLike, *, time: Optional[float] = None, purpose: str = "preview",  # noqa: A001 (as io.open)
          geometry_purpose: str = "render", device: Optional[Device] = None, meters_per_unit: Optional[float] = None,
-         strict: bool = False, frames_in_flight: int = 2) -> Stage:
+         strict: bool = False, frames_in_flight: int = 2, subdivision_level: int = 2) -> Stage:
     """Opens a stage for drawing: a snell.Scene of its meshes and a Renderer on `device`.
 
     Without a device the stage makes its own and closes it with itself. The
@@ -69,7 +75,7 @@ def open(path: PathLike, *, time: Optional[float] = None, purpose: str = "previe
     the file or prim when the stage cannot be drawn.
     """
     contents = read(path, time=time, purpose=purpose, geometry_purpose=geometry_purpose,
-                    meters_per_unit=meters_per_unit, strict=strict)
+                    meters_per_unit=meters_per_unit, strict=strict, subdivision_level=subdivision_level)
     return Stage(contents, device=device, frames_in_flight=frames_in_flight)
 
 

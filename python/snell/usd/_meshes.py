@@ -8,6 +8,15 @@ from the primvars' indices at open time, so faceVarying normals or st split
 points exactly where they differ, and the same split serves every frame.
 Unauthored normals are computed smooth (area-weighted face normals summed at
 each point) from the posed points.
+
+A subdivision surface (subdivisionScheme catmullClark, USD's fallback, loop
+or bilinear) is sent as its cage instead: every point, its faces as USD
+gives them, and its tags (creases, corners, holes, interpolateBoundary,
+faceVaryingLinearInterpolation, triangleSubdivisionRule) in a
+snell.Subdivision, which snell refines on the GPU each time the points are
+sent. Each material's part carries the whole cage, the other parts' faces
+as holes, so every part refines the one surface. Its normals are snell's
+own (USD ignores authored normals on a subdivision surface).
 """
 
 from __future__ import annotations
@@ -18,6 +27,7 @@ from typing import Optional
 import numpy as np
 from pxr import Usd, UsdGeom, UsdShade, Vt
 
+from .. import Subdivision
 from ._problems import Problems
 from ._skinning import SkelFrame, Skin
 
@@ -66,6 +76,7 @@ class Part:
     uvs: Optional[np.ndarray] = None
     identity: bool = False  #: vertex i is point i: positions copy without a gather
     mesh: int = -1  #: snell's mesh index
+    cage: Optional[Subdivision] = None  #: a subdivision surface's scheme and tags: indices are then its faces
 
 
 @dataclass
@@ -119,6 +130,51 @@ def read_topology(mesh: UsdGeom.Mesh, time: Usd.TimeCode, problems: Problems) ->
         problems.warn(path, "has no faces of 3 or more vertices: skipped")
         return None
     return Topology(point_count, counts, face_points, triangles, face)
+
+
+_SCHEMES = ("catmullClark", "loop", "bilinear")
+
+
+def read_subdivision(mesh: UsdGeom.Mesh, topology: Topology, time: Usd.TimeCode, level: int,
+                     problems: Problems) -> Optional[Subdivision]:
+    """The mesh's subdivisionScheme and tags as a snell.Subdivision of the whole cage; None for a polygon mesh
+    (scheme none), a level of 0 (cages drawn as they are), or a cage that cannot be refined (said once)."""
+    scheme = str(mesh.GetSubdivisionSchemeAttr().Get(time) or "catmullClark")
+    if scheme == "none" or level <= 0:
+        return None
+    path = mesh.GetPath()
+    if scheme not in _SCHEMES:
+        problems.warn(path, f"subdivisionScheme '{scheme}' is not one USD defines: drawn as its cage")
+        return None
+    if (topology.face_counts < 3).any():
+        problems.warn(path, "a subdivision cage with faces of fewer than 3 vertices: drawn unrefined")
+        return None
+
+    def values(attribute: Usd.Attribute, kind) -> np.ndarray:
+        return np.asarray(attribute.Get(time) or [], kind)
+
+    cage = Subdivision(scheme=scheme, level=level, face_vertex_counts=topology.face_counts)
+    boundary = str(mesh.GetInterpolateBoundaryAttr().Get(time) or "edgeAndCorner")
+    face_varying = str(mesh.GetFaceVaryingLinearInterpolationAttr().Get(time) or "cornersPlus1")
+    for what, token, setter in (("interpolateBoundary", boundary, "interpolate_boundary"),
+                                ("faceVaryingLinearInterpolation", face_varying, "face_varying_linear_interpolation")):
+        try:
+            setattr(cage, setter, token)
+        except ValueError:
+            problems.warn(path, f"{what} '{token}' is not one USD defines: its fallback applies")
+    cage.smooth_triangles = str(mesh.GetTriangleSubdivisionRuleAttr().Get(time) or "") == "smooth"
+    cage.left_handed = mesh.GetOrientationAttr().Get(time) == UsdGeom.Tokens.leftHanded
+    cage.hole_indices = values(mesh.GetHoleIndicesAttr(), np.int64)
+    cage.crease_indices = values(mesh.GetCreaseIndicesAttr(), np.int64)
+    cage.crease_lengths = values(mesh.GetCreaseLengthsAttr(), np.int64)
+    cage.crease_sharpnesses = values(mesh.GetCreaseSharpnessesAttr(), np.float32)
+    cage.corner_indices = values(mesh.GetCornerIndicesAttr(), np.int64)
+    cage.corner_sharpnesses = values(mesh.GetCornerSharpnessesAttr(), np.float32)
+    for attribute in (mesh.GetCreaseIndicesAttr(), mesh.GetCornerIndicesAttr(), mesh.GetCreaseSharpnessesAttr()):
+        if attribute.ValueMightBeTimeVarying():
+            problems.warn(path, f"its {attribute.GetName()} are animated; snell keeps those of time code "
+                                f"{time.GetValue():g}")
+    return cage
 
 
 def read_primvar(prim: Usd.Prim, attribute: Usd.Attribute, interpolation: str, indices: Optional[np.ndarray],
@@ -186,11 +242,12 @@ class MeshSource:
     """One mesh prim read for snell (or one prototype's mesh, shared by instances): its parts and its pose."""
 
     def __init__(self, mesh: UsdGeom.Mesh, topology: Topology, normals: Optional[Primvar],
-                 skin: Optional[Skin], problems: Problems) -> None:
+                 skin: Optional[Skin], problems: Problems, cage: Optional[Subdivision] = None) -> None:
         self.mesh = mesh
         self.path = str(mesh.GetPath())
         self.topology = topology
-        self.normals = normals
+        self.cage = cage  #: the whole cage's subdivision, when the mesh is sent as one
+        self.normals = None if cage is not None else normals
         self.skin = skin
         self.problems = problems
         self.parts: list[Part] = []
@@ -207,8 +264,11 @@ class MeshSource:
     def add_part(self, name: str, triangles: np.ndarray, material: int, st: Optional[Primvar],
                  st_values: Optional[np.ndarray], corner_uvs: Optional[np.ndarray] = None) -> Part:
         """A part of these triangles, with its vertices split where its normals or st differ; with corner_uvs
-        ((T * 3, 2): a colour atlas's, _colours.py) every triangle has its own three vertices, with those UVs."""
+        ((T * 3, 2): a colour atlas's, _colours.py) every triangle has its own three vertices, with those UVs.
+        A cage's part is the whole cage, with the faces of the other parts as holes."""
         t = self.topology
+        if self.cage is not None:
+            return self._add_cage_part(name, triangles, material, st, st_values)
         corners = t.triangles[triangles]
         normal_per_point = self.normals is None or self.normals.point_ids is not None
         st_per_point = st is None or st.point_ids is not None
@@ -246,6 +306,32 @@ class MeshSource:
         self.parts.append(part)
         return part
 
+    def _add_cage_part(self, name: str, triangles: np.ndarray, material: int, st: Optional[Primvar],
+                       st_values: Optional[np.ndarray]) -> Part:
+        t = self.topology
+        cage = Subdivision(self.cage.scheme, self.cage.level, t.face_counts, self.cage.interpolate_boundary,
+                           self.cage.face_varying_linear_interpolation)
+        for tag in ("smooth_triangles", "left_handed", "crease_indices", "crease_lengths", "crease_sharpnesses",
+                    "corner_indices", "corner_sharpnesses"):
+            setattr(cage, tag, getattr(self.cage, tag))
+        drawn = np.zeros(t.face_count, bool)
+        drawn[t.triangle_face[triangles]] = True
+        holes = np.union1d(np.nonzero(~drawn)[0], np.asarray(self.cage.hole_indices, np.int64))
+        cage.hole_indices = holes[(holes >= 0) & (holes < t.face_count)]
+        part = Part(name, triangles, material, cage=cage, identity=True)
+        part.vertex_point = np.arange(t.point_count)
+        part.vertex_normal = part.vertex_point
+        part.indices = np.ascontiguousarray(t.face_points, np.uint32)
+        if st is not None:
+            per_point = st.point_ids is not None
+            uv = st_values[st.point_ids].astype(np.float64) if per_point else st_values.astype(np.float64)
+            uv[:, 1] = 1.0 - uv[:, 1]  # USD's st (0, 0) is the image's lower left; snell's v runs down
+            part.uvs = uv.astype(np.float32)
+            if not per_point:
+                cage.uv_indices = st.corner_ids
+        self.parts.append(part)
+        return part
+
     def _points(self, time: Usd.TimeCode) -> Vt.Vec3fArray:
         if self._rest is not None:
             return self._rest
@@ -269,6 +355,8 @@ class MeshSource:
             points, basis = self.skin.deform(rest, frame, linear_parts=self.skinned_normals)
         else:
             points = np.asarray(rest)
+        if self.cage is not None:  # snell makes a cage's normals
+            return Pose(points, np.zeros((1, 3), np.float32), unit=True)
         if self.normals is None:
             return Pose(points, smooth_normals(points, self.topology), unit=True)
         values = self.normals.attribute.Get(time)
@@ -281,6 +369,9 @@ class MeshSource:
             np.copyto(positions, pose.points)
         else:
             np.take(pose.points, part.vertex_point, axis=0, out=positions)
+        if part.cage is not None:
+            normals.fill(0.0)
+            return
         if pose.normal_basis is None and pose.unit:
             np.take(pose.normals, part.vertex_normal, axis=0, out=normals)
             return

@@ -26,7 +26,8 @@ from ._gprims import TYPES as GPRIM_TYPES
 from ._gprims import GprimMesh
 from ._lights import LightRecord, read_light, unsupported_light
 from ._materials import MaterialRecord, MaterialTable
-from ._meshes import MeshSource, Part, Pose, Topology, material_subsets, read_normals, read_primvar, read_topology
+from ._meshes import (MeshSource, Part, Pose, Topology, material_subsets, read_normals, read_primvar,
+                      read_subdivision, read_topology)
 from ._problems import Problems, StageError
 from ._skinning import SkelFrame, Skin
 
@@ -44,6 +45,7 @@ class ReadOptions:
     load_textures: bool = True
     strict: bool = False  #: a broken stage (mesh without points, missing texture) raises StageError
     missing_textures_fail: bool = False  #: a missing texture file is an error, not a warning with its fallback
+    subdivision_level: int = 2  #: levels a subdivision surface's cage is refined by on the GPU; 0: draw cages
 
 
 @dataclass
@@ -369,20 +371,25 @@ class StageContents:
     def _make_source(self, mesh: UsdGeom.Mesh, topology: Topology, skin: Optional[Skin], parts: list,
                      flip: bool, time: Usd.TimeCode) -> Optional[MeshSource]:
         prim = mesh.GetPrim()
-        normals = read_normals(mesh, topology, time, self.problems)
-        source = MeshSource(mesh, topology, normals, skin, self.problems)
+        cage = None
+        if prim.IsA(UsdGeom.Mesh):
+            cage = read_subdivision(mesh, topology, time, self.options.subdivision_level, self.problems)
+        normals = None if cage is not None else read_normals(mesh, topology, time, self.problems)
+        source = MeshSource(mesh, topology, normals, skin, self.problems, cage)
         pose = source.pose(time, SkelFrame(time))
         if pose is None:
             return None
         for bind, triangles, material in parts:
-            material, corner_uvs = self._own_colours(prim, topology, triangles, material, time)
+            material, corner_uvs = self._own_colours(prim, topology, triangles, material, time, cage is None)
             record = self.materials.records[material]
             st, st_values = None, None
             if record.st_primvar is not None and corner_uvs is None:
                 st, st_values = self._st(prim, record.st_primvar, topology, time, record.path)
             name = str(prim.GetPath()) if bind == prim else f"{prim.GetPath()} ({bind.GetName()})"
             part = source.add_part(name, triangles, material, st, st_values, corner_uvs)
-            if flip:
+            if flip and part.cage is not None:
+                part.cage.left_handed = not part.cage.left_handed
+            elif flip:
                 part.indices = np.ascontiguousarray(part.indices[:, [0, 2, 1]])
             if part.uvs is not None:
                 self._undrawn_wraps(prim, part, record)
@@ -391,9 +398,10 @@ class StageContents:
         return source
 
     def _own_colours(self, prim: Usd.Prim, topology: Topology, triangles: np.ndarray, material: int,
-                     time: Usd.TimeCode) -> tuple[int, Optional[np.ndarray]]:
+                     time: Usd.TimeCode, atlas: bool = True) -> tuple[int, Optional[np.ndarray]]:
         """A material whose colour or opacity reads the mesh's primvars, made the mesh's own (_colours.py): the
-        material's index for these triangles, and the UVs of their split corners where the colour varies."""
+        material's index for these triangles, and the UVs of their split corners where the colour varies
+        (without `atlas`, a subdivision cage's: their mean colour instead)."""
         record = self.materials.records[material]
         if record.colour_primvar is None and record.opacity_primvar is None:
             return material, None
@@ -403,6 +411,12 @@ class StageContents:
         if colours.corners is None:
             return self.materials.variant(material, tuple(colours.constant)), None
         named = [f"primvars:{p[0]}" for p in (record.colour_primvar, record.opacity_primvar) if p is not None]
+        if not atlas:
+            mean = colours.corners.reshape(-1, 4).mean(axis=0)
+            self.problems.warn(prim.GetPath(), f"{' and '.join(named)} vary over a subdivision surface, whose "
+                                               f"refined triangles carry no colour of their own: their mean "
+                                               f"{_fmt_colour(mean)} is used")
+            return self.materials.variant(material, tuple(mean)), None
         if record.slots:
             mean = colours.corners.reshape(-1, 4).mean(axis=0)
             self.problems.warn(prim.GetPath(), f"{' and '.join(named)} vary over the mesh, but {record.path}'s "
@@ -471,8 +485,8 @@ class StageContents:
                 normals = np.empty_like(positions)
                 source.write(part, pose, positions, normals)
                 part.mesh = len(meshes)
-                meshes.append(Mesh(positions, normals, part.indices, part.uvs, material=part.material,
-                                   name=part.name))
+                meshes.append(Mesh(positions, None if part.cage is not None else normals, part.indices, part.uvs,
+                                   material=part.material, name=part.name, subdivision=part.cage))
         return meshes
 
     def snell_instances(self) -> list[Instance]:

@@ -88,6 +88,16 @@ def _size(text: str) -> tuple[int, int]:
     return width, height
 
 
+def _level(text: str) -> int:
+    try:
+        level = int(text)
+    except ValueError:
+        level = -1
+    if not 0 <= level <= 8:
+        raise argparse.ArgumentTypeError(f"a subdivision level is 0 to 8, not '{text}'")
+    return level
+
+
 def _positive(text: str) -> float:
     try:
         value = float(text)
@@ -131,6 +141,9 @@ def _parser() -> argparse.ArgumentParser:
                          help="the geometry drawn beside 'default' ('guide' never is; default render)")
     reading.add_argument("--meters-per-unit", type=_positive, metavar="M",
                          help="the stage's unit in metres, instead of its metersPerUnit")
+    reading.add_argument("--subdiv-level", dest="subdivision_level", type=_level, default=2, metavar="N",
+                         help="levels a subdivision surface's cage is refined by, on the GPU (0 to 8; 0 draws the "
+                              "cages as they are; default 2)")
     reading.add_argument("--strict", action="store_true",
                          help="a missing texture file is an error (by default a warning, and the texture's "
                               "fallback is drawn, as usdview draws it)")
@@ -213,7 +226,8 @@ class _Console:
 
 def _info(args: argparse.Namespace, console: _Console) -> int:
     contents = read(args.stage, time=args.time, purpose=args.purpose, geometry_purpose=args.geometry_purpose,
-                    meters_per_unit=args.meters_per_unit, load_textures=False, missing_textures_fail=args.strict)
+                    meters_per_unit=args.meters_per_unit, load_textures=False, missing_textures_fail=args.strict,
+                    subdivision_level=args.subdivision_level)
     listing = _listing(contents)
     if args.json:
         print(json.dumps(listing, indent=2))
@@ -231,7 +245,10 @@ def _listing(contents: "StageContents") -> dict[str, Any]:
         entry = {
             "prim": source.path, "points": t.point_count, "faces": t.face_count,
             "triangles": int(sum(len(p.triangles) for p in source.parts)),
-            "normals": source.normals.interpolation if source.normals is not None else "computed (smooth)",
+            "normals": (source.normals.interpolation if source.normals is not None else
+                        "snell's, of the refined surface" if source.cage is not None else "computed (smooth)"),
+            "subdivision": ({"scheme": source.cage.scheme, "level": source.cage.level}
+                            if source.cage is not None else None),
             "skeleton": str(source.skin.skeleton_prim.GetPath()) if source.skin is not None else None,
             "deforms": source.deforms, "moves": any(p.varying for p in placements), "instances": len(placements),
             "parts": [{"name": part.name, "vertices": len(part.vertex_point), "triangles": len(part.triangles),
@@ -281,8 +298,10 @@ def _print_listing(i: dict[str, Any]) -> None:
         motion = [w for w, on in (("deforms", m["deforms"]), ("moves", m["moves"])) if on]
         skinned = f", skinned by {m['skeleton']}" if m["skeleton"] else ""
         shared = f", {m['instances']} instances" if m["instances"] > 1 else ""
-        print(f"  {m['prim']}: {m['points']} points, {m['faces']} faces ({m['triangles']} triangles), normals "
-              f"{m['normals']}{skinned}{shared}{', ' + ' and '.join(motion) if motion else ', static'}")
+        refined = (f", a {m['subdivision']['scheme']} subdivision surface refined {m['subdivision']['level']} "
+                   "levels on the GPU" if m["subdivision"] else "")
+        print(f"  {m['prim']}: {m['points']} points, {m['faces']} faces ({m['triangles']} triangles){refined}, "
+              f"normals {m['normals']}{skinned}{shared}{', ' + ' and '.join(motion) if motion else ', static'}")
         for part in m["parts"]:
             print(f"    {part['name']}: {part['vertices']} vertices, {part['triangles']} triangles, "
                   f"material {part['material']}")
@@ -355,7 +374,7 @@ def _render(args: argparse.Namespace, console: _Console) -> int:
             return EXIT_OK
     contents = read(args.stage, time=frames[0] if frames else None, purpose=args.purpose,
                     geometry_purpose=args.geometry_purpose, meters_per_unit=args.meters_per_unit,
-                    missing_textures_fail=args.strict)
+                    missing_textures_fail=args.strict, subdivision_level=args.subdivision_level)
     if contents.problems.errors:  # a stage broken where snell needs it: nothing is drawn
         raise StageError(f"{contents.path}: {contents.problems.errors[0]}".replace(": error: ", ": ", 1))
     if frames is None:
