@@ -224,6 +224,84 @@ TEST(Embedding, HostBufferMeshesFollowTheHostsDeformationLikeTheGltfMorphAndSkin
   std::filesystem::remove(glb);
 }
 
+// A subdivision cage (a cube, Catmull-Clark, level 2) and a plain floor, as
+// a host gives them: in its own buffers, or as vertex lists snell keeps.
+snell::HostScene cageAndFloor(const float* cage, const float* floor) {
+  snell::HostScene host;
+  host.name = "cage and floor";
+  snell::Material glass;
+  glass.transmission = 1.0f;
+  glass.ior = 1.5f;
+  host.materials = {glass, snell::Material{}};
+  snell::Mesh floorMesh;
+  floorMesh.name = "floor";
+  floorMesh.vertexCount = 4;
+  floorMesh.indices = {0, 1, 2, 0, 2, 3};
+  floorMesh.material = 1;
+  snell::Mesh cube;
+  cube.name = "cube";
+  cube.firstVertex = 4;
+  cube.vertexCount = 8;
+  cube.indices = {0, 4, 6, 2, 1, 3, 7, 5, 0, 1, 5, 4, 2, 6, 7, 3, 0, 2, 3, 1, 4, 5, 7, 6};
+  cube.material = 0;
+  cube.subdivision.scheme = snell::Subdivision::Scheme::CatmullClark;
+  cube.subdivision.faceVertexCounts.assign(6, 4);
+  cube.subdivision.normals = snell::Subdivision::Normals::Mesh;
+  host.meshes = {floorMesh, cube};
+  host.instances = {{0, snell::kIdentity}, {1, snell::kIdentity}};
+  if (cage) {  // kept: snell's own copy
+    host.vertices = {{std::vector<float>(floor, floor + 12), std::vector<float>(12, 0.0f)},
+                     {std::vector<float>(cage, cage + 24), {}}};
+    for (size_t v = 0; v < 4; ++v) host.vertices[0].normals[3 * v + 1] = 1.0f;
+  }
+  return host;
+}
+
+TEST(Embedding, ASubdivisionCageInTheHostsBuffersDrawsAsTheSameCageKeptBySnell) {
+  snell::Device device = snell::Device::create({.validation = true, .synchronizationValidation = true});
+  float cage[24], floor[12] = {-2, -0.8f, -2, 2, -0.8f, -2, 2, -0.8f, 2, -2, -0.8f, 2};
+  for (int i = 0; i < 8; ++i) {
+    for (int c = 0; c < 3; ++c) cage[3 * i + c] = (i >> c & 1) ? 0.5f : -0.5f;
+  }
+  HostBuffer positions(device, 12 * 3), normals(device, 12 * 3);
+  std::memcpy(positions.mapped, floor, sizeof floor);
+  std::memcpy(positions.mapped + 12, cage, sizeof cage);
+  for (int v = 0; v < 12; ++v) normals.mapped[3 * v] = 0, normals.mapped[3 * v + 1] = v < 4 ? 1.0f : 0.0f, normals.mapped[3 * v + 2] = 0;
+  snell::HostScene inBuffers = cageAndFloor(nullptr, nullptr);
+  inBuffers.positions = positions.buffer;
+  inBuffers.normals = normals.buffer;
+  inBuffers.vertexCapacity = 12;
+  snell::Scene hostScene = snell::Scene::fromHost(inBuffers), keptScene = snell::Scene::fromHost(cageAndFloor(cage, floor));
+  EXPECT_EQ(hostScene.vertexCount(1), 8u);
+  EXPECT_EQ(hostScene.drawnVertexCount(1), 98u);
+  snell::Renderer hostRenderer(device, hostScene), keptRenderer(device, keptScene);
+  snell::View view;
+  view.width = 80;
+  view.height = 60;
+  view.output = snell::View::Output::Trace;
+  view.camera.eye = {1.2f, 1.0f, 2.4f};
+  std::vector<float> before;
+  for (int frame = 0; frame < 2; ++frame) {
+    if (frame == 1) {  // the host squashes its cage; snell refines it again
+      for (int v = 0; v < 8; ++v) positions.mapped[12 + 3 * v + 1] *= 0.5f;
+      hostRenderer.markDirty(1);
+      snell::Vertices kept = keptRenderer.vertices(1);
+      ASSERT_EQ(kept.count, 8u);
+      for (int v = 0; v < 8; ++v) kept.positions[3 * v + 1] *= 0.5f;
+      keptRenderer.markDirty(1);
+    }
+    std::vector<float> fromHost = hostRenderer.read(view), fromKept = keptRenderer.read(view);
+    EXPECT_EQ(hostRenderer.lastFrame().meshesRefined, 1u) << "frame " << frame;  // the first: everything the host holds
+    io::ImageDifference d = compare(view, fromKept, fromHost);
+    EXPECT_LE(d.over1, 2u) << "frame " << frame << ": largest difference " << d.maximum << "/255";
+    if (frame == 0) before = fromHost;
+    if (frame == 1) {
+      EXPECT_GT(compare(view, before, fromHost).over1, 100u) << "the squashed cage drew as before";
+    }
+  }
+  EXPECT_EQ(device.validationMessages(), 0u);
+}
+
 TEST(Embedding, TheApisDefaultBackgroundIsTheRenderersDefault) {
   const snell::Vec3 api = snell::View{}.background;
   for (int c = 0; c < 3; ++c) EXPECT_EQ(api[size_t(c)], float(snell::scene::kDefaultBackground[c])) << "channel " << c;

@@ -175,10 +175,49 @@ void DeformPass::record(vk::Commands& commands, const scene::Pose& pose, vk::Upl
   commands.computeToTransfer();
 }
 
+void DeformPass::recordCopies(vk::Commands& commands, vk::UploadArena& arena, const vk::Buffer& fromPositions,
+                              const vk::Buffer& fromNormals, const vk::Buffer& toPositions,
+                              const vk::Buffer& toNormals, std::span<const VertexCopy> copies) {
+  std::vector<gpu::DeformJob> jobs;
+  uint32_t threads = 0;
+  for (const VertexCopy& c : copies) {
+    gpu::DeformJob job{};
+    job.threadBase = threads;
+    job.vertexCount = c.count;
+    job.restFirst = c.from;
+    job.outputFirst = c.to;
+    threads += c.count;
+    jobs.push_back(job);
+  }
+  if (jobs.empty()) return;
+  if (copyJobs_.size() < jobs.size() * sizeof(gpu::DeformJob)) {
+    copyJobs_ = vk::Buffer(context_, {jobs.size() * sizeof(gpu::DeformJob), kStorage, vk::MemoryDomain::Device,
+                                      "vertex copy jobs"});
+  }
+  arena.copy(commands, jobs, copyJobs_);
+  commands.transferToCompute();
+  gpu::DeformPush push{threads, static_cast<uint32_t>(jobs.size()), 0, 0};
+  program_->dispatchThreads(commands,
+                            {{gpu::kDeformBindingRestPositions, &fromPositions},
+                             {gpu::kDeformBindingRestNormals, &fromNormals},
+                             {gpu::kDeformBindingMorphDeltas, &morphDeltas_},
+                             {gpu::kDeformBindingMorphWeights, &weights_},
+                             {gpu::kDeformBindingJoints, &joints_},
+                             {gpu::kDeformBindingSkinWeights, &skinWeights_},
+                             {gpu::kDeformBindingJointMatrices, &jointMatrices_},
+                             {gpu::kDeformBindingPositions, &toPositions},
+                             {gpu::kDeformBindingNormals, &toNormals},
+                             {gpu::kDeformBindingJobs, &copyJobs_}},
+                            push, threads);
+  commands.computeToCompute();
+  commands.computeToGraphics();
+  commands.computeToTransfer();
+}
+
 uint64_t DeformPass::bytes() const {
   uint64_t total = 0;
   for (const vk::Buffer* b : {&restPositions_, &restNormals_, &morphDeltas_, &joints_, &skinWeights_, &jobs_, &weights_,
-                              &jointMatrices_, &ownPositions_, &ownNormals_}) {
+                              &jointMatrices_, &ownPositions_, &ownNormals_, &copyJobs_}) {
     total += b->size();
   }
   return total;

@@ -4,6 +4,7 @@
 // frame's items go in one dispatch, whatever their number; static shapes skip it.
 #pragma once
 
+#include "render/scene_gpu.h"
 #include "scene/evaluate.h"
 #include "scene/scene.h"
 #include "vk/buffer.h"
@@ -60,6 +61,14 @@ class DeformPass {
   void record(vk::Commands& commands, const scene::Pose& pose, vk::UploadArena& arena,
               std::span<const uint32_t> which = {});
 
+  /// Records copies of vertices between vertex buffers, in one dispatch of
+  /// the deform program with nothing to morph or skin: a host's buffers,
+  /// which may be storage buffers only (no transfer source), into the
+  /// scene's. A barrier as record()'s follows.
+  void recordCopies(vk::Commands& commands, vk::UploadArena& arena, const vk::Buffer& fromPositions,
+                    const vk::Buffer& fromNormals, const vk::Buffer& toPositions, const vk::Buffer& toNormals,
+                    std::span<const VertexCopy> copies);
+
   const std::vector<DeformOutput>& outputs() const { return outputs_; }
   /// GPU memory of the rest poses, morph deltas, skins and per-frame tables.
   uint64_t bytes() const;
@@ -76,6 +85,7 @@ class DeformPass {
   std::vector<DeformOutput> outputs_;
   vk::Buffer restPositions_, restNormals_, morphDeltas_, joints_, skinWeights_;
   vk::Buffer jobs_, weights_, jointMatrices_;  ///< device-local, rewritten per record
+  vk::Buffer copyJobs_;                        ///< recordCopies' jobs, grown as needed
   vk::Buffer ownPositions_, ownNormals_;       ///< when no slots were given
 };
 

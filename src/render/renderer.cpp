@@ -192,7 +192,7 @@ uint64_t Renderer::submit(const FrameRequest& request) {
   // the one before may still be reading.
   commands.fullBarrier();
   if (kept_) stats.shapesCopied = kept_->recordCopies(commands, scene_, *refine_);
-  recordHostCopies(commands, stats);
+  recordHostCopies(commands, slot);
   if (stats.shapesCopied) commands.fullBarrier();
   recordRefine(commands, slot);
   for (const vk::Image* image : targets_.takeNewImages()) {
@@ -267,16 +267,16 @@ void Renderer::planDeform(const scene::Pose& pose, Update& u, FrameStats& stats)
   }
 }
 
-void Renderer::recordHostCopies(vk::Commands& commands, FrameStats& stats) {
+void Renderer::recordHostCopies(vk::Commands& commands, Slot& slot) {
+  std::vector<VertexCopy> copies;
   for (size_t shape = 0; shape < hostDirty_.size(); ++shape) {
     if (!std::exchange(hostDirty_[shape], 0)) continue;
-    ++stats.shapesCopied;
-    if (sceneModel_.shapes[shape].subdivided()) {
-      refine_->markDirty(int(shape));  // read in place by the refine pass
-    } else {
-      scene_.copyHostShape(commands, sceneModel_, int(shape));
-    }
+    ++slot.result.stats.shapesCopied;
+    refine_->markDirty(int(shape));  // a subdivision surface's cage is read in place by the refine pass
+    for (const VertexCopy& c : scene_.hostCopies(sceneModel_, int(shape))) copies.push_back(c);
   }
+  deform_->recordCopies(commands, slot.arena, scene_.hostPositions, scene_.hostNormals, scene_.positions,
+                        scene_.normals, copies);
 }
 
 void Renderer::recordRefine(vk::Commands& commands, Slot& slot) {

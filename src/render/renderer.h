@@ -146,7 +146,7 @@ class Renderer {
                     Slot& slot);
   void planDeform(const scene::Pose& pose, Update& update, FrameStats& stats);
   /// A copied host scene's shapes marked dirty: their vertices copied from the host's buffers, or their cages refined.
-  void recordHostCopies(vk::Commands& commands, FrameStats& stats);
+  void recordHostCopies(vk::Commands& commands, Slot& slot);
   /// The refine pass over the subdivision surfaces whose cage moved.
   void recordRefine(vk::Commands& commands, Slot& slot);
   void recordUpdate(vk::Commands& commands, Slot& slot, const scene::Pose& pose, const Update& update);

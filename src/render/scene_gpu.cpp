@@ -399,16 +399,14 @@ std::vector<gpu::GpuLight> SceneGpu::packLights(const scene::Scene& scene, const
   return lights;
 }
 
-void SceneGpu::copyHostShape(vk::Commands& commands, const scene::Scene& scene, int shape) const {
+std::vector<VertexCopy> SceneGpu::hostCopies(const scene::Scene& scene, int shape) const {
+  std::vector<VertexCopy> copies;
   const scene::Shape& s = scene.shapes.at(size_t(shape));
-  if (!copiesHost() || !s.host || s.subdivided()) return;
+  if (!copiesHost() || !s.host || s.subdivided()) return copies;
   for (const GeometryRange& range : geometries) {
-    if (range.shape != shape) continue;
-    const VkDeviceSize from = VkDeviceSize(s.host->first) * 12, to = VkDeviceSize(range.firstVertex) * 12;
-    const VkDeviceSize bytes = VkDeviceSize(range.vertexCount) * 12;
-    commands.copyBuffer(hostPositions, positions, bytes, from, to);
-    commands.copyBuffer(hostNormals, normals, bytes, from, to);
+    if (range.shape == shape) copies.push_back({s.host->first, range.firstVertex, range.vertexCount});
   }
+  return copies;
 }
 
 void SceneGpu::appendBindings(std::vector<vk::BufferBinding>& out, const vk::Buffer& instances,
