@@ -12,7 +12,9 @@
 #include "scene/gltf_loader.h"
 #include "scene/procedural_eye.h"
 #include "scene/scene_summary.h"
+#include "scene/subdivision.h"
 #include "scene/view.h"
+#include "stress/stress.h"
 
 #include <algorithm>
 #include <chrono>
@@ -33,13 +35,16 @@ struct Options {
   bool viewport = false, noMask = false, noRefraction = false;
   bool orbit = false;  ///< the camera swings about the scene, 30 degrees either way over 240 frames
   uint32_t traceLanes = 0;  ///< RendererOptions::traceLanes (0: chosen per frame)
+  uint32_t subdivision = 0;  ///< > 0: a subdivided cornea refined this many levels, its cage moved each frame
   std::string json;
   double soak = 0;  ///< seconds; 0: measure --frames instead
 };
 
 // The refraction work these tables quote: the refraction passes, and the
 // deform that trees and trace both wait for.
-bool refractionPass(const std::string& name) { return name == pass::kDeform || render::isRefractionPass(name); }
+bool refractionPass(const std::string& name) {
+  return name == pass::kDeform || name == pass::kRefine || render::isRefractionPass(name);
+}
 
 // The view turned `degrees` about the vertical axis through `centre`: an orbit.
 scene::View orbited(scene::View v, const glm::dvec3& centre, double degrees) {
@@ -128,9 +133,15 @@ int runFrame(const Options& o) {
   if (!o.json.empty()) io::checkWritable(o.json);
   const uint32_t width = o.width, height = o.height, frames = o.frames, warmup = o.warmup;
   const bool viewport = o.viewport, masked = !o.noMask, refraction = !o.noRefraction;
-  scene::Scene scene = o.file.empty() ? scene::makeEye(o.eye) : scene::loadGltf(o.file);
+  scene::Scene scene = o.subdivision ? stress::subdividedCorneaScene(o.subdivision, true, 6, 24)
+                      : o.file.empty() ? scene::makeEye(o.eye)
+                                       : scene::loadGltf(o.file);
   std::string label = o.file;
-  if (o.file.empty()) {
+  if (o.subdivision) {
+    const scene::Refinement& r = *scene.shapes[0].refinement;
+    label = "a cornea of " + std::to_string(r.cageFaces) + " cage faces refined " + std::to_string(r.level) +
+            " levels to " + std::to_string(scene.shapes[0].vertexCount()) + " vertices, its cage moved every frame";
+  } else if (o.file.empty()) {
     label = o.eye.crowd ? "eye crowd of " + std::to_string(o.eye.crowd) : std::string("eye");
     label += " (resolution " + std::to_string(o.eye.resolution) + ")";
   }
@@ -150,17 +161,28 @@ int runFrame(const Options& o) {
   const glm::dvec3 centre = lo.x <= hi.x ? 0.5 * (lo + hi) : glm::dvec3(0.0);
   render::RendererOptions rendererOptions;
   rendererOptions.traceLanes = o.traceLanes;
+  rendererOptions.keepVertices = o.subdivision > 0;  // the host moves the cage
   render::Renderer renderer(*context, scene, firstPose, rendererOptions);
   std::map<std::string, std::vector<double>> times;
   std::vector<std::string> order;
   std::vector<double> totals, refractionTotals, walls;
   std::map<std::string, std::vector<double>> counters;
-  std::vector<std::string> counterOrder = {"items deformed", "trees refit", "trees rebuilt", "triangles refit",
-                                           "pixels traced", "trace lanes", "dispatches", "draws"};
+  std::vector<std::string> counterOrder = {"items deformed", "vertices refined", "trees refit", "trees rebuilt",
+                                           "triangles refit", "pixels traced", "trace lanes", "dispatches", "draws"};
   // One animated frame, rendered and waited for; its wall time in `wall`.
   auto renderFrame = [&](uint64_t f, double& wall) -> const render::FrameResult& {
     double t = std::fmod(double(f) / 24.0, duration);
     scene::Pose pose = scene::evaluate(scene, t);
+    if (o.subdivision) {  // the cornea breathes: its cage stretched along its axis, as a host's rig would move it
+      const std::vector<glm::vec3>& rest = scene.shapes[0].refinement->cageRest;
+      render::KeptVertices kept = renderer.keptVertices(0);
+      const float stretch = 1.0f + 0.1f * std::sin(float(f) * 0.25f);
+      for (size_t v = 0; v < rest.size(); ++v) {
+        kept.positions[3 * v] = rest[v].x, kept.positions[3 * v + 1] = rest[v].y;
+        kept.positions[3 * v + 2] = rest[v].z * stretch;
+      }
+      renderer.markDirty(0);
+    }
     render::ViewRequest view;
     scene::View camera = scene::resolveView(scene, pose, {});
     // A swing of 30 degrees either way, not a full circle: the side that faces the camera stays in view.
@@ -207,6 +229,7 @@ int runFrame(const Options& o) {
     walls.push_back(wall);
     const render::FrameStats& s = result.stats;
     counters["items deformed"].push_back(s.itemsDeformed);
+    counters["vertices refined"].push_back(s.verticesRefined);
     counters["trees refit"].push_back(s.treesRefit);
     counters["trees rebuilt"].push_back(s.treesBuilt);
     counters["triangles refit"].push_back(double(s.trianglesRefit));
@@ -293,6 +316,11 @@ void addBenchFrame(CLI::App& bench, Runner& run) {
   sub->add_flag("--no-refraction", o->noRefraction, "with --viewport: glass left out, nothing traced")
       ->needs(viewport)
       ->excludes(noMask);
+  sub->add_option("--subdiv", o->subdivision,
+                  "a cornea made as a Catmull-Clark cage of 216 faces (stress::corneaCage), refined LEVEL times on "
+                  "the GPU every frame its host moves the cage, instead of the eye")
+      ->type_name("LEVEL")
+      ->check(CLI::Range(1, 8));
   sub->add_option("--trace-lanes", o->traceLanes,
                   "with --viewport: lanes that trace each glass pixel, 1, 2, 4 or 8 (default: chosen each frame "
                   "from the last frame's count)")

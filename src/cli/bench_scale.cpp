@@ -4,6 +4,8 @@
 // against a CPU binned-SAH tree, next to the driver's own acceleration
 // structures built and updated over the same triangles in the same run.
 // With characters, on crowds of the procedural eye: the viewport frame's passes.
+// With refined vertices, on subdivision cages refined twice: the refine pass
+// and the refit after it, per frame the host moves the cage.
 #include "cli/commands.h"
 #include "io/image_file.h"
 #include "io/json.h"
@@ -16,6 +18,8 @@
 #include "render/renderer.h"
 #include "scene/evaluate.h"
 #include "scene/procedural_eye.h"
+#include "scene/scene_builder.h"
+#include "scene/subdivision.h"
 #include "scene/view.h"
 #include "vk/commands.h"
 #include "vk/upload_arena.h"
@@ -34,6 +38,7 @@ namespace {
 struct Options {
   // Lists as given: numbers in any notation (1e6), 0 skipping an entry.
   std::vector<double> triangles = {1e4, 1e5, 1e6, 1e7}, crowds = {1, 2, 10, 100, 1000};
+  std::vector<double> refined = {1e4, 1e5, 1e6};  ///< refined vertices of a subdivision cage
   uint32_t runs = 10, restructure = 0, width = 3840, height = 2160, frames = 20;
   uint64_t sahLimit = 1000000;
   render::BvhTuning tuning;
@@ -153,9 +158,71 @@ CrowdRow measureCrowd(vk::Context& context, uint32_t characters, uint32_t width,
   return row;
 }
 
+struct RefineRow {
+  uint32_t cageVertices = 0, cageFaces = 0, refinedVertices = 0;
+  double refineMs = 0, refitMs = 0;
+};
+
+// A wavy open grid of n x n quads as a Catmull-Clark cage refined twice
+// ((4n + 1)^2 vertices), moved by the host every frame: the refine pass and
+// the refit of its tree, medians over `frames`.
+RefineRow measureRefine(vk::Context& context, uint64_t target, uint32_t frames) {
+  const uint32_t n = std::max<uint32_t>(1, uint32_t(std::lround((std::sqrt(double(target)) - 1.0) / 4.0)));
+  scene::SubdivisionCage cage;
+  for (uint32_t y = 0; y <= n; ++y) {
+    for (uint32_t x = 0; x <= n; ++x) cage.positions.push_back({float(x) / float(n) - 0.5f, float(y) / float(n) - 0.5f, 0.0f});
+  }
+  for (uint32_t y = 0; y < n; ++y) {
+    for (uint32_t x = 0; x < n; ++x) {
+      uint32_t a = y * (n + 1) + x;
+      cage.faceVertexIndices.insert(cage.faceVertexIndices.end(), {a, a + 1, a + n + 2, a + n + 1});
+      cage.faceVertexCounts.push_back(4);
+    }
+  }
+  scene::Scene s;
+  s.source = "a refined grid";
+  scene::Shape shape;
+  std::vector<std::string> warnings;
+  scene::subdivide(cage, shape, "grid", warnings);
+  scene::addRootShape(s, std::move(shape));
+  scene::Pose pose = scene::evaluate(s, 0.0);
+  render::RendererOptions options;
+  options.keepVertices = true;
+  render::Renderer renderer(context, s, pose, options);
+  scene::ViewRequest look;
+  look.lookAt = scene::LookAt{{0.0, 0.0, 2.0}, {0.0, 0.0, 0.0}, {0.0, 1.0, 0.0}};
+  render::ViewRequest view;
+  view.settings = {16, 16, scene::resolveView(s, pose, look), glm::vec3(0.0f), 1};  // the trees, hardly a trace
+  render::FrameRequest request;
+  request.pose = &pose;
+  request.views.push_back(view);
+  renderer.wait(renderer.submit(request));  // the first build
+  std::vector<double> refine, refit;
+  for (uint32_t f = 0; f < frames + 3; ++f) {
+    render::KeptVertices kept = renderer.keptVertices(0);
+    for (uint32_t v = 0; v < kept.count; ++v) {
+      kept.positions[3 * v + 2] = 0.05f * std::sin(3.0f * kept.positions[3 * v] + 0.3f * float(f));
+    }
+    renderer.markDirty(0);
+    const render::FrameResult& result = renderer.wait(renderer.submit(request));
+    if (f < 3) continue;  // warm-up
+    for (const vk::PassTime& p : result.passes) {
+      if (p.name == pass::kRefine) refine.push_back(p.milliseconds);
+      if (p.name == pass::kBlasRefit || p.name == pass::kBlasBuild) refit.push_back(p.milliseconds);
+    }
+  }
+  RefineRow row;
+  row.cageVertices = uint32_t(cage.positions.size());
+  row.cageFaces = uint32_t(cage.faceVertexCounts.size());
+  row.refinedVertices = uint32_t(s.shapes[0].vertexCount());
+  row.refineMs = io::median(refine);
+  row.refitMs = io::median(refit);
+  return row;
+}
+
 int runScale(const Options& o) {
   if (!o.json.empty()) io::checkWritable(o.json);
-  const std::vector<uint64_t> sizes = counts(o.triangles), crowds = counts(o.crowds);
+  const std::vector<uint64_t> sizes = counts(o.triangles), crowds = counts(o.crowds), refineSizes = counts(o.refined);
   const uint32_t runs = o.runs, restructure = o.restructure, width = o.width, height = o.height, frames = o.frames;
   vk::ContextDesc desc = io::contextDescFromEnvironment();
   desc.driverAccelerationStructures = true;
@@ -303,6 +370,19 @@ int runScale(const Options& o) {
     std::fflush(stdout);
     crowdRows.push_back(std::move(r));
   }
+  std::vector<RefineRow> refineRows;
+  if (!refineSizes.empty()) {
+    std::printf("\nsubdivision cages refined twice, moved every frame (median GPU ms of %u frames)\n", frames);
+    std::printf("%12s %12s %14s %11s %14s %10s\n", "cage verts", "cage faces", "refined verts", "refine ms",
+                "M verts/s", "refit ms");
+  }
+  for (uint64_t target : refineSizes) {
+    RefineRow r = measureRefine(*context, target, frames);
+    std::printf("%12u %12u %14u %11.4f %14.1f %10.4f\n", r.cageVertices, r.cageFaces, r.refinedVertices, r.refineMs,
+                r.refineMs > 0 ? r.refinedVertices / r.refineMs / 1e3 : 0.0, r.refitMs);
+    std::fflush(stdout);
+    refineRows.push_back(r);
+  }
   if (!o.json.empty()) {
     io::Json j = io::reportHead("bench-scale", &context->facts());
     j["driver_acceleration_structures"] = driver;
@@ -344,6 +424,15 @@ int runScale(const Options& o) {
                                     {"passes_ms", std::move(passes)}});
     }
     j["crowds"] = std::move(crowdsJson);
+    io::Json refineJson = io::Json::array();
+    for (const RefineRow& r : refineRows) {
+      refineJson.push_back(io::Json{{"cage_vertices", r.cageVertices},
+                                    {"cage_faces", r.cageFaces},
+                                    {"refined_vertices", r.refinedVertices},
+                                    {"refine_ms", r.refineMs},
+                                    {"refit_ms", r.refitMs}});
+    }
+    j["subdivision"] = std::move(refineJson);
     io::writeJson(o.json, j);
   }
   return validationExitCode(*context);
@@ -368,7 +457,11 @@ void addBenchScale(CLI::App& bench, Runner& run) {
       "\n"
       "Characters: animated viewport frames of crowds of the procedural eye (two\n"
       "eyes a character): the median GPU time of each pass, the refraction work\n"
-      "(deform, trees, masked trace), pixels traced and the trace's rays per second.");
+      "(deform, trees, masked trace), pixels traced and the trace's rays per second.\n"
+      "\n"
+      "Refined vertices: a Catmull-Clark cage of n x n quads refined twice, which\n"
+      "the host moves every frame: the refine pass's GPU time, vertices refined per\n"
+      "second, and the refit of the refined surface's tree after it.");
   sub->footer(kHelpFooter);
   // Lists take one word each, so they never swallow the words after them.
   sub->add_option("--triangles", o->triangles, "sphere sizes (default 10000,100000,1000000,10000000; 0 skips)")
@@ -393,8 +486,13 @@ void addBenchScale(CLI::App& bench, Runner& run) {
       ->delimiter(',')
       ->allow_extra_args(false)
       ->check(countOrZero(10000));
+  sub->add_option("--refined", o->refined, "refined vertices per subdivision cage (default 10000,100000,1000000; 0 skips)")
+      ->type_name("N,N,...")
+      ->delimiter(',')
+      ->allow_extra_args(false)
+      ->check(countOrZero(4194304));
   addSize(*sub, "--size", o->width, o->height, "viewport size of the crowd frames (default 3840x2160)");
-  sub->add_option("--frames", o->frames, "animated frames measured per crowd (default 20, after 5)")
+  sub->add_option("--frames", o->frames, "animated frames measured per crowd and refined cage (default 20, after 5)")
       ->type_name("N")
       ->check(positiveCount());
   sub->add_option("--json", o->json, "write the results as JSON too")->type_name("FILE");

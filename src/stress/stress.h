@@ -58,9 +58,10 @@ scene::Scene morphingSphereScene(float ior);
 /// infinitely sharp crease) fitted so that its limit surface lies on the cap
 /// and the disc; refined `level` times (0: the cage itself, as a mesh).
 scene::SubdivisionCage corneaCage(uint32_t rings, uint32_t segments, float radius, float height, uint32_t level);
-/// corneaCage(3, 8, 1, 0.5, level) of IOR 1.376, refined, in front of the backdrop; without `creased`
-/// its rim is smooth (no crease: a rounded dome, convex all over, for rays aimed at its edges).
-scene::Scene subdividedCorneaScene(uint32_t level, bool creased = true);
+/// corneaCage(rings, segments, 1, 0.5) of IOR 1.376 (fitted at level 2 at most), refined `level` times, in
+/// front of the backdrop; without `creased` its rim is smooth (no crease: a rounded dome, convex all over,
+/// for rays aimed at its edges).
+scene::Scene subdividedCorneaScene(uint32_t level, bool creased = true, uint32_t rings = 3, uint32_t segments = 8);
 /// A sphere whose one morph target (at weight 1) sends a band of vertices to NaN
 /// and one to infinity; `poisonedTriangles` says how many triangles that spoils.
 scene::Scene nonFiniteMorphScene(uint32_t& poisonedTriangles);

@@ -5,6 +5,7 @@
 #include "scene/scene_builder.h"
 #include "stress/stress.h"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -380,13 +381,14 @@ scene::SubdivisionCage corneaCage(uint32_t rings, uint32_t segments, float radiu
   return cage;
 }
 
-scene::Scene subdividedCorneaScene(uint32_t level, bool creased) {
+scene::Scene subdividedCorneaScene(uint32_t level, bool creased, uint32_t rings, uint32_t segments) {
   scene::Scene s;
   s.source = "stress subdivided cornea";
   scene::Shape shape;
   shape.name = "cornea";
   std::vector<std::string> warnings;
-  scene::SubdivisionCage cage = corneaCage(3, 8, 1.0f, 0.5f, level);
+  scene::SubdivisionCage cage = corneaCage(rings, segments, 1.0f, 0.5f, std::min(level, 2u));
+  cage.level = level;
   if (!creased) cage.creaseIndices.clear(), cage.creaseLengths.clear(), cage.creaseSharpnesses.clear();
   scene::subdivide(cage, shape, "cornea", warnings);
   shape.material = scene::addMaterial(s, glass(1.376f));
