@@ -52,6 +52,33 @@ TEST_F(ComputeProgramTest, DispatchThreadsCoversExactlyTheCountGiven) {
   for (uint32_t i = count; i < count + 24; ++i) ASSERT_EQ(back[i], 0xDEADBEEFu) << "written past the count at " << i;
 }
 
+// The tests' context checks buffer bounds (tests/gpu_test.cpp): a shader
+// writing past a buffer's end, as a wrong count or index would make it, leaves
+// the memory beyond alone, so the mistake fails a test as wrong values rather
+// than corrupting the heap of a CPU driver's process. (lavapipe checks every
+// storage buffer access anyway; SwiftShader without the checks writes into its
+// heap, and this test dies there.)
+TEST_F(ComputeProgramTest, AWritePastTheBuffersEndIsDroppedUnderTheTestsBoundsChecks) {
+  ASSERT_FALSE(context().caps().robustAccess.empty()) << "the device offers no robustBufferAccess";
+  vk::ComputeProgram program(context(), fillDesc(64));
+  const uint32_t size = 64, stray = 4096;
+  const VkBufferUsageFlags usage =
+      VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT;
+  vk::Buffer out(context(), {size * 4, usage, vk::MemoryDomain::Device, "short fill"});
+  vk::Buffer beyond(context(), {stray * 4, usage, vk::MemoryDomain::Device, "beyond"});
+  vk::Commands commands(context(), "stray fill");
+  commands.begin();
+  commands.fillBuffer(beyond, 0xDEADBEEFu);
+  commands.transferToCompute();
+  program.dispatchThreads(commands, {{0, &out}}, FillPush{stray, 1}, stray);
+  commands.submitAndWait();
+  std::vector<uint32_t> inside(size), after(stray);
+  vk::download(context(), out, inside.data(), size * 4);
+  vk::download(context(), beyond, after.data(), stray * 4);
+  for (uint32_t i = 0; i < size; ++i) ASSERT_EQ(inside[i], 1 + i) << "at " << i;
+  for (uint32_t i = 0; i < stray; ++i) ASSERT_EQ(after[i], 0xDEADBEEFu) << "the next buffer was written at " << i;
+}
+
 TEST_F(ComputeProgramTest, DispatchBeyondTheXLimitIsSplitOverY) {
   vk::ComputeProgram program(context(), fillDesc(8));
   uint64_t limit = context().caps().maxComputeWorkgroupCount[0];

@@ -11,6 +11,7 @@ vk::Context& gpuContext() {
     desc.applicationName = "snell tests";
     desc.validation = true;
     desc.synchronizationValidation = true;
+    desc.robustBufferAccess = true;  // a shader's stray write fails a test, not the heap
     return vk::Context::create(desc);
   }();
   return *context;

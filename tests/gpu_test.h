@@ -14,6 +14,11 @@ namespace snell::test {
 /// The shared context; created on first use, with validation required.
 vk::Context& gpuContext();
 
+/// Whether the tests run on SwiftShader (VK_DRIVER_FILES naming its ICD: the
+/// test command's SwiftShader.* tests), whose rasteriser decides which face a
+/// pixel exactly on a silhouette shows by rules of its own.
+inline bool onSwiftShader() { return gpuContext().facts().driverId == VK_DRIVER_ID_GOOGLE_SWIFTSHADER; }
+
 class GpuTest : public ::testing::Test {
  protected:
   void SetUp() override;

@@ -36,15 +36,19 @@ void main() {
                          texcoords[i.z]);
   outMaterial = inst.material;
   outPosition = world;
-  outTangent = outBitangent = vec3(0.0);
+  // Every output is written once, outside any branch: Mesa 22.3's llvmpipe
+  // at 128-bit vectors (4-lane subgroups: CPUs without AVX, and 64-bit ARM)
+  // corrupts the heap drawing any mesh when a vertex shader writes an output
+  // inside a branch it keeps (this frame was `if (map && tangentFrame(...))`).
+  // The Lavapipe4Lanes tests draw the viewport so.
   GpuTextureSlot normalMap = materials[inst.material].normal;
   vec3 t, b;
-  if (normalMap.texture != kNoTexture &&
-      tangentFrame(vectorToWorld(inst, p1 - p0), vectorToWorld(inst, p2 - p0), textureUv(normalMap, texcoords[i.x]),
-                   textureUv(normalMap, texcoords[i.y]), textureUv(normalMap, texcoords[i.z]), t, b)) {
-    outTangent = t;
-    outBitangent = b;
-  }
+  bool framed = tangentFrame(vectorToWorld(inst, p1 - p0), vectorToWorld(inst, p2 - p0),
+                             textureUv(normalMap, texcoords[i.x]), textureUv(normalMap, texcoords[i.y]),
+                             textureUv(normalMap, texcoords[i.z]), t, b);
+  bool mapped = framed && normalMap.texture != kNoTexture;
+  outTangent = mapped ? t : vec3(0.0);
+  outBitangent = mapped ? b : vec3(0.0);
 
   // precise: the depth pre-pass and the shading pass (EQUAL) must agree on
   // every depth bit, so no compiler may fuse this arithmetic differently in

@@ -101,6 +101,7 @@ vk::ContextDesc contextDesc(const DeviceOptions& options) {
   desc.environment = io::deviceEnvironment();  // SNELL_DEVICE, or the GPUs a launcher gave the process
   desc.validation = options.validation;
   desc.synchronizationValidation = options.synchronizationValidation;
+  desc.robustBufferAccess = options.validation;
   desc.driverRayTracing = options.driverRayTracing;
   if (options.interop) {
     desc.deviceExtensions = {VK_KHR_EXTERNAL_MEMORY_FD_EXTENSION_NAME};

@@ -32,6 +32,7 @@ vk::ContextDesc contextDescFromEnvironment() {
   const char* validation = std::getenv("SNELL_VALIDATION");
   desc.validation = validation && std::string(validation) == "1";
   desc.synchronizationValidation = desc.validation;  // as the tests' own context has it
+  desc.robustBufferAccess = desc.validation;
   return desc;
 }
 

@@ -70,17 +70,19 @@ MipLevel nextMipLevel(const MipLevel& above, bool colour) {
   for (uint32_t y = 0; y < below.height; ++y) {
     for (uint32_t x = 0; x < below.width; ++x) {
       for (int c = 0; c < 4; ++c) {
-        double sum = 0.0;
+        double linearSum = 0.0;
+        uint32_t byteSum = 0;
         for (uint32_t j = 0; j < 2; ++j) {
           for (uint32_t i = 0; i < 2; ++i) {
             uint32_t sx = std::min(2 * x + i, above.width - 1), sy = std::min(2 * y + j, above.height - 1);
             uint8_t v = above.rgba[(size_t(sy) * above.width + sx) * 4 + size_t(c)];
-            sum += colour && c < 3 ? decode[v] : v / 255.0;
+            linearSum += decode[v];
+            byteSum += v;
           }
         }
-        double mean = sum / 4.0;
+        // Data bytes averaged in integers, half up, as texture_mips.comp does (its comment says why).
         below.rgba[(size_t(y) * below.width + x) * 4 + size_t(c)] =
-            colour && c < 3 ? encodeSrgb(mean) : uint8_t(std::lround(std::clamp(mean, 0.0, 1.0) * 255.0));
+            colour && c < 3 ? encodeSrgb(linearSum / 4.0) : uint8_t((byteSum + 2) / 4);
       }
     }
   }

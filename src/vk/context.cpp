@@ -301,6 +301,27 @@ std::unique_ptr<Context> Context::create(const ContextDesc& desc) {
     }
   }
 
+  // Bounds checks, for the tests: robustness2 drops a write past the bound
+  // range (robustBufferAccess alone may land it anywhere inside the buffer).
+  VkPhysicalDeviceRobustness2FeaturesEXT robustness2{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_ROBUSTNESS_2_FEATURES_EXT};
+  std::string robustAccess;
+  if (desc.robustBufferAccess) {
+    VkPhysicalDeviceRobustness2FeaturesEXT offered2{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_ROBUSTNESS_2_FEATURES_EXT};
+    VkPhysicalDeviceFeatures2 probe{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2, &offered2};
+    if (has(VK_EXT_ROBUSTNESS_2_EXTENSION_NAME)) vkGetPhysicalDeviceFeatures2(physical, &probe);
+    if (supported.features.robustBufferAccess) {
+      features.features.robustBufferAccess = VK_TRUE;  // robustBufferAccess2 requires it
+      robustAccess = "robustBufferAccess";
+      if (offered2.robustBufferAccess2) {
+        extensions.push_back(VK_EXT_ROBUSTNESS_2_EXTENSION_NAME);
+        robustness2.robustBufferAccess2 = VK_TRUE;
+        robustness2.pNext = features13.pNext;
+        features13.pNext = &robustness2;
+        robustAccess = "robustBufferAccess2";
+      }
+    }
+  }
+
   VkDeviceCreateInfo info{VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO};
   info.pNext = &features;
   info.queueCreateInfoCount = 1;
@@ -318,6 +339,7 @@ std::unique_ptr<Context> Context::create(const ContextDesc& desc) {
   c.caps_.driverAccelerationStructures = driverAcceleration;
   c.caps_.driverRayTracing = driverRayTracing;
   c.caps_.bufferDeviceAddress = driverAcceleration;
+  c.caps_.robustAccess = robustAccess;
   return context;
 }
 

@@ -59,6 +59,12 @@ struct ContextDesc {
   /// With driverAccelerationStructures: the driver's ray tracing pipelines too
   /// (VK_KHR_ray_tracing_pipeline), for the driver-rt method; DeviceCaps::driverRayTracing.
   bool driverRayTracing = false;
+  /// Bounds-checked buffer access, a debugging aid (the tests and SNELL_VALIDATION=1
+  /// turn it on): robustBufferAccess2 (VK_EXT_robustness2) where offered, else
+  /// robustBufferAccess. A shader's write past a buffer's end is then dropped, so
+  /// it shows as wrong pixels in a test instead of damaging whatever memory lies
+  /// beyond (on a CPU driver, the process's heap). DeviceCaps::robustAccess says which.
+  bool robustBufferAccess = false;
 };
 
 /// Handles a host application created; snell uses them and never destroys them.
@@ -100,6 +106,9 @@ struct DeviceCaps {
   bool driverRayTracing = false;
   /// Buffers may ask for device addresses (bufferDeviceAddress is enabled).
   bool bufferDeviceAddress = false;
+  /// The bounds checks ContextDesc::robustBufferAccess enabled: "robustBufferAccess2",
+  /// "robustBufferAccess", or "" (none asked for or none offered).
+  std::string robustAccess;
 };
 
 /// Every devices' facts and the verdict on each, without creating a device.
