@@ -116,8 +116,9 @@ scene::Scene prismScene() {
   for (int v : {0, 1, 2, 3, 5, 4}) p.push_back(corners[size_t(v)]);
   idx.insert(idx.end(), {base, base + 1, base + 2, base + 3, base + 4, base + 5});  // caps
   addFlatShape(s, p, idx, 0);
-  // Walls: red behind the camera's left (where reflected rays go), blue far behind, green floor.
-  addFlatShape(s, {{-6, -3, -1}, {-6, -3, 5}, {-6, 3, 5}, {-6, 3, -1}}, {0, 1, 2, 0, 2, 3}, 1);
+  // Walls, each facing the prism: red behind the camera's left (where reflected rays go), blue far behind,
+  // green floor.
+  addFlatShape(s, {{-6, -3, -1}, {-6, -3, 5}, {-6, 3, 5}, {-6, 3, -1}}, {0, 2, 1, 0, 3, 2}, 1);  // faces +x
   addFlatShape(s, {{-6, -3, 8}, {6, -3, 8}, {6, 3, 8}, {-6, 3, 8}}, {0, 2, 1, 0, 3, 2}, 2);
   addFlatShape(s, {{-6, -3, -8}, {6, -3, -8}, {6, -3, 8}, {-6, -3, 8}}, {0, 2, 1, 0, 3, 2}, 3);
   scene::Light light;

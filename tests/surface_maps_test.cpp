@@ -215,14 +215,19 @@ scene::Scene withUnusedFeatures(scene::Scene s) {
 class SurfaceMaps : public GpuTest {};
 
 TEST_F(SurfaceMaps, ASceneTracesWithOnlyTheSurfaceFeaturesItsMaterialsUse) {
-  EXPECT_EQ(surfaceOf(context(), rippledGlass(false)), gpu::kSurfaceTextures | gpu::kSurfaceEmissiveMaps);
+  // Their opaque faces are single-sided, glTF's default: the walk culls backs.
+  const uint32_t oneSided = gpu::kSurfaceSingleSided;
+  EXPECT_EQ(surfaceOf(context(), rippledGlass(false)), gpu::kSurfaceTextures | gpu::kSurfaceEmissiveMaps | oneSided);
   EXPECT_EQ(surfaceOf(context(), rippledGlass(true)),
-            gpu::kSurfaceTextures | gpu::kSurfaceEmissiveMaps | gpu::kSurfaceNormalMaps);
+            gpu::kSurfaceTextures | gpu::kSurfaceEmissiveMaps | gpu::kSurfaceNormalMaps | oneSided);
   EXPECT_EQ(surfaceOf(context(), seeThroughCard(scene::AlphaMode::Mask, 1.0f)),
-            gpu::kSurfaceTextures | gpu::kSurfaceEmissiveMaps | gpu::kSurfaceAlpha);
+            gpu::kSurfaceTextures | gpu::kSurfaceEmissiveMaps | gpu::kSurfaceAlpha | oneSided);
   scene::Scene plain = rippledGlass(false);
   plain.materials[0].emissiveTexture = {};
-  EXPECT_EQ(surfaceOf(context(), plain), 0u);
+  EXPECT_EQ(surfaceOf(context(), plain), oneSided);
+  scene::Scene twoSided = plain;
+  for (scene::Material& m : twoSided.materials) m.doubleSided = true;
+  EXPECT_EQ(surfaceOf(context(), twoSided), 0u);
   EXPECT_EQ(surfaceOf(context(), withUnusedFeatures(plain)), gpu::kSurfaceAll);
 }
 

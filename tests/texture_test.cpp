@@ -238,6 +238,7 @@ FloorShot checkerFloor(bool slab) {
   floor.baseColorFactor = {0, 0, 0, 1};
   floor.emissiveFactor = glm::vec3(1.0f);
   floor.emissiveTexture.texture = 0;
+  floor.doubleSided = true;  // laid down below, it faces the ground
   s.materials.push_back(floor);
   // addFlatShape's uv is (x / 2 + 0.5, y / 2 + 0.5) before the node moves
   // it: a quad in the xy plane, laid down onto y = 0, one repeat per 2 units.

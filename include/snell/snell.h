@@ -150,7 +150,7 @@ struct Material {
   float thickness = 0;    ///< 0: thin-walled
   Vec3 attenuationColor{1, 1, 1};
   float attenuationDistance = INFINITY;
-  bool doubleSided = false;
+  bool doubleSided = false;  ///< false: opaque faces seen from behind are not drawn (glTF's rule; glass always is)
   Vec3 emissive{0, 0, 0};  ///< linear RGB the faces give off
   int emissiveTexture = -1;  ///< sRGB, multiplies `emissive`; -1: none
   TextureTransform emissiveTransform;

@@ -92,7 +92,10 @@ float enterBox(ShearedRay r, vec3 lo, vec3 hi, float tMax) {
 }
 
 // Watertight ray/triangle test; returns t (or kInf) and the barycentrics.
-float intersectTriangle(ShearedRay r, uint tri, float tMax, out vec3 bary) {
+// det > 0 where the ray meets the triangle's front (counter-clockwise seen
+// from the ray's origin): with cullSign 1 a back is missed, with -1 a front
+// (a mirrored instance's world back), with 0 neither.
+float intersectTriangle(ShearedRay r, uint tri, float tMax, float cullSign, out vec3 bary) {
   precise vec3 A = vertexAt(indices[3u * tri]) - r.origin;
   precise vec3 B = vertexAt(indices[3u * tri + 1u]) - r.origin;
   precise vec3 C = vertexAt(indices[3u * tri + 2u]) - r.origin;
@@ -108,7 +111,7 @@ float intersectTriangle(ShearedRay r, uint tri, float tMax, out vec3 bary) {
   precise float W = Bx * Ay - By * Ax;
   if ((U < 0.0 || V < 0.0 || W < 0.0) && (U > 0.0 || V > 0.0 || W > 0.0)) return kInf;
   float det = U + V + W;
-  if (det == 0.0) return kInf;
+  if (det == 0.0 || det * cullSign < 0.0) return kInf;
   float T = U * r.shear.z * A[kz] + V * r.shear.z * B[kz] + W * r.shear.z * C[kz];
   if (det < 0.0 ? (T >= 0.0 || T < tMax * det) : (T <= 0.0 || T > tMax * det)) return kInf;
   float inv = 1.0 / det;
@@ -163,14 +166,23 @@ ShearedRay objectRay(uint instance, vec3 origin, vec3 dir) {
   return shearRay(o, d);
 }
 
+// Which faces of the instance the ray passes (intersectTriangle's cullSign):
+// the backs of a single-sided material's, where the scene has one, on every
+// ray of the path: glass of IOR 1 must show what no glass shows.
+float cullSignOf(uint instance) {
+  if (!surfaceUses(kSurfaceSingleSided)) return 0.0;
+  uint flags = instances[instance].flags;
+  return (flags & kInstanceCullBackFaces) == 0u ? 0.0 : (flags & kInstanceMirrored) != 0u ? -1.0 : 1.0;
+}
+
 // A triangle of the instance's tree: the closest hit so far if nearer.
 // tMax: hit.t, or less where another lane of the pixel has a nearer hit.
 void testTriangle(ShearedRay r, uint instance, uint tri, uint skipPrim, uint first, uint end, float tMin, float tMax,
-                  inout Hit hit) {
+                  float cullSign, inout Hit hit) {
   if (tri == skipPrim || tri < first || tri >= end) return;  // skipPrim: the face this ray leaves
   ++triangleTests;
   vec3 bary;
-  float t = intersectTriangle(r, tri, tMax, bary);
+  float t = intersectTriangle(r, tri, tMax, cullSign, bary);
   if (t < tMax && t > tMin) hit = Hit(t, instance, tri, bary);
 }
 
@@ -186,6 +198,7 @@ void traverseBlas(uint instance, vec3 origin, vec3 dir, uint skipPrim, float tMi
   if (group.root == kBvhNone) return;
   uint end = group.first + group.count;
   ShearedRay r = objectRay(instance, origin, dir);
+  const float cullSign = cullSignOf(instance);
   uint sp = base;
   uint ref = group.root;
   bool haveNode = (ref & kBvhLeafBit) == 0u;
@@ -194,7 +207,7 @@ void traverseBlas(uint instance, vec3 origin, vec3 dir, uint skipPrim, float tMi
   for (;;) {
     countStep();
     for (uint k = 0u; k < leafCount; ++k) {
-      testTriangle(r, instance, leaves[k], skipPrim, group.first, end, tMin, hit.t, hit);
+      testTriangle(r, instance, leaves[k], skipPrim, group.first, end, tMin, hit.t, cullSign, hit);
     }
     leafCount = 0u;
     // The budget before anything else: a walk that always goes on to a nearer
@@ -356,7 +369,8 @@ Hit traverseLanes(vec3 origin, vec3 dir, uint skipInstance, uint skipPrim, float
           }
         }
         for (uint k = 0u; k < leafCount; ++k) {
-          testTriangle(r, nodeInst, leaves[k], skip, group.first, end, tMin, min(hit.t, nearest), hit);
+          testTriangle(r, nodeInst, leaves[k], skip, group.first, end, tMin, min(hit.t, nearest), cullSignOf(nodeInst),
+                       hit);
         }
       }
     }

@@ -63,5 +63,13 @@ void main() {
   precise float x = (dot(rel, pc.right.xyz) - pc.shiftX * w) * pc.right.w;
   precise float y = -(dot(rel, pc.up.xyz) - pc.shiftY * w) * pc.up.w;  // Vulkan's y points down the image, as row 0 is the top
   precise float depth = ortho ? clamp((pc.eye.w - z) / (pc.eye.w - pc.forward.w), 0.0, 1.0) : pc.forward.w;
-  gl_Position = vec4(x, y, depth, w);  // perspective: depth = near / z, reverse Z, far plane at infinity
+  // A single-sided face seen from behind is not drawn, as the trace passes it
+  // (trace.comp: cullSignOf): every corner of it lands outside the view.
+  vec3 winding = cross(vectorToWorld(inst, p1 - p0), vectorToWorld(inst, p2 - p0));  // the world's front
+  vec3 corner0 = vec3(dot(inst.objectToWorld[0], vec4(p0, 1.0)), dot(inst.objectToWorld[1], vec4(p0, 1.0)),
+                      dot(inst.objectToWorld[2], vec4(p0, 1.0)));
+  bool singleSided = (inst.flags & kInstanceCullBackFaces) != 0u;
+  bool fromBehind = dot(winding, ortho ? pc.forward.xyz : corner0 - pc.eye.xyz) > 0.0;
+  bool culled = singleSided && fromBehind;
+  gl_Position = culled ? vec4(2.0, 2.0, 0.5, 1.0) : vec4(x, y, depth, w);  // perspective: depth = near / z, reverse Z
 }

@@ -149,9 +149,17 @@ struct GpuInstance {
   vec4 worldToObject[3];  // 48: rows of its inverse
   uint geometry;          // 4: the bottom-level group
   uint material;          // 4: index into the material table
-  uint pad0;              // 4
+  uint flags;             // 4: kInstance*
   uint pad1;              // 4
 };
+
+// GpuInstance::flags
+// Its faces are seen from their front only (a single-sided material, glTF's
+// and USD's doubleSided false, that is not glass): rays pass their backs.
+SNELL_CONST kInstanceCullBackFaces = 1u;
+// Its transform mirrors (a negative determinant): its faces' fronts in the
+// world are their backs in its own space, where the trace tests them.
+SNELL_CONST kInstanceMirrored = 2u;
 
 SNELL_GPU_END
 #endif

@@ -271,7 +271,8 @@ SNELL_CONST kSurfaceEmissiveMaps = 2u;  // some material has an emissive texture
 SNELL_CONST kSurfaceIorMaps = 4u;       // some material has an IOR texture
 SNELL_CONST kSurfaceNormalMaps = 8u;    // some material has a normal map
 SNELL_CONST kSurfaceAlpha = 16u;        // some material masks or blends by alpha
-SNELL_CONST kSurfaceAll = 31u;
+SNELL_CONST kSurfaceSingleSided = 32u;  // some opaque material is single-sided: its back faces are culled
+SNELL_CONST kSurfaceAll = 63u;
 // Nodes one ray segment may visit before it gives up: a corrupted tree ends here.
 SNELL_CONST kTraceMaxVisits = 1u << 20;
 

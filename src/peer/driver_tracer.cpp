@@ -83,7 +83,15 @@ void DriverTracer::recordUpdate(vk::Commands& commands, vk::UploadArena& arena,
     t.instanceCustomIndex = static_cast<uint32_t>(i) & 0xffffffu;  // 24 bits: capped below
     t.mask = 0xff;
     t.instanceShaderBindingTableRecordOffset = 0;
-    t.flags = VK_GEOMETRY_INSTANCE_TRIANGLE_FACING_CULL_DISABLE_BIT_KHR;
+    // snell's single-sided faces (GpuInstance::flags) are culled as the trace
+    // culls them: the driver decides facing in the instance's own space, where
+    // its default front is clockwise, and glTF's counter-clockwise; a
+    // mirroring transform turns that round again.
+    const uint32_t f = instances[i].flags;
+    const bool counterClockwise = (f & gpu::kInstanceMirrored) == 0;
+    const uint32_t noCulling = VK_GEOMETRY_INSTANCE_TRIANGLE_FACING_CULL_DISABLE_BIT_KHR;
+    const uint32_t frontCounterClockwise = VK_GEOMETRY_INSTANCE_TRIANGLE_FRONT_COUNTERCLOCKWISE_BIT_KHR;
+    t.flags = (f & gpu::kInstanceCullBackFaces) == 0 ? noCulling : counterClockwise ? frontCounterClockwise : 0u;
     t.accelerationStructureReference = blas_.at(instances[i].geometry)->address();
   }
   commands.beginPass(pass::kDriverTlas);

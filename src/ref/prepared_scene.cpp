@@ -161,6 +161,10 @@ void PreparedScene::addItem(const scene::Scene& scene, const scene::DrawItem& it
     d.item = itemIndex;
     d.primitive = int32_t(t);
     d.material = shape.material;
+    // glTF's and USD's doubleSided false (the default material's too); glass is seen from both sides.
+    const bool known = shape.material >= 0 && size_t(shape.material) < scene.materials.size();
+    const scene::Material& m = known ? scene.materials[size_t(shape.material)] : scene::Material{};
+    d.singleSided = !m.doubleSided && !m.refractive();
     data_.push_back(d);
   }
 }
@@ -224,7 +228,7 @@ void PreparedScene::buildBvh() {
   corners_.resize(count);
   for (uint32_t i = 0; i < count; ++i) {
     sorted[i] = data_[order[i]];
-    corners_[i] = {{sorted[i].v[0], sorted[i].v[1], sorted[i].v[2]}};
+    corners_[i] = {{sorted[i].v[0], sorted[i].v[1], sorted[i].v[2]}, sorted[i].singleSided};
   }
   data_ = std::move(sorted);
 }
@@ -295,7 +299,8 @@ Hit PreparedScene::intersect(const glm::dvec3& origin, const glm::dvec3& directi
         const double u = cx * by - cy * bx, v = ax * cy - ay * cx, w = bx * ay - by * ax;
         if ((u < 0.0 || v < 0.0 || w < 0.0) && (u > 0.0 || v > 0.0 || w > 0.0)) continue;
         const double det = u + v + w;
-        if (det == 0.0) continue;
+        // det > 0: the ray meets the triangle's front (counter-clockwise seen from the ray's origin).
+        if (det == 0.0 || (tri.singleSided && det < 0.0)) continue;
         const double t = (u * sz * a[kz] + v * sz * b[kz] + w * sz * c[kz]) / det;
         if (!(t > tMin)) continue;
         const double b1 = v / det, b2 = w / det;

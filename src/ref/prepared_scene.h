@@ -37,12 +37,14 @@ struct TriangleData {
   double curvature = 0.0;          // signed: the mean turn of the unit vertex normals along its edges, > 0 bulging to ng's side
   int32_t item = -1, primitive = -1;
   int material = -1;
+  bool singleSided = false;  // its back is never hit: a single-sided material that is not glass
 };
 
 // The corners exactly as every triangle sharing them sees them: the
 // watertight test needs a shared vertex to be bit-for-bit the same in each.
 struct Corners {
   glm::dvec3 v[3];
+  bool singleSided = false;  // rays pass its back (TriangleData::singleSided)
 };
 
 struct BvhNode {
@@ -64,7 +66,8 @@ class PreparedScene {
 
   /// The closest triangle with tMin < t, other than `excluded`. Equal
   /// distances go to the triangle stored first, so that the answer does not
-  /// depend on the traversal order (nor on the thread count).
+  /// depend on the traversal order (nor on the thread count). Single-sided
+  /// faces seen from behind are passed, by every ray.
   Hit intersect(const glm::dvec3& origin, const glm::dvec3& direction, double tMin, uint32_t excluded) const;
 
   const TriangleData& triangle(uint32_t i) const { return data_[i]; }

@@ -276,6 +276,10 @@ SceneGpu uploadScene(vk::Context& context, const scene::Scene& scene, const scen
     const scene::Material* material = hasMaterial ? &scene.materials[size_t(shape.material)] : nullptr;
     gpu.itemRefractive.push_back(material && material->refractive() ? 1 : 0);
     gpu.itemSeeThrough.push_back(material && (material->refractive() || material->alphaMode != scene::AlphaMode::Opaque));
+    // The default material is single-sided too, as glTF's is.
+    const scene::Material& drawn = material ? *material : scene::Material{};
+    gpu.itemSingleSided.push_back(!drawn.doubleSided && !drawn.refractive());
+    if (gpu.itemSingleSided.back()) gpu.surface |= gpu::kSurfaceSingleSided;
   }
   if (host && !hostCopies) vertices = host->vertexCapacity;  // the host's numbering, gaps and all
   gpu.vertexCount = static_cast<uint32_t>(vertices);
@@ -313,7 +317,7 @@ SceneGpu uploadScene(vk::Context& context, const scene::Scene& scene, const scen
   std::vector<gpu::GpuMaterial> materials;
   for (const scene::Material& m : scene.materials) materials.push_back(packMaterial(m, scene));
   materials.push_back(packMaterial(scene::Material{}, scene));  // for shapes without one
-  gpu.surface = surfaceOf(materials);
+  gpu.surface |= surfaceOf(materials);
 
   TexturePlacement place = placeTextures(context, scene);
   std::vector<gpu::GpuTexture> textures;
@@ -373,6 +377,8 @@ std::vector<gpu::GpuInstance> SceneGpu::packInstances(const scene::Pose& pose, c
     rows(glm::inverse(toWorld), inst.worldToObject);
     inst.geometry = itemGeometry[i];
     inst.material = itemMaterial[i];
+    inst.flags = (itemSingleSided[i] ? gpu::kInstanceCullBackFaces : 0u) |
+                 (glm::determinant(glm::dmat3(toWorld)) < 0.0 ? gpu::kInstanceMirrored : 0u);
   }
   return instances;
 }

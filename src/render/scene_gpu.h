@@ -44,6 +44,9 @@ struct SceneGpu {
   /// Per pose item: a viewport leaves its pixels to the trace (its faces
   /// refract, or alpha may make them see-through).
   std::vector<char> itemSeeThrough;
+  /// Per pose item: its faces are seen from the front only (a single-sided
+  /// material that is not glass: glTF's and USD's doubleSided false).
+  std::vector<char> itemSingleSided;
   /// gpu::kSurface* bits: what its materials use (the trace compiles out the rest).
   uint32_t surface = 0;
   uint32_t vertexCount = 0, triangleCount = 0;

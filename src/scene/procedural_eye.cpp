@@ -82,8 +82,9 @@ void addIris(Shape& s, float z, uint32_t rings, uint32_t segments) {
   }
   for (uint32_t r = 0; r < rings; ++r) {
     for (uint32_t k = 0; k < segments; ++k) {
-      uint32_t a = r * (segments + 1) + k, b = a + segments + 1;
-      s.indices.insert(s.indices.end(), {a, a + 1, b, a + 1, b + 1, b});
+      uint32_t a = r * (segments + 1) + k, b = a + segments + 1;  // b: the next ring out
+      // Counter-clockwise seen from the front (+z), where its normals point: glTF's front face.
+      s.indices.insert(s.indices.end(), {a, b, a + 1, a + 1, b, b + 1});
     }
   }
 }
@@ -269,6 +270,8 @@ Scene makeEye(const EyeOptions& o) {
 
   scene.materials = {plain("sclera", {0.93f, 0.90f, 0.86f}), plain("cornea_tip", {1, 1, 1}),
                      plain("cornea_rest", {0.93f, 0.90f, 0.86f}), plain("iris", {1, 1, 1}), plain("pupil", {0.02f, 0.02f, 0.02f})};
+  // The sclera is a shell open behind the cornea: its inside is seen through it.
+  scene.materials[kSclera].doubleSided = true;
   scene.materials[kCorneaTip].transmission = 1.0f;
   scene.materials[kCorneaTip].ior = o.ior;
   scene.materials[kCorneaTip].doubleSided = true;

@@ -93,7 +93,7 @@ std::string describe(const Scene& scene, uint32_t width, uint32_t height) {
     out << "  texture memory " << mebibytes(decoded) << " decoded (RGBA8), " << mebibytes(s.textureBytes)
         << " on the GPU with mips; largest " << (largest->name.empty() ? "(unnamed)" : "'" + largest->name + "'") << " "
         << largest->width << "x" << largest->height;
-    if (undrawn) out << "; " << undrawn << " not uploaded (normal, occlusion or metallic-roughness maps: not drawn)";
+    if (undrawn) out << "; " << undrawn << " not uploaded (occlusion or metallic-roughness maps: not drawn)";
     out << "\n";
   }
   if (s.subdividedShapes) {

@@ -233,3 +233,22 @@ def test_rigid_skinning_moves_the_instance_as_vertex_skinning_moves_the_points(t
     rigid_points = np.asarray(meshes[0].positions, float) @ rigid[:3, :3].T + rigid[:3, 3]
     np.testing.assert_allclose(rigid_points, skinned, atol=1e-6)
     assert not np.allclose(skinned, meshes[0].positions, atol=1e-3)
+
+
+def test_a_single_sided_mesh_seen_from_behind_is_not_drawn_as_usdview_culls_it(tmp_path, device):
+    def picture(double_sided: bool):
+        path = tmp_path / f"sided_{double_sided}.usda"
+        stage = new_stage(path)
+        m = quad(stage, "/World/Card", size=2.0)
+        m.CreateDoubleSidedAttr(double_sided)
+        bind(m.GetPrim(), preview_material(stage, "/World/Red", diffuseColor=(0.0, 0.0, 0.0),
+                                           emissiveColor=(1.0, 0.0, 0.0)))
+        camera = UsdGeom.Camera.Define(stage, "/World/Behind")  # on -Z, looking at the card's back
+        camera.AddTranslateOp().Set(Gf.Vec3d(0, 0, -4))
+        camera.AddRotateYOp().Set(180.0)
+        stage.GetRootLayer().Save()
+        with snell.usd.open(path, device=device) as opened:
+            return opened.render(32, 32, camera="/World/Behind")[16, 16, :3]
+
+    assert picture(True)[0] > 0.5, "a double-sided card is seen from behind"
+    assert picture(False)[0] < 0.1, "a single-sided one (USD's doubleSided fallback, 0) is not"
