@@ -388,6 +388,7 @@ PYBIND11_MODULE(_snell, m) {
       "method: auto (trace, or driver-rt where it times faster) or one of snell.methods():\n" +
       methodList();
   m.doc() = "snell: refraction through deforming meshes, ray traced by Vulkan compute.";
+  m.attr("DEFAULT_YFOV") = snell::kDefaultYfov;  // radians: framed views' and View(yfov=)'s default
   py::register_exception<snell::Error>(m, "Error", PyExc_RuntimeError);
   m.def("version", &snell::version, "snell's version, 'major.minor.patch'.");
   m.def(
@@ -585,7 +586,7 @@ PYBIND11_MODULE(_snell, m) {
              c.name = name;
              return c;
            }),
-           "transform"_a = py::none(), "orthographic"_a = false, "yfov"_a = 0.6981317f, "ymag"_a = 1.0f,
+           "transform"_a = py::none(), "orthographic"_a = false, "yfov"_a = float(snell::kDefaultYfov), "ymag"_a = 1.0f,
            "name"_a = "",
            "transform: camera to world (4x4, it looks down its -Z, +Y up); yfov in radians\n"
            "(perspective); ymag: half the view's height (orthographic).")
@@ -819,7 +820,7 @@ PYBIND11_MODULE(_snell, m) {
            }),
            "width"_a = 640, "height"_a = 480, "camera"_a = -1, "view_matrix"_a = py::none(), "projection"_a = py::none(),
            "eye"_a = std::vector<float>{0, 0, 3}, "target"_a = std::vector<float>{0, 0, 0},
-           "up"_a = std::vector<float>{0, 1, 0}, "yfov"_a = 0.6981317f, "viewport"_a = false, "method"_a = "auto",
+           "up"_a = std::vector<float>{0, 1, 0}, "yfov"_a = float(snell::kDefaultYfov), "viewport"_a = false, "method"_a = "auto",
            "max_interfaces"_a = 8, "fresnel"_a = true, "dispersion"_a = true, "volume"_a = true,
            "background"_a = std::vector<float>(kDefaultBackground.begin(), kDefaultBackground.end()),
            "transparent_background"_a = false, "environment"_a = py::none(), kViewDoc.c_str())

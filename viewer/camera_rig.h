@@ -18,7 +18,7 @@ class CameraRig {
   glm::dvec3 target{0.0};
   double distance = 1.0;
   double yaw = 0.0, pitch = 0.0;  ///< radians; yaw about +Y, pitch up from the horizon
-  double yfov = 0.6981317;        ///< the rig's vertical field of view (40 degrees)
+  double yfov = kDefaultYfov;     ///< the rig's vertical field of view
   glm::dvec2 filmPan{0.0};        ///< in fractions of the view's half height
   double filmZoom = 1.0;          ///< > 1 magnifies
 

@@ -124,7 +124,7 @@ void Viewer::useScene(std::unique_ptr<scene::Scene> scene, int camera) {
   scene::sceneBounds(*scene, pose, lo, hi);
   auto resolves = [&](int c) {
     try {
-      scene::resolveView(*scene, pose, {c, std::nullopt, 0.6981317});
+      scene::resolveView(*scene, pose, {c, std::nullopt, kDefaultYfov});
       return true;
     } catch (const std::invalid_argument&) {
       return false;
@@ -185,7 +185,7 @@ void Viewer::notify(const std::string& text) {
 bool Viewer::cameraResolves(int camera) const {
   if (camera < 0 || size_t(camera) >= scene_->cameras.size()) return false;
   try {
-    scene::resolveView(*scene_, pose_, {camera, std::nullopt, 0.6981317});
+    scene::resolveView(*scene_, pose_, {camera, std::nullopt, kDefaultYfov});
     return true;
   } catch (const std::invalid_argument&) {
     return false;

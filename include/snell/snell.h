@@ -16,6 +16,7 @@
 // Renderer::read), as Vulkan requires of any queue.
 #pragma once
 
+#include <snell/defaults.h>
 #include <vulkan/vulkan.h>
 
 #include <array>
@@ -247,7 +248,7 @@ struct SceneCamera {
   std::string name;
   Mat4 transform = kIdentity;  ///< camera to world: it looks down its -Z axis, +Y up
   bool orthographic = false;
-  float yfov = 0.6981317f;  ///< radians (perspective)
+  float yfov = float(kDefaultYfov);  ///< radians (perspective)
   float ymag = 1;           ///< half the view's height (orthographic)
 };
 
@@ -324,7 +325,7 @@ class Scene {
 /// A look-at camera with a vertical field of view.
 struct Camera {
   Vec3 eye{0, 0, 3}, target{0, 0, 0}, up{0, 1, 0};
-  float yfov = 0.6981317f;  ///< radians (40 degrees)
+  float yfov = float(kDefaultYfov);  ///< radians
 };
 
 /// A camera given as the host's own matrices (a DCC viewport's), OpenGL's conventions.

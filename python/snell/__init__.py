@@ -18,6 +18,7 @@ docs/python.md covers the module.
 """
 
 from ._snell import (
+    DEFAULT_YFOV,
     Camera,
     Device,
     Environment,
@@ -44,6 +45,7 @@ from ._snell import (
 __version__ = version()
 
 __all__ = [
+    "DEFAULT_YFOV",
     "Camera",
     "Device",
     "Environment",

@@ -6,6 +6,8 @@ from typing import Any, Callable, Iterable, Optional, Sequence, Union
 import numpy as np
 import numpy.typing as npt
 
+DEFAULT_YFOV: float  # radians (40 degrees): the field of view of framed views and of View(yfov=)
+
 Matrix = npt.ArrayLike  # 4x4, numpy (row, column) order, as mathutils.Matrix
 
 class Error(RuntimeError):
@@ -141,7 +143,7 @@ class Camera:
         self,
         transform: Optional[Matrix] = None,
         orthographic: bool = False,
-        yfov: float = 0.6981317,
+        yfov: float = DEFAULT_YFOV,
         ymag: float = 1.0,
         name: str = "",
     ) -> None: ...
@@ -297,7 +299,7 @@ class View:
         eye: Sequence[float] = (0, 0, 3),
         target: Sequence[float] = (0, 0, 0),
         up: Sequence[float] = (0, 1, 0),
-        yfov: float = 0.6981317,
+        yfov: float = DEFAULT_YFOV,
         viewport: bool = False,
         method: str = "auto",
         max_interfaces: int = 8,

@@ -5,6 +5,7 @@
 
 #include "scene/evaluate.h"
 #include "scene/scene.h"
+#include "snell/defaults.h"
 
 #include <glm/glm.hpp>
 
@@ -21,7 +22,7 @@ struct LookAt {
 struct ViewRequest {
   int camera = -1;                ///< glTF camera index; -1: camera 0 when the scene has one
   std::optional<LookAt> lookAt;   ///< wins over any camera
-  double yfov = 0.6981317;        ///< radians, for look-at and framed views (40 degrees)
+  double yfov = kDefaultYfov;     ///< radians, for look-at and framed views
 };
 
 /// A ray in world space, for ray lists (FrameSettings::rays, ReferenceSettings::rays).

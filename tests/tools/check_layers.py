@@ -42,8 +42,15 @@ def layer_of_folder(relative: str) -> int | None:
     return None
 
 
+# Leaf headers of the public API that state shared defaults and include
+# nothing: they sit in the bottom layer, so any layer may include them.
+SHARED_PUBLIC = {"snell/defaults.h"}
+
+
 def layer_of_include(target: str) -> int | None:
     """The rank of the layer an include names ("render/bvh.h": render), or None."""
+    if target in SHARED_PUBLIC:
+        return 0
     head = target.split("/", 1)[0]
     if head == "snell" and "/" in target:
         return next(r for r, (name, _) in enumerate(LAYERS) if name == "api")

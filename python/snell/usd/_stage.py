@@ -18,12 +18,11 @@ from typing import Any, Callable, Optional, Union
 
 import numpy as np
 
-from .. import Device, Environment, Mesh, Renderer, Scene, ShotFrame, View
+from .. import DEFAULT_YFOV, Device, Environment, Mesh, Renderer, Scene, ShotFrame, View
 from ._cameras import CameraState
 from ._problems import StageError, StageWarning
 from ._reader import Frame, StageContents
 
-FRAMED_YFOV = 0.6981317  # radians: snell render's framed view (40 degrees)
 
 
 @dataclass
@@ -201,9 +200,9 @@ def framed_view(lo: np.ndarray, hi: np.ndarray, width: int, height: int, **optio
     centre, radius = np.zeros(3), 1.0
     if np.all(lo <= hi):
         centre, radius = 0.5 * (lo + hi), max(0.5 * float(np.linalg.norm(hi - lo)), 1e-6)
-    distance = radius / math.sin(FRAMED_YFOV / 2)
+    distance = radius / math.sin(DEFAULT_YFOV / 2)
     return View(width, height, eye=tuple(centre + (0.0, 0.0, distance)), target=tuple(centre), up=(0, 1, 0),
-                yfov=FRAMED_YFOV, **options)
+                yfov=DEFAULT_YFOV, **options)
 
 
 def shot_frame(contents: StageContents, time_code: float, camera: Optional[CameraState], width: int, height: int,
