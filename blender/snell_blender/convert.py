@@ -503,21 +503,6 @@ def light_of(light_object, matrix: np.ndarray) -> tuple:
     return snell.Light(type="point", color=colour, intensity=intensity, position=position), note
 
 
-def view_of(scene, width: int, height: int, view_matrix, projection, viewport: bool, background):
-    """A snell.View of the scene's settings through Blender's view and projection matrices."""
-    import snell
-
-    from .properties import settings
-    from .sync import Y_UP
-
-    options = settings(scene)
-    to_camera = np.array([list(row) for row in view_matrix], np.float64) @ np.linalg.inv(Y_UP)
-    return snell.View(width, height, view_matrix=to_camera, projection=np.array([list(r) for r in projection]),
-                      viewport=viewport, method=options.method, max_interfaces=options.max_interfaces,
-                      fresnel=options.fresnel, dispersion=options.dispersion, volume=options.volume,
-                      background=background)
-
-
 def background_of(world) -> tuple:
     """The world's colour (its Background node's colour times strength), linear RGB."""
     if world is None:

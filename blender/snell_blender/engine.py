@@ -154,10 +154,9 @@ class SnellRenderEngine(bpy.types.RenderEngine):
             display.draw_text(self.problem or runtime.problem() or "snell: nothing to draw", error=True)
             return
         started = time.perf_counter()
-        from .convert import view_of
+        from .camera import viewport_view
 
-        view = view_of(scene, region.width, region.height, rv3d.view_matrix, rv3d.window_matrix, True,
-                       self.sync.background)
+        view = viewport_view(scene, region, rv3d, self.sync.background)
         if self.display is None:
             self.display = display.Display(runtime.device())
         try:
@@ -222,18 +221,9 @@ def _turned_to_camera(normals, depsgraph, camera, width: int, height: int):
     pixel's ray, as Blender's Normal pass has them: a mesh wound inwards still shows normals that face out."""
     import numpy as np
 
-    from .sync import Y_UP
+    from .camera import pixel_rays
 
-    camera = camera.evaluated_get(depsgraph)
-    p = np.array([list(row) for row in camera.calc_matrix_camera(depsgraph, x=width, y=height)], np.float64)
-    rows, columns = np.mgrid[0:height, 0:width] + 0.5
-    ndc_x, ndc_y = 2.0 * columns / width - 1.0, 1.0 - 2.0 * rows / height
-    if p[3, 3] == 0.0:  # perspective: camera-space direction (x / -z, y / -z, -1) from the off-centre frustum
-        rays = np.stack([(ndc_x + p[0, 2]) / p[0, 0], (ndc_y + p[1, 2]) / p[1, 1], -np.ones_like(ndc_x)], -1)
-    else:
-        rays = np.broadcast_to(np.array([0.0, 0.0, -1.0]), (height, width, 3))
-    to_world = Y_UP[:3, :3] @ np.array([list(row)[:3] for row in camera.matrix_world.to_3x3()], np.float64)
-    along = np.einsum("hwc,hwc->hw", normals, rays @ to_world.T)
+    along = np.einsum("hwc,hwc->hw", normals, pixel_rays(depsgraph, camera, width, height))
     return np.where((along > 0.0)[..., None], -normals, normals).astype(np.float32)
 
 
@@ -241,12 +231,12 @@ def _pass_values(key: str, plane):
     """A snell AOV in the form Blender's pass of it holds."""
     import numpy as np
 
-    from .sync import Y_UP
+    from .camera import normals_to_blender
 
     if key == "depth":
         return np.where(np.isfinite(plane), plane, np.float32(1e10))  # Blender's depth where nothing is hit
     if key == "normal":
-        return plane @ Y_UP[:3, :3].astype(np.float32)  # snell's Y-up world back to Blender's Z-up one
+        return normals_to_blender(plane)
     if key in ("instance", "primitive"):
         return np.where(plane == 0xFFFFFFFF, -1.0, plane.astype(np.float64)).astype(np.float32)
     return plane.astype(np.float32)

@@ -83,16 +83,14 @@ class RenderJob:
         """The frame at the depsgraph's time, or None when `stop()` said so between its steps."""
         import numpy as np
 
-        from .convert import view_of
+        from .camera import scene_camera, view_of
 
         started = time.perf_counter()
         if not self._synced(depsgraph, stop, progress):
             return None
         synced = time.perf_counter()
         scene = depsgraph.scene
-        camera = camera.evaluated_get(depsgraph)
-        projection = np.array([list(row) for row in camera.calc_matrix_camera(
-            depsgraph, x=width, y=height, scale_x=pixel_aspect[0], scale_y=pixel_aspect[1])], np.float64)
+        view_matrix, projection = scene_camera(depsgraph, camera, width, height, pixel_aspect)
         picture = FramePicture()
         keys = ["rgba"] + [key for key, *_ in passes]
         for key in keys:
@@ -105,8 +103,8 @@ class RenderJob:
                 return None
             step = "tracing" if len(rows) == 1 else f"tracing strip {done + 1} of {len(rows)}"
             progress(0.5 + 0.5 * done / len(rows), step)
-            view = view_of(scene, width, count, camera.matrix_world.inverted(),
-                           strip_projection(projection, height, top, count), False, self.sync.background)
+            view = view_of(scene, width, count, view_matrix, strip_projection(projection, height, top, count), False,
+                           self.sync.background)
             if passes:
                 planes = self.sync.renderer.render_aovs(view)
                 for key in keys:

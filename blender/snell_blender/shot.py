@@ -23,7 +23,7 @@ from typing import Optional
 
 import bpy
 
-from . import convert, runtime
+from . import camera, runtime
 
 AHEAD = 2  # frames posed and waiting for the shot's thread
 last: Optional[dict] = None  # the last shot's summary (snell.render_frames'), for tests
@@ -37,10 +37,9 @@ class AnimationShot:
     """The frames of a scene's range on `devices`, posed on this thread and drawn on the shot's."""
 
     def __init__(self, context, devices: str, device: str = "") -> None:
-        import numpy as np
         import snell
 
-        from .sync import Y_UP, SceneSync
+        from .sync import SceneSync
 
         scene = context.scene
         if scene.camera is None:
@@ -51,7 +50,6 @@ class AnimationShot:
         scale = scene.render.resolution_percentage / 100.0
         self.width = max(1, int(scene.render.resolution_x * scale))
         self.height = max(1, int(scene.render.resolution_y * scale))
-        self._to_snell = np.linalg.inv(Y_UP)
         self._frame_before = scene.frame_current
         scene.frame_set(self.frames[0])
         depsgraph = context.evaluated_depsgraph_get()
@@ -71,22 +69,14 @@ class AnimationShot:
 
     def _camera(self, depsgraph) -> tuple:
         """The scene camera's (view matrix in snell's world, projection) at the depsgraph's frame."""
-        import numpy as np
-
-        camera = self.scene.camera.evaluated_get(depsgraph)
-        projection = np.array([list(row) for row in camera.calc_matrix_camera(
-            depsgraph, x=self.width, y=self.height, scale_x=self.scene.render.pixel_aspect_x,
-            scale_y=self.scene.render.pixel_aspect_y)], np.float64)
-        to_camera = np.array([list(row) for row in camera.matrix_world.inverted()], np.float64) @ self._to_snell
-        return to_camera, projection
+        pixel_aspect = (self.scene.render.pixel_aspect_x, self.scene.render.pixel_aspect_y)
+        return camera.scene_camera(depsgraph, self.scene.camera, self.width, self.height, pixel_aspect)
 
     def _view(self, depsgraph):
         """The shot's View: the scene's settings (method, optics, background); each frame brings its camera."""
-        from .sync import Y_UP
-
         view_matrix, projection = self._camera(depsgraph)
-        return convert.view_of(self.scene, self.width, self.height, view_matrix @ Y_UP, projection, False,
-                               self.sync.background)
+        return camera.view_of(self.scene, self.width, self.height, view_matrix, projection, False,
+                              self.sync.background)
 
     def _draw(self) -> None:
         """The shot's thread: snell.render_frames over the posed frames."""

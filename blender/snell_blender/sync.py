@@ -27,7 +27,7 @@ from typing import Optional
 
 import numpy as np
 
-from . import compat, convert, runtime, subdivision
+from . import camera, compat, convert, runtime, subdivision
 
 
 @dataclass
@@ -64,17 +64,6 @@ def _instance_key(instance) -> tuple:
     if instance.is_instance:
         return (instance.parent.original.name, instance.object.original.name, tuple(instance.persistent_id))
     return (instance.object.original.name,)
-
-
-# Blender's world is Z-up, snell's (glTF's) Y-up: the studio gradient that glass
-# reflects has its sky at +Y. Everything goes to snell through this rotation,
-# the glTF exporter's own: (x, y, z) -> (x, z, -y).
-Y_UP = np.array([[1, 0, 0, 0], [0, 0, 1, 0], [0, -1, 0, 0], [0, 0, 0, 1]], np.float64)
-
-
-def _matrix(m) -> np.ndarray:
-    """A Blender matrix in snell's Y-up world."""
-    return Y_UP @ np.array([list(row) for row in m], np.float64)
 
 
 def _read_mesh(obj):
@@ -118,9 +107,9 @@ class SceneSync:
 
         for instance in depsgraph.object_instances:
             obj = instance.object
-            matrix = _matrix(instance.matrix_world)
+            matrix = camera.to_snell(instance.matrix_world)
             if obj.type == "LIGHT":
-                light, note = convert.light_of(obj, _matrix(instance.matrix_world))
+                light, note = convert.light_of(obj, camera.to_snell(instance.matrix_world))
                 lights.append(light)
                 if note:
                     self.notes.add(note)
@@ -418,7 +407,7 @@ class SceneSync:
                 if obj.type in ("MESH", "CURVE", "SURFACE", "META", "FONT"):
                     raise TopologyChanged(f"{obj.name} appeared")
                 continue
-            matrices[key] = _matrix(instance.matrix_world)
+            matrices[key] = camera.to_snell(instance.matrix_world)
         if len(matrices) != len(self.instances):
             raise TopologyChanged("an object was hidden or deleted")
         return matrices
