@@ -112,7 +112,7 @@ def test_opacity_from_the_diffuse_textures_alpha_is_the_base_colour_textures_alp
     record = material_of(contents)
     assert (record.fields["alpha_mode"], record.fields["alpha_cutoff"]) == ("mask", pytest.approx(0.3))
     assert record.fields["base_color"] == (1.0, 1.0, 1.0, 1.0)
-    np.testing.assert_array_equal(contents.materials.textures[record.slots["base_color"].index], rgba)
+    np.testing.assert_array_equal(contents.materials.textures[record.slots["base_color"].index].rgba, rgba)
 
 
 def test_opacity_from_another_texture_prim_of_the_diffuse_file_is_its_alpha_with_that_prims_scale(tmp_path):
@@ -127,7 +127,7 @@ def test_opacity_from_another_texture_prim_of_the_diffuse_file_is_its_alpha_with
 
     contents = read_quad(tmp_path, build)
     assert len(contents.materials.textures) == 1 and material_of(contents).fields["alpha_mode"] == "blend"
-    texels = contents.materials.textures[0]
+    texels = contents.materials.textures[0].rgba
     np.testing.assert_array_equal(texels[..., :3], rgba[..., :3])
     np.testing.assert_allclose(texels[..., 3], rgba[..., 3] * 0.5, atol=0.5)  # rounded to the nearest byte
 
@@ -144,7 +144,7 @@ def test_an_opacity_texture_under_a_constant_diffuse_colour_is_a_white_texture_w
     contents = read_quad(tmp_path, build)
     record = material_of(contents)
     np.testing.assert_allclose(record.fields["base_color"], (0.9, 0.5, 0.3, 1.0), rtol=1e-6)
-    texels = contents.materials.textures[record.slots["base_color"].index]
+    texels = contents.materials.textures[record.slots["base_color"].index].rgba
     assert (texels[..., :3] == 255).all()
     np.testing.assert_array_equal(texels[..., 3], grey[..., 0])
 
@@ -178,7 +178,8 @@ def test_a_textured_opacity_without_a_threshold_blends_as_gltfs_blend(tmp_path):
     contents = read_quad(tmp_path, build)
     record = material_of(contents)
     assert record.fields["transmission"] == 0.0 and record.fields["alpha_mode"] == "blend"
-    np.testing.assert_array_equal(contents.materials.textures[record.slots["base_color"].index][..., 3], mask[..., 3])
+    texels = contents.materials.textures[record.slots["base_color"].index].rgba
+    np.testing.assert_array_equal(texels[..., 3], mask[..., 3])
     assert "coverage: opacity blends" in record.summary and not contents.problems.items
 
 
@@ -257,7 +258,7 @@ def test_display_opacity_read_through_a_primvar_reader_blends_by_vertex(tmp_path
     contents = read_quad(tmp_path, build)
     record = material_of(contents)
     assert record.fields["alpha_mode"] == "blend" and record.fields["transmission"] == 0.0
-    texels = contents.materials.textures[record.fields["base_color_texture"]]
+    texels = contents.materials.textures[record.fields["base_color_texture"]].rgba
     uvs = contents.snell_meshes()[0].uvs
     alpha = bilinear(texels, uvs)[:, 3] / 255.0
     points = contents.sources[0].parts[0].vertex_point
@@ -294,7 +295,7 @@ def test_a_meshs_vertex_display_color_is_interpolated_linearly_across_each_trian
     contents = read_quad(tmp_path, build)
     record = material_of(contents)
     meshed = contents.snell_meshes()[0]
-    texels = contents.materials.textures[record.fields["base_color_texture"]]
+    texels = contents.materials.textures[record.fields["base_color_texture"]].rgba
     points = contents.sources[0].parts[0].vertex_point
     assert len(meshed.positions) == 6  # two triangles, each with its own three vertices
     uvs = np.asarray(meshed.uvs, np.float64)
@@ -343,7 +344,7 @@ def test_an_emissive_texture_without_a_bias_folds_its_scale_into_the_emissive_fa
     contents = read_quad(tmp_path, build)
     record = material_of(contents)
     assert record.fields["emissive"] == (4.0, 2.0, 0.5)  # brighter than 1 stays exact: the bytes are the file's
-    np.testing.assert_array_equal(contents.materials.textures[record.slots["emissive"].index][..., :3], rgb)
+    np.testing.assert_array_equal(contents.materials.textures[record.slots["emissive"].index].rgba[..., :3], rgb)
     assert not contents.problems.items
 
 
@@ -361,7 +362,7 @@ def test_an_emissive_texture_with_a_bias_is_stored_over_its_largest_value(tmp_pa
     record = material_of(contents)
     expected = grey / 255.0 * np.array([3.0, 1.0, 1.0]) + np.array([0.5, 0.0, 0.1])
     np.testing.assert_allclose(record.fields["emissive"], expected.reshape(-1, 3).max(axis=0).clip(1.0), rtol=1e-6)
-    texels = contents.materials.textures[record.slots["emissive"].index][..., :3] / 255.0
+    texels = contents.materials.textures[record.slots["emissive"].index].rgba[..., :3] / 255.0
     decoded = np.where(texels <= 0.04045, texels / 12.92, ((texels + 0.055) / 1.055) ** 2.4)
     np.testing.assert_allclose(decoded * record.fields["emissive"], expected, rtol=0.01, atol=0.002)
 
@@ -381,11 +382,11 @@ def test_a_normal_map_is_stored_as_data_snell_decodes_to_the_specs_normal(tmp_pa
     contents = read_quad(tmp_path, build((2.0, 2.0, 2.0, 1.0), (-1.0, -1.0, -1.0, 0.0)))
     record = material_of(contents)
     assert record.fields["normal_scale"] == 1.0 and not contents.problems.items
-    np.testing.assert_array_equal(contents.materials.textures[record.slots["normal"].index][..., :3], rgb)
+    np.testing.assert_array_equal(contents.materials.textures[record.slots["normal"].index].rgba[..., :3], rgb)
     # Any other scale and bias: the bytes hold (v + 1) / 2.
     contents = read_quad(tmp_path, build((1.0, 1.5, 1.0, 1.0), (-0.5, -0.5, 0.0, 0.0)))
     v = rgb / 255.0 * np.array([1.0, 1.5, 1.0]) - np.array([0.5, 0.5, 0.0])
-    texels = contents.materials.textures[material_of(contents).slots["normal"].index][..., :3]
+    texels = contents.materials.textures[material_of(contents).slots["normal"].index].rgba[..., :3]
     np.testing.assert_allclose(2.0 * texels / 255.0 - 1.0, v.clip(-1, 1), atol=1.0 / 255 + 1e-9)
 
 
@@ -402,7 +403,7 @@ def test_a_normal_map_scaled_beyond_the_usual_one_is_the_usual_one_with_a_normal
     contents = read_quad(tmp_path, build)
     record = material_of(contents)
     assert record.fields["normal_scale"] == 2.5
-    np.testing.assert_array_equal(contents.materials.textures[record.slots["normal"].index][..., :3], rgb)
+    np.testing.assert_array_equal(contents.materials.textures[record.slots["normal"].index].rgba[..., :3], rgb)
 
 
 def test_a_normal_from_something_other_than_a_texture_is_a_warning_naming_the_input(tmp_path):
@@ -451,8 +452,8 @@ def test_an_srgb_texture_passes_through_byte_for_byte(tmp_path):
     contents = read_quad(tmp_path, build)
     record = material_of(contents)
     assert record.slots["base_color"].index == 0 and record.fields["base_color"] == (1, 1, 1, 1)
-    np.testing.assert_array_equal(contents.materials.textures[0][..., :3], rgba[..., :3])
-    assert (contents.materials.textures[0][..., 3] == 255).all()
+    np.testing.assert_array_equal(contents.materials.textures[0].rgba[..., :3], rgba[..., :3])
+    assert (contents.materials.textures[0].rgba[..., 3] == 255).all()
 
 
 def test_scale_and_bias_apply_in_linear_light_after_the_colour_space(tmp_path):
@@ -465,7 +466,7 @@ def test_scale_and_bias_apply_in_linear_light_after_the_colour_space(tmp_path):
                 bias=(0.1, 0.0, 0.0, 0.0))
         bind(prim, material)
 
-    texels = read_quad(tmp_path, build).materials.textures[0][..., :3].astype(float) / 255
+    texels = read_quad(tmp_path, build).materials.textures[0].rgba[..., :3].astype(float) / 255
     linear = grey / 255.0 * 0.5 + np.array([0.1, 0.0, 0.0])  # raw: the file's values are linear already
     expected = np.where(linear <= 0.0031308, 12.92 * linear, 1.055 * np.clip(linear, 0, 1) ** (1 / 2.4) - 0.055)
     np.testing.assert_allclose(texels, expected, atol=0.5 / 255 + 1e-9)
@@ -596,7 +597,7 @@ def test_clamp_and_mirror_wraps_are_snells_samplers(tmp_path):
         bind(prim, material)
 
     contents = read_quad(tmp_path, build)
-    assert contents.materials.texture_wraps == [("clamp", "mirror")] and not contents.problems.items
+    assert [t.wraps for t in contents.materials.textures] == [("clamp", "mirror")] and not contents.problems.items
 
 
 def test_a_black_wrap_is_a_warning_only_where_the_textures_st_leaves_the_unit_square(tmp_path):
@@ -643,7 +644,7 @@ def test_a_texture_inside_a_usdz_package_is_read(tmp_path):
     contents = snell.usd.read(tmp_path / "quad.usdz")
     contents.snell_meshes()
     assert not contents.problems.items
-    np.testing.assert_array_equal(contents.materials.textures[0][..., :3], rgba)
+    np.testing.assert_array_equal(contents.materials.textures[0].rgba[..., :3], rgba)
 
 
 def _textured(stage, file: str):

@@ -95,6 +95,18 @@ class TextureSlot:
         return _khr_matrix(self.transform) if self.transform is not None else np.eye(3)
 
 
+@dataclass(frozen=True)
+class TextureRecord:
+    """One snell texture of the stage: its texels, the name it goes by (its file) and its wraps."""
+
+    rgba: np.ndarray  #: height x width x 4 bytes
+    name: str
+    wraps: tuple[str, str] = ("clamp", "clamp")  #: snell.Texture's wrap_s, wrap_t
+
+    def snell_texture(self) -> Texture:
+        return Texture(self.rgba, name=self.name, wrap_s=self.wraps[0], wrap_t=self.wraps[1])
+
+
 @dataclass
 class MaterialRecord:
     """One snell material and what the meshes using it must provide (the st primvar its textures read)."""
@@ -135,16 +147,13 @@ class MaterialTable:
         self.problems = problems
         self.load_textures = load_textures
         self.records: list[MaterialRecord] = []
-        self.textures: list[np.ndarray] = []
-        self.texture_paths: list[str] = []
-        self.texture_wraps: list[tuple[str, str]] = []
+        self.textures: list[TextureRecord] = []  # snell's texture i is textures[i]
         self._read: dict[str, MaterialRecord] = {}
         self._index: dict[tuple, int] = {}
         self._texture_index: dict[tuple, tuple[int, tuple[float, float, float]]] = {}
 
     def snell_textures(self) -> list[Texture]:
-        return [Texture(rgba, name=path, wrap_s=wraps[0], wrap_t=wraps[1])
-                for rgba, path, wraps in zip(self.textures, self.texture_paths, self.texture_wraps)]
+        return [texture.snell_texture() for texture in self.textures]
 
     def bound_material(self, prim: Usd.Prim) -> Optional[UsdShade.Material]:
         """The material bound to prim (or a GeomSubset) for the purpose, else its all-purpose one."""
@@ -193,9 +202,7 @@ class MaterialTable:
 
     def add_texture(self, rgba: np.ndarray, name: str, wraps: tuple[str, str] = ("clamp", "clamp")) -> int:
         """A texture snell's reader made itself (a mesh's colours), by index."""
-        self.textures.append(rgba)
-        self.texture_paths.append(name)
-        self.texture_wraps.append(wraps)
+        self.textures.append(TextureRecord(rgba, name, wraps))
         return len(self.textures) - 1
 
     def _append(self, record: MaterialRecord) -> int:
@@ -229,9 +236,7 @@ class MaterialTable:
                 return -1, (1.0, 1.0, 1.0)
         else:
             image = TextureImage(np.zeros((1, 1, 4), np.uint8))
-        self.textures.append(image.rgba)
-        self.texture_paths.append(slot.request.path)
-        self.texture_wraps.append(slot.snell_wraps)
+        self.textures.append(TextureRecord(image.rgba, slot.request.path, slot.snell_wraps))
         self._texture_index[key] = (len(self.textures) - 1, image.gain)
         return self._texture_index[key]
 
