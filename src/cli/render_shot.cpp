@@ -228,8 +228,6 @@ render::ShotSettings shotSettings(const RenderOptions& o, const scene::Scene& sc
   return s;
 }
 
-// A device override per worker, and why: one, as --device or SNELL_DEVICE or
-// a launcher picks it; or with --devices, one per device it names.
 }  // namespace
 
 int renderShot(RenderOptions& o, render::ShotReport* report) {

@@ -1,4 +1,4 @@
-"""snell-usd's frame lists and file names follow `snell render`'s (src/cli/frames.cpp)."""
+"""snell-usd's frame lists and file names follow `snell render`'s (src/farm/frames.cpp)."""
 
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""Frame lists and file names as `snell render` reads them (src/cli/frames.cpp, the same rules).
+"""Frame lists and file names as `snell render` reads them (src/farm/frames.cpp, the same rules).
 
 A list is items separated by commas, each a frame or a range:
 first:last[:step] (snell's own), first-last[xstep] (Deadline, Nuke),
