@@ -14,8 +14,9 @@ def public(names) -> set[str]:
     return {n for n in names if not n.startswith("_")}
 
 
-def test_the_stub_names_every_class_and_function_of_the_module():
+def test_the_stub_names_every_class_function_and_constant_of_the_module():
     stubbed = {node.name for node in STUB.body if isinstance(node, (ast.ClassDef, ast.FunctionDef))}
+    stubbed |= {node.target.id for node in STUB.body if isinstance(node, ast.AnnAssign)}
     assert stubbed == public(dir(compiled)) - {"Matrix"}
 
 
