@@ -41,7 +41,9 @@ carry_runtime() {
     apt-get $o update -qq && (cd .gl && apt-get $o download -qq libvulkan1 libegl1 libglvnd0 libopengl0 libgl1 libglx0 libgles2)
   fi
   cp -u /usr/lib/x86_64-linux-gnu/libVkLayer_khronos_validation.so .carry/layer/
-  cp -u /usr/share/vulkan/explicit_layer.d/VkLayer_khronos_validation.json .carry/layer/
+  # The manifest names the library bare, which the loader looks up on the library path, not beside it.
+  sed 's|"library_path": "libVkLayer|"library_path": "./libVkLayer|' \
+    /usr/share/vulkan/explicit_layer.d/VkLayer_khronos_validation.json >.carry/layer/VkLayer_khronos_validation.json
 }
 
 build_one() {
