@@ -19,16 +19,7 @@ layout(std430, binding = kBvhBindingPrimBoxes) writeonly buffer PrimBoxes { floa
 layout(std430, binding = kBvhBindingDropped) buffer Dropped { uint dropped; };
 #include "bvh_leaves.glsl"
 
-// The entry whose packed primitives hold position t.
-uint entryOf(uint t) {
-  uint lo = 0u, hi = pc.entryCount;
-  while (hi - lo > 1u) {
-    uint mid = (lo + hi) / 2u;
-    if (entries[mid].base <= t) lo = mid;
-    else hi = mid;
-  }
-  return lo;
-}
+#include "bvh_entry_of.glsl"
 
 void main() {
   uint t = threadIndex();

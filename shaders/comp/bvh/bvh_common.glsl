@@ -1,6 +1,7 @@
 // Helpers every BVH pass shares: boxes as six floats, surface areas, float
 // keys whose unsigned order is the float order (so atomicMin can reduce
-// floats), and the mapping from a thread to the build or refit entry it serves.
+// floats); bvh_entry_of.glsl maps a thread to the build or refit entry it
+// serves (included after the entries buffer it reads).
 #include "../../shared/bvh.h"
 
 layout(local_size_x_id = kBvhSpecWorkgroupSize) in;

@@ -64,15 +64,7 @@ void teamSyncDevice() {
                  gl_SemanticsAcquireRelease);
 }
 
-uint entryOf(uint s) {
-  uint lo = 0u, hi = pc.entryCount;
-  while (hi - lo > 1u) {
-    uint mid = (lo + hi) / 2u;
-    if (entries[mid].base <= s) lo = mid;
-    else hi = mid;
-  }
-  return lo;
-}
+#include "bvh_entry_of.glsl"
 
 uvec2 sortedKey(uint pos) {
   if ((pc.flags & kBvhFlagKeys32) != 0u) return uvec2(keys[pos], 0u);

@@ -20,15 +20,7 @@ uint spreadBits(uint v) {
   return v;
 }
 
-uint entryOf(uint t) {
-  uint lo = 0u, hi = pc.entryCount;
-  while (hi - lo > 1u) {
-    uint mid = (lo + hi) / 2u;
-    if (entries[mid].base <= t) lo = mid;
-    else hi = mid;
-  }
-  return lo;
-}
+#include "bvh_entry_of.glsl"
 
 void main() {
   uint t = threadIndex();

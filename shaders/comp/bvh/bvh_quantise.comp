@@ -16,27 +16,9 @@ layout(std430, binding = kBvhBindingPrimBoxes) readonly buffer PrimBoxes { float
 layout(std430, binding = kBvhBindingExactBoxes) readonly buffer ExactBoxes { float exact[]; };
 layout(std430, binding = kBvhBindingNodes) buffer Nodes { BvhNode nodes[]; };
 
-uint entryOf(uint t) {
-  uint lo = 0u, hi = pc.entryCount;
-  while (hi - lo > 1u) {
-    uint mid = (lo + hi) / 2u;
-    if (entries[mid].base <= t) lo = mid;
-    else hi = mid;
-  }
-  return lo;
-}
+#include "bvh_entry_of.glsl"
 
-// A child's exact box: its primitive's, where the box pass put it, or the node's own.
-void childBox(BvhBuildEntry entry, uint ref, out vec3 lo, out vec3 hi) {
-  uint at = (ref & kBvhLeafBit) != 0u ? entry.base + ((ref & ~kBvhLeafBit) - entry.first) : ref;
-  if ((ref & kBvhLeafBit) != 0u) {
-    lo = vec3(primBoxes[6u * at], primBoxes[6u * at + 1u], primBoxes[6u * at + 2u]);
-    hi = vec3(primBoxes[6u * at + 3u], primBoxes[6u * at + 4u], primBoxes[6u * at + 5u]);
-  } else {
-    lo = vec3(exact[6u * at], exact[6u * at + 1u], exact[6u * at + 2u]);
-    hi = vec3(exact[6u * at + 3u], exact[6u * at + 4u], exact[6u * at + 5u]);
-  }
-}
+#include "bvh_child_box.glsl"
 
 void main() {
   uint t = threadIndex();

@@ -40,15 +40,8 @@ layout(std430, binding = kBvhBindingStats) buffer Stats { uvec4 stats[]; };
 layout(std430, binding = kBvhBindingDropped) buffer Dropped { uint dropped; };
 #include "bvh_leaves.glsl"
 
-uint entryOf(uint t) {
-  uint lo = 0u, hi = pc.entryCount;
-  while (hi - lo > 1u) {
-    uint mid = (lo + hi) / 2u;
-    if (entries[mid].threadBase <= t) lo = mid;
-    else hi = mid;
-  }
-  return lo;
-}
+#define BVH_ENTRY_FIRST(i) entries[i].threadBase
+#include "bvh_entry_of.glsl"
 
 // A 64-bit add from two 32-bit atomics: the low word's carry is seen by the
 // adder that caused it, and the high word's additions commute.

@@ -40,18 +40,7 @@ const float kMinGain = 1e-5;
 
 BvhBuildEntry entry;  // the group of the invocation's tree
 
-// A child's exact box: its primitive's, where the box pass put it, or the node's own.
-void slotBox(uint node, uint slot, out vec3 lo, out vec3 hi) {
-  uint ref = nodes[node].child[slot];
-  uint at = (ref & kBvhLeafBit) != 0u ? entry.base + ((ref & ~kBvhLeafBit) - entry.first) : ref;
-  if ((ref & kBvhLeafBit) != 0u) {
-    lo = vec3(primBoxes[6u * at], primBoxes[6u * at + 1u], primBoxes[6u * at + 2u]);
-    hi = vec3(primBoxes[6u * at + 3u], primBoxes[6u * at + 4u], primBoxes[6u * at + 5u]);
-  } else {
-    lo = vec3(exact[6u * at], exact[6u * at + 1u], exact[6u * at + 2u]);
-    hi = vec3(exact[6u * at + 3u], exact[6u * at + 4u], exact[6u * at + 5u]);
-  }
-}
+#include "bvh_child_box.glsl"
 
 // The treelet under construction: its leaves (subtrees kept whole) and the
 // internal nodes it opened, whose indices the new tree reuses.
@@ -77,7 +66,7 @@ uint formTreelet(uint root, out float currentCost) {
   uint internals = 1u;
   for (uint c = 0u; c < 2u; ++c) {
     leafRef[c] = nodes[root].child[c];
-    slotBox(root, c, leafLo[c], leafHi[c]);
+    childBox(entry, nodes[root].child[c], leafLo[c], leafHi[c]);
   }
   vec3 rootLo = min(leafLo[0], leafLo[1]), rootHi = max(leafHi[0], leafHi[1]);
   currentCost = boxArea(rootLo, rootHi);
@@ -98,9 +87,9 @@ uint formTreelet(uint root, out float currentCost) {
     internalNode[internals++] = opened;
     currentCost += bestBoxArea;
     leafRef[best] = nodes[opened].child[0];
-    slotBox(opened, 0u, leafLo[best], leafHi[best]);
+    childBox(entry, nodes[opened].child[0u], leafLo[best], leafHi[best]);
     leafRef[leaves] = nodes[opened].child[1];
-    slotBox(opened, 1u, leafLo[leaves], leafHi[leaves]);
+    childBox(entry, nodes[opened].child[1u], leafLo[leaves], leafHi[leaves]);
     ++leaves;
   }
   for (uint j = 0u; j < leaves; ++j) currentCost += refCost(leafRef[j], leafLo[j], leafHi[j]);
@@ -194,23 +183,15 @@ void settle(uint node) {
     }
   } else {
     vec3 lo0, hi0, lo1, hi1;
-    slotBox(node, 0u, lo0, hi0);
-    slotBox(node, 1u, lo1, hi1);
+    childBox(entry, nodes[node].child[0u], lo0, hi0);
+    childBox(entry, nodes[node].child[1u], lo1, hi1);
     currentCost = boxArea(min(lo0, lo1), max(hi0, hi1)) + refCost(nodes[node].child[0], lo0, hi0) +
                   refCost(nodes[node].child[1], lo1, hi1);
   }
   nodeStats[node] = uvec2(floatBitsToUint(currentCost), leavesBelow);
 }
 
-uint entryOf(uint t) {
-  uint lo = 0u, hi = pc.entryCount;
-  while (hi - lo > 1u) {
-    uint mid = (lo + hi) / 2u;
-    if (entries[mid].base <= t) lo = mid;
-    else hi = mid;
-  }
-  return lo;
-}
+#include "bvh_entry_of.glsl"
 
 // Whether `node`'s subtrees are both settled after this arrival. Release
 // what this invocation settled below, acquire what the sibling's did.
