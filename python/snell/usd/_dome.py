@@ -24,6 +24,7 @@ from dataclasses import dataclass
 import numpy as np
 from pxr import Usd, UsdGeom, UsdLux
 
+from ._lights import attribute_value, emission, warn_if_animated
 from ._problems import Problems
 from ._textures import TextureReadError, _decoded, _local_file, _usd_channels, is_srgb, srgb_to_linear
 
@@ -47,10 +48,6 @@ class Dome:
 
         return Environment(self.radiance, name=f"{self.path} (DomeLight)")
 
-
-def _value(attribute: Usd.Attribute, time: Usd.TimeCode, fallback):
-    value = attribute.Get(time) if attribute else None
-    return fallback if value is None else value
 
 
 def _rotation(matrix: np.ndarray) -> np.ndarray:
@@ -117,31 +114,21 @@ def read_dome(prim: Usd.Prim, time: Usd.TimeCode, to_snell: np.ndarray, up_axis:
     """The environment of a DomeLight or DomeLight_1 prim at a time code (see the module's docstring)."""
     path = str(prim.GetPath())
     api = UsdLux.LightAPI(prim)
-    intensity = float(_value(api.GetIntensityAttr(), time, 1.0))
-    luminance = intensity * 2.0 ** float(_value(api.GetExposureAttr(), time, 0.0))
-    colour = np.array(_value(api.GetColorAttr(), time, (1.0, 1.0, 1.0)), float)
-    if _value(api.GetEnableColorTemperatureAttr(), time, False):
-        colour *= np.array(UsdLux.BlackbodyTemperatureAsRgb(float(_value(api.GetColorTemperatureAttr(), time, 6500.0))))
+    luminance, colour = emission(api, time)
     radiance = np.maximum(colour * luminance, 0.0)
-    for name in ("intensity", "exposure", "color", "texture:file"):
-        attribute = prim.GetAttribute(f"inputs:{name}")
-        if attribute and attribute.ValueMightBeTimeVarying():
-            problems.warn(path, f"inputs:{name} is animated; snell sets the environment when the scene is built "
-                                f"(time code {time.GetValue():g})")
-    if UsdGeom.Xformable(prim).TransformMightBeTimeVarying():
-        problems.warn(path, "it turns over time; snell sets the environment when the scene is built "
-                            f"(time code {time.GetValue():g})")
+    warn_if_animated(prim, ("intensity", "exposure", "color", "texture:file"), "the environment", "turns", time,
+                     problems)
     if prim.GetRelationship("portals") and prim.GetRelationship("portals").GetTargets():
         problems.warn(path, "its portals only guide sampling, which snell's environment does not need: ignored")
     shown = "(" + ", ".join(f"{c:.4g}" for c in radiance) + ")"
     uniform = Dome(path, radiance.astype(np.float32).reshape(1, 1, 3), f"snell's environment, uniform {shown}")
 
     dome = UsdLux.DomeLight_1(prim) if prim.IsA(UsdLux.DomeLight_1) else UsdLux.DomeLight(prim)
-    asset = _value(dome.GetTextureFileAttr(), time, None)
+    asset = attribute_value(dome.GetTextureFileAttr(), time, None)
     if asset is None or not asset.path:
         return uniform
     fallback = f"the dome's colour {shown} is drawn instead"
-    layout = str(_value(dome.GetTextureFormatAttr(), time, "automatic"))
+    layout = str(attribute_value(dome.GetTextureFormatAttr(), time, "automatic"))
     if layout not in ("automatic", "latlong"):
         problems.warn(path, f"texture {asset.path} is a {layout} map; snell reads lat-long maps: {fallback}")
         return uniform

@@ -39,9 +39,36 @@ class LightRecord:
     summary: str
 
 
-def _value(attribute: Usd.Attribute, time: Usd.TimeCode, fallback):
+def attribute_value(attribute: Usd.Attribute, time: Usd.TimeCode, fallback):
+    """The attribute's value at a time code; `fallback` where it is missing or holds none."""
     value = attribute.Get(time) if attribute else None
     return fallback if value is None else value
+
+
+
+def emission(api: UsdLux.LightAPI, time: Usd.TimeCode) -> tuple[float, np.ndarray]:
+    """A UsdLux light's luminance (intensity x 2^exposure) and its linear RGB (colour x colour temperature)."""
+    intensity = float(attribute_value(api.GetIntensityAttr(), time, 1.0))
+    luminance = intensity * 2.0 ** float(attribute_value(api.GetExposureAttr(), time, 0.0))
+    colour = np.array(attribute_value(api.GetColorAttr(), time, (1.0, 1.0, 1.0)), float)
+    if attribute_value(api.GetEnableColorTemperatureAttr(), time, False):
+        kelvin = float(attribute_value(api.GetColorTemperatureAttr(), time, 6500.0))
+        colour *= np.array(UsdLux.BlackbodyTemperatureAsRgb(kelvin))
+    return luminance, colour
+
+
+def warn_if_animated(prim: Usd.Prim, inputs: tuple[str, ...], what: str, turns: str, time: Usd.TimeCode,
+                     problems: Problems) -> None:
+    """A warning for each of the light's `inputs` that is animated, and one where it `turns` over time:
+    snell sets `what` (its lights, the environment) once, when the scene is built."""
+    path = str(prim.GetPath())
+    when = f"snell sets {what} when the scene is built (time code {time.GetValue():g})"
+    for name in inputs:
+        attribute = prim.GetAttribute(f"inputs:{name}")
+        if attribute and attribute.ValueMightBeTimeVarying():
+            problems.warn(path, f"inputs:{name} is animated; {when}")
+    if UsdGeom.Xformable(prim).TransformMightBeTimeVarying():
+        problems.warn(path, f"it {turns} over time; {when}")
 
 
 def _distant_size(angle_degrees: float) -> float:
@@ -64,22 +91,11 @@ def read_light(prim: Usd.Prim, time: Usd.TimeCode, to_snell: np.ndarray, xform_c
     position = world[:3, 3]
     direction = world[:3, :3] @ np.array([0.0, 0.0, -1.0])  # UsdLux lights shine down their -Z
     direction /= max(np.linalg.norm(direction), 1e-30)
-    intensity = float(_value(api.GetIntensityAttr(), time, 1.0))
-    luminance = intensity * 2.0 ** float(_value(api.GetExposureAttr(), time, 0.0))
-    colour = np.array(_value(api.GetColorAttr(), time, (1.0, 1.0, 1.0)), float)
-    if _value(api.GetEnableColorTemperatureAttr(), time, False):
-        colour *= np.array(UsdLux.BlackbodyTemperatureAsRgb(float(_value(api.GetColorTemperatureAttr(), time, 6500.0))))
-    normalize = bool(_value(api.GetNormalizeAttr(), time, False))
-    for name in ("intensity", "exposure", "color"):
-        attribute = prim.GetAttribute(f"inputs:{name}")
-        if attribute and attribute.ValueMightBeTimeVarying():
-            problems.warn(path, f"inputs:{name} is animated; snell sets lights when the scene is built (time code "
-                                f"{time.GetValue():g})")
-    if UsdGeom.Xformable(prim).TransformMightBeTimeVarying():
-        problems.warn(path, "it moves over time; snell sets lights when the scene is built "
-                            f"(time code {time.GetValue():g})")
+    luminance, colour = emission(api, time)
+    normalize = bool(attribute_value(api.GetNormalizeAttr(), time, False))
+    warn_if_animated(prim, ("intensity", "exposure", "color"), "lights", "moves", time, problems)
     for name, fallback in (("diffuse", 1.0), ("specular", 1.0)):
-        value = _value(prim.GetAttribute(f"inputs:{name}"), time, fallback)
+        value = attribute_value(prim.GetAttribute(f"inputs:{name}"), time, fallback)
         if value != fallback:
             problems.warn(path, f"inputs:{name} is {value:g}; snell's lights light diffuse and specular alike")
     link = prim.GetAttribute("collection:lightLink:includeRoot")
@@ -88,29 +104,30 @@ def read_light(prim: Usd.Prim, time: Usd.TimeCode, to_snell: np.ndarray, xform_c
     colour_list = tuple(float(c) for c in colour)
 
     if prim.IsA(UsdLux.DistantLight):
-        angle = float(_value(UsdLux.DistantLight(prim).GetAngleAttr(), time, 0.53))
+        angle = float(attribute_value(UsdLux.DistantLight(prim).GetAngleAttr(), time, 0.53))
         lux = luminance if normalize else luminance * _distant_size(angle)
         light = Light(type="directional", color=colour_list, intensity=lux, direction=tuple(direction))
         return LightRecord(path, kind, light, f"directional, {lux:.4g} lux")
 
     area, shape = None, ""
     if prim.IsA(UsdLux.SphereLight):
-        r = float(_value(UsdLux.SphereLight(prim).GetRadiusAttr(), time, 0.5))
+        r = float(attribute_value(UsdLux.SphereLight(prim).GetRadiusAttr(), time, 0.5))
         area = 4.0 * math.pi * r * r * float(np.prod(axes)) ** (2.0 / 3.0)
     elif prim.IsA(UsdLux.RectLight):
         light = UsdLux.RectLight(prim)
-        if _value(light.GetTextureFileAttr(), time, None):
+        if attribute_value(light.GetTextureFileAttr(), time, None):
             problems.warn(path, "its texture is not drawn: snell's lights have one colour")
-        area = float(_value(light.GetWidthAttr(), time, 1.0)) * float(_value(light.GetHeightAttr(), time, 1.0))
+        width = float(attribute_value(light.GetWidthAttr(), time, 1.0))
+        area = width * float(attribute_value(light.GetHeightAttr(), time, 1.0))
         area *= axes[0] * axes[1]
         shape = "rect"
     elif prim.IsA(UsdLux.DiskLight):
-        r = float(_value(UsdLux.DiskLight(prim).GetRadiusAttr(), time, 0.5))
+        r = float(attribute_value(UsdLux.DiskLight(prim).GetRadiusAttr(), time, 0.5))
         area, shape = math.pi * r * r * axes[0] * axes[1], "disk"
     elif prim.IsA(UsdLux.CylinderLight):
         light = UsdLux.CylinderLight(prim)
-        r = float(_value(light.GetRadiusAttr(), time, 0.5))
-        length = float(_value(light.GetLengthAttr(), time, 1.0)) * axes[0]  # along its x axis
+        r = float(attribute_value(light.GetRadiusAttr(), time, 0.5))
+        length = float(attribute_value(light.GetLengthAttr(), time, 1.0)) * axes[0]  # along its x axis
         area = 2.0 * math.pi * r * math.sqrt(axes[1] * axes[2]) * length
         shape = "cylinder"
     else:
@@ -129,12 +146,12 @@ def read_light(prim: Usd.Prim, time: Usd.TimeCode, to_snell: np.ndarray, xform_c
                             "its intensity in every direction): its highlights are points, not discs")
     shaping = UsdLux.ShapingAPI(prim)
     if prim.HasAPI(UsdLux.ShapingAPI):
-        if _value(shaping.GetShapingIesFileAttr(), time, None):
+        if attribute_value(shaping.GetShapingIesFileAttr(), time, None):
             problems.warn(path, "its IES profile is not drawn")
-        if float(_value(shaping.GetShapingFocusAttr(), time, 0.0)) != 0.0:
+        if float(attribute_value(shaping.GetShapingFocusAttr(), time, 0.0)) != 0.0:
             problems.warn(path, "shaping:focus is not drawn")
-        cone = float(_value(shaping.GetShapingConeAngleAttr(), time, 90.0))
-        softness = min(max(float(_value(shaping.GetShapingConeSoftnessAttr(), time, 0.0)), 0.0), 1.0)
+        cone = float(attribute_value(shaping.GetShapingConeAngleAttr(), time, 90.0))
+        softness = min(max(float(attribute_value(shaping.GetShapingConeSoftnessAttr(), time, 0.0)), 0.0), 1.0)
         if cone <= 90.0:
             outer = math.radians(max(cone, 0.0))
             light = Light(type="spot", color=colour_list, intensity=candela, position=tuple(position),

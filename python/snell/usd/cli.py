@@ -98,17 +98,8 @@ def _level(text: str) -> int:
     return level
 
 
-def _positive(text: str) -> float:
-    try:
-        value = float(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"'{text}' is not a number") from None
-    if not np.isfinite(value) or value <= 0:
-        raise argparse.ArgumentTypeError(f"'{text}' must be a finite number above 0")
-    return value
-
-
-def _finite(text: str) -> float:
+def _number(text: str) -> float:
+    """A command-line number, finite."""
     try:
         value = float(text)
     except ValueError:
@@ -116,6 +107,14 @@ def _finite(text: str) -> float:
     if not np.isfinite(value):
         raise argparse.ArgumentTypeError(f"'{text}' must be finite")
     return value
+
+
+def _positive(text: str) -> float:
+    value = _number(text)
+    if value <= 0:
+        raise argparse.ArgumentTypeError(f"'{text}' must be a finite number above 0")
+    return value
+
 
 
 def _global_options(defaults: bool) -> argparse.ArgumentParser:
@@ -158,7 +157,7 @@ def _parser() -> argparse.ArgumentParser:
     info = commands.add_parser("info", parents=[common, reading], help="what snell reads from a stage",
                                description=INFO_DESCRIPTION, epilog=FOOTER,
                                formatter_class=argparse.RawDescriptionHelpFormatter)
-    info.add_argument("--time", type=_finite, metavar="T", help="the time code read (default: the stage's start)")
+    info.add_argument("--time", type=_number, metavar="T", help="the time code read (default: the stage's start)")
     info.add_argument("--json", action="store_true", help="print the listing as JSON")
 
     render = commands.add_parser("render", parents=[common, reading], help="render frames to EXR or PNG",
