@@ -17,6 +17,7 @@
 #pragma once
 
 #include <snell/defaults.h>
+#include <snell/host_device.h>
 #include <vulkan/vulkan.h>
 
 #include <array>
@@ -76,21 +77,6 @@ struct DeviceOptions {
   /// Enable the driver's ray tracing, for View::method "driver-rt" (the peer
   /// snell measures itself against; creation fails if the device lacks it).
   bool driverRayTracing = false;
-};
-
-/// A device a host application created, for snell to use and never destroy.
-/// The device must be Vulkan 1.3 with subgroupSizeControl, computeFullSubgroups
-/// and maintenance4 enabled (state them in `enabled13`), and `queue` must
-/// support compute and graphics. Host-owned buffers and images snell uses must
-/// be in `queueFamily` with exclusive sharing.
-struct HostDevice {
-  VkInstance instance = VK_NULL_HANDLE;
-  VkPhysicalDevice physicalDevice = VK_NULL_HANDLE;
-  VkDevice device = VK_NULL_HANDLE;
-  uint32_t queueFamily = 0;
-  VkQueue queue = VK_NULL_HANDLE;
-  /// What the host enabled of Vulkan 1.3 (its pNext is ignored).
-  VkPhysicalDeviceVulkan13Features enabled13{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_3_FEATURES};
 };
 
 /// The GPU snell runs on: its own, or the host's. Outlives every object made on it.

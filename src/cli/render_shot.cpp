@@ -213,13 +213,13 @@ void drawReference(const RenderOptions& o, const scene::Scene& scene,
 // The shot's settings from the command line.
 render::ShotSettings shotSettings(const RenderOptions& o, const scene::Scene& scene, double firstTime) {
   render::ShotSettings s;
-  s.width = o.shot.width;
-  s.height = o.shot.height;
+  s.frame.width = o.shot.width;
+  s.frame.height = o.shot.height;
   s.view = [&o, &scene](const scene::Pose& pose) { return o.shot.resolveView("render", scene, pose); };
-  s.background = o.shot.background;
-  s.backgroundAlpha = o.exr() ? 0.0f : 1.0f;  // an EXR's alpha is coverage: the raster clears it to 0
-  s.maxInterfaces = o.shot.maxInterfaces;
-  s.optics = o.optics;
+  s.frame.background = o.shot.background;
+  s.frame.backgroundAlpha = o.exr() ? 0.0f : 1.0f;  // an EXR's alpha is coverage: the raster clears it to 0
+  s.frame.maxInterfaces = o.shot.maxInterfaces;
+  s.frame.optics = o.optics;
   s.method = o.autoMethod ? std::string("auto") : std::string(render::methodName(*o.method));
   s.raster = o.raster;
   s.aov = o.exr();  // coverage (EXR alpha) comes from the trace's AOV

@@ -21,13 +21,6 @@ namespace snell::render {
 
 namespace {
 
-constexpr VkBufferUsageFlags kStorage =
-    VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT;
-
-vk::Buffer deviceBuffer(vk::Context& context, VkDeviceSize bytes, const std::string& name) {
-  return vk::Buffer(context, {std::max<VkDeviceSize>(bytes, 16), kStorage, vk::MemoryDomain::Device, name});
-}
-
 uint32_t flagsOf(const Bvh& bvh) { return bvh.leaves == BvhLeaves::Instances ? gpu::kBvhFlagInstances : 0u; }
 
 // One subgroup per workgroup for the passes that hand boxes from one
@@ -79,7 +72,7 @@ BvhBuilder::BvhBuilder(vk::Context& context, BvhTuning tuning)
                    {{gpu::kBvhSpecWorkgroupSize, tuning.refitWorkgroup ? tuning.refitWorkgroup : handOffWorkgroup(context)}});
   restructure_ = program("bvh restructure", kSpvBvhRestructure, {{gpu::kBvhSpecWorkgroupSize, handOffWorkgroup(context)}});
   quantise_ = program("bvh quantise", kSpvBvhQuantise, {{gpu::kBvhSpecWorkgroupSize, 64}});
-  placeholder_ = deviceBuffer(context, 16, "bvh placeholder");
+  placeholder_ = vk::storageBuffer(context, 16, "bvh placeholder");
 }
 
 BvhBuilder::~BvhBuilder() = default;
@@ -101,14 +94,14 @@ Bvh BvhBuilder::makeBvh(const std::vector<uint32_t>& groupSizes, BvhLeaves leave
   }
   bvh.primitiveCount = static_cast<uint32_t>(primitives);
   size_t groupCount = std::max<size_t>(groupSizes.size(), 1);
-  bvh.nodes = deviceBuffer(context_, primitives * sizeof(gpu::BvhNode), name + " nodes");
-  bvh.groups = deviceBuffer(context_, groupCount * sizeof(gpu::BvhGroup), name + " groups");
-  bvh.stats = deviceBuffer(context_, groupCount * 16, name + " SAH statistics");
-  bvh.dropped = deviceBuffer(context_, 4, name + " dropped triangles");
-  bvh.buildEntries = deviceBuffer(context_, groupCount * sizeof(gpu::BvhBuildEntry), name + " build list");
-  bvh.refitEntries = deviceBuffer(context_, groupCount * sizeof(gpu::BvhRefitEntry), name + " refit list");
+  bvh.nodes = vk::storageBuffer(context_, primitives * sizeof(gpu::BvhNode), name + " nodes");
+  bvh.groups = vk::storageBuffer(context_, groupCount * sizeof(gpu::BvhGroup), name + " groups");
+  bvh.stats = vk::storageBuffer(context_, groupCount * 16, name + " SAH statistics");
+  bvh.dropped = vk::storageBuffer(context_, 4, name + " dropped triangles");
+  bvh.buildEntries = vk::storageBuffer(context_, groupCount * sizeof(gpu::BvhBuildEntry), name + " build list");
+  bvh.refitEntries = vk::storageBuffer(context_, groupCount * sizeof(gpu::BvhRefitEntry), name + " refit list");
   // Every build and refit passes exact boxes up through them.
-  bvh.exactBoxes = deviceBuffer(context_, primitives * 24, name + " exact boxes");
+  bvh.exactBoxes = vk::storageBuffer(context_, primitives * 24, name + " exact boxes");
 
   std::vector<gpu::BvhGroup> groups(groupCount);
   for (size_t g = 0; g < groups.size(); ++g) {
@@ -139,11 +132,11 @@ void BvhBuilder::ensureScratch(vk::Commands& commands, uint64_t primitives) {
   if (scratch_) commands.keepAlive(scratch_);
   auto s = std::make_shared<Scratch>();
   s->primitives = std::max<uint64_t>(primitives, scratch_ ? scratch_->primitives : 0);
-  s->primBoxes = deviceBuffer(context_, s->primitives * 24, "bvh build primitive boxes");
-  s->keys = deviceBuffer(context_, s->primitives * 8, "bvh build keys");
-  s->values = deviceBuffer(context_, s->primitives * 4, "bvh build values");
-  s->parentIds = deviceBuffer(context_, s->primitives * 4, "bvh build meeting points");
-  s->clusters = deviceBuffer(context_, s->primitives * sizeof(gpu::BvhCluster), "bvh build clusters");
+  s->primBoxes = vk::storageBuffer(context_, s->primitives * 24, "bvh build primitive boxes");
+  s->keys = vk::storageBuffer(context_, s->primitives * 8, "bvh build keys");
+  s->values = vk::storageBuffer(context_, s->primitives * 4, "bvh build values");
+  s->parentIds = vk::storageBuffer(context_, s->primitives * 4, "bvh build meeting points");
+  s->clusters = vk::storageBuffer(context_, s->primitives * sizeof(gpu::BvhCluster), "bvh build clusters");
   scratch_ = std::move(s);
 }
 
@@ -255,8 +248,8 @@ void BvhBuilder::recordRestructure(vk::Commands& commands, Bvh& bvh, uint32_t en
   if (s.counters.size() < uint64_t(bvh.primitiveCount) * 4) {
     commands.keepAlive(std::make_shared<vk::Buffer>(std::move(s.counters)));  // an earlier round may use them
     commands.keepAlive(std::make_shared<vk::Buffer>(std::move(s.nodeStats)));
-    s.counters = deviceBuffer(context_, uint64_t(bvh.primitiveCount) * 4, "bvh restructure arrivals");
-    s.nodeStats = deviceBuffer(context_, uint64_t(bvh.primitiveCount) * 8, "bvh restructure subtree costs");
+    s.counters = vk::storageBuffer(context_, uint64_t(bvh.primitiveCount) * 4, "bvh restructure arrivals");
+    s.nodeStats = vk::storageBuffer(context_, uint64_t(bvh.primitiveCount) * 8, "bvh restructure subtree costs");
   }
   gpu::BvhPush push{primitives, entryCount, flagsOf(bvh), bvh.primitiveCount};
   commands.fillBuffer(s.counters, 0);

@@ -16,15 +16,6 @@ namespace snell::render {
 namespace {
 
 constexpr uint32_t kWorkgroupSize = 64;
-constexpr VkBufferUsageFlags kStorage =
-    VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT;
-
-template <typename T>
-vk::Buffer uploaded(vk::Context& context, const std::vector<T>& data, const std::string& name) {
-  vk::Buffer buffer(context, {std::max<VkDeviceSize>(data.size() * sizeof(T), 16), kStorage, vk::MemoryDomain::Device, name});
-  if (!data.empty()) vk::upload(context, buffer, data.data(), data.size() * sizeof(T));
-  return buffer;
-}
 
 }  // namespace
 
@@ -84,13 +75,13 @@ DeformPass::DeformPass(vk::Context& context, const scene::Scene& scene, const sc
     outputs_.push_back(out);
   }
   std::string name = scene.source.empty() ? std::string("scene") : scene.source;
-  restPositions_ = uploaded(context, restPositions, name + " rest positions");
-  restNormals_ = uploaded(context, restNormals, name + " rest normals");
-  morphDeltas_ = uploaded(context, morphDeltas, name + " morph deltas");
-  joints_ = uploaded(context, joints, name + " skin joints");
-  skinWeights_ = uploaded(context, skinWeights, name + " skin weights");
+  restPositions_ = vk::uploadedBuffer(context, restPositions, name + " rest positions");
+  restNormals_ = vk::uploadedBuffer(context, restNormals, name + " rest normals");
+  morphDeltas_ = vk::uploadedBuffer(context, morphDeltas, name + " morph deltas");
+  joints_ = vk::uploadedBuffer(context, joints, name + " skin joints");
+  skinWeights_ = vk::uploadedBuffer(context, skinWeights, name + " skin weights");
   auto device = [&](VkDeviceSize bytes, const std::string& what) {
-    return vk::Buffer(context, {std::max<VkDeviceSize>(bytes, 16), kStorage, vk::MemoryDomain::Device, name + " " + what});
+    return vk::storageBuffer(context, bytes, name + " " + what);
   };
   jobs_ = device(outputs_.size() * sizeof(gpu::DeformJob), "deform jobs");
   weights_ = device(weightCapacity * 4ull, "morph weights");
@@ -191,8 +182,7 @@ void DeformPass::recordCopies(vk::Commands& commands, vk::UploadArena& arena, co
   }
   if (jobs.empty()) return;
   if (copyJobs_.size() < jobs.size() * sizeof(gpu::DeformJob)) {
-    copyJobs_ = vk::Buffer(context_, {jobs.size() * sizeof(gpu::DeformJob), kStorage, vk::MemoryDomain::Device,
-                                      "vertex copy jobs"});
+    copyJobs_ = vk::storageBuffer(context_, jobs.size() * sizeof(gpu::DeformJob), "vertex copy jobs");
   }
   arena.copy(commands, jobs, copyJobs_);
   commands.transferToCompute();

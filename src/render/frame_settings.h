@@ -32,6 +32,10 @@ struct FrameSettings {
   scene::Optics optics;
   /// The composite's alpha where nothing is drawn (0: a host composites the image over its own).
   float backgroundAlpha = 1.0f;
+  /// A host draws the picture over its own: where the picture is the
+  /// composite, its background is 0 with alpha 0 (MethodChoice::view); the
+  /// trace's image, which has no coverage to show it by, keeps the background.
+  bool transparentBackground = false;
   /// Benchmarks only: a replay must follow a record of the same view and pose.
   HitReplay hitReplay = HitReplay::Off;
   friend bool operator==(const FrameSettings&, const FrameSettings&) = default;

@@ -168,7 +168,12 @@ Method MethodChoice::next() const {
 }
 
 ViewRequest MethodChoice::view(Method method, const FrameSettings& settings, const RasterOptions& raster) const {
-  return viewport_ ? methodViewport(method, settings, raster) : methodView(method, settings, raster);
+  ViewRequest view = viewport_ ? methodViewport(method, settings, raster) : methodView(method, settings, raster);
+  if (settings.transparentBackground && view.output == ViewOutput::Composite) {
+    view.settings.background = glm::vec3(0.0f);
+    view.settings.backgroundAlpha = 0.0f;
+  }
+  return view;
 }
 
 void MethodChoice::note(Method drawn, const std::vector<vk::PassTime>& passes) {

@@ -113,7 +113,8 @@ class MethodChoice {
   bool viewport() const { return viewport_; }
   /// The method the next frame draws with.
   Method next() const;
-  /// The view that draws `settings` with `method` (next()'s), as the caller shows it.
+  /// The view that draws `settings` with `method` (next()'s), as the caller
+  /// shows it (a composite's background made transparent where asked).
   ViewRequest view(Method method, const FrameSettings& settings, const RasterOptions& raster) const;
   /// A frame drawn with `drawn` is done: auto hears its pass times.
   void note(Method drawn, const std::vector<vk::PassTime>& passes);

@@ -14,8 +14,6 @@ namespace snell::render {
 namespace {
 
 constexpr uint32_t kWorkgroupSize = 64;
-constexpr VkBufferUsageFlags kStorage =
-    VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT;
 
 // Appends `values` to `out`; returns where they start.
 template <typename T>
@@ -71,21 +69,16 @@ RefinePass::RefinePass(vk::Context& context, const scene::Scene& scene, const Sc
                                " MiB; the device binds at most " +
                                std::to_string(context.caps().maxStorageBufferRange >> 20) + " MiB in one buffer");
     }
-    vk::Buffer buffer(context, {std::max<VkDeviceSize>(bytes, 16), kStorage, vk::MemoryDomain::Device, name + " " + what});
-    if (bytes) vk::upload(context, buffer, data.data(), bytes);
-    return buffer;
+    return vk::uploadedBuffer(context, data, name + " " + what);
   };
   words_ = uploaded(words, "refine tables");
   weights_ = uploaded(weights, "refine weights");
-  refined_ = vk::Buffer(context, {std::max<VkDeviceSize>(VkDeviceSize(refined) * 12, 16), kStorage,
-                                  vk::MemoryDomain::Device, name + " refined vertices"});
-  jobs_ = vk::Buffer(context, {std::max<VkDeviceSize>(shapes_.size() * sizeof(gpu::RefineJob), 16), kStorage,
-                               vk::MemoryDomain::Device, name + " refine jobs"});
+  refined_ = vk::storageBuffer(context, VkDeviceSize(refined) * 12, name + " refined vertices");
+  jobs_ = vk::storageBuffer(context, shapes_.size() * sizeof(gpu::RefineJob), name + " refine jobs");
   if (gpu.copiesHost()) {
     cage_ = &gpu.hostPositions;
   } else {
-    ownCage_ = vk::Buffer(context, {std::max<VkDeviceSize>(VkDeviceSize(cageVertices) * 12, 16), kStorage,
-                                    vk::MemoryDomain::Device, name + " subdivision cages"});
+    ownCage_ = vk::storageBuffer(context, VkDeviceSize(cageVertices) * 12, name + " subdivision cages");
     cage_ = &ownCage_;
   }
   auto program = [&](uint32_t stage, const char* what) {

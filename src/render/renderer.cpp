@@ -496,6 +496,13 @@ RefractionBake Renderer::bakeRefractionMap(const scene::Pose& pose, const FrameS
   return bake;
 }
 
+std::optional<RefractionBake> Renderer::keepRefractionMap(const scene::Pose& pose, const FrameSettings& settings,
+                                                          size_t view) {
+  const RefractionMapBuffer& kept = refractionMap(view);
+  if (kept.width == settings.width && kept.height == settings.height) return std::nullopt;
+  return bakeRefractionMap(pose, settings, view);
+}
+
 const RefractionMapBuffer& Renderer::refractionMap(size_t view) const {
   static const RefractionMapBuffer none;
   return view < maps_.size() ? maps_[view] : none;

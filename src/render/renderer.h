@@ -108,6 +108,11 @@ class Renderer {
   /// which that view reads where its RasterOptions name no map of their own,
   /// and redraws the views with it; the bake itself goes to the caller.
   RefractionBake bakeRefractionMap(const scene::Pose& pose, const FrameSettings& settings, size_t view = 0);
+  /// The refraction-map method's map for view `view`, baked from `settings`
+  /// at `pose` unless one of the view's size is kept: baked once, it is read
+  /// as the scene moves on (a caller that wants a new pose bakes anew). The
+  /// bake where it baked.
+  std::optional<RefractionBake> keepRefractionMap(const scene::Pose& pose, const FrameSettings& settings, size_t view = 0);
   /// The map kept for view `view` (0 x 0 before one is baked).
   const RefractionMapBuffer& refractionMap(size_t view = 0) const;
 

@@ -107,7 +107,7 @@ class Worker {
     report_.device = context_->facts().name;
     report_.why = device_.why.empty() ? context_->deviceWhy() : device_.why;
     choice_.emplace(settings_.method, context_->caps().driverRayTracing, settings_.viewport, settings_.frames);
-    checkImageSize(*context_, settings_.width, settings_.height);
+    checkImageSize(*context_, settings_.frame.width, settings_.frame.height);
     RendererOptions options;
     options.passTimes = settings_.passTimes || choice_->isAuto();  // timestamps only where someone reads them
     options.independentFrames = true;  // a frame's pixels are the same whichever worker, chunk or retry draws it
@@ -119,15 +119,14 @@ class Worker {
       // The trace bakes the map once, and every frame reads it as the scene moves on.
       if (!settings_.view) throw std::invalid_argument("shot: refraction-map bakes its map from ShotSettings::view");
       scene::Pose pose = scene::evaluate(scene_, settings_.bakeTime);
-      RefractionBake bake = renderer_->bakeRefractionMap(pose, frameSettings(settings_.view(pose)));
-      if (io_.baked) io_.baked(id_, bake);
+      std::optional<RefractionBake> bake = renderer_->keepRefractionMap(pose, frameSettings(settings_.view(pose)));
+      if (bake && io_.baked) io_.baked(id_, *bake);
     }
   }
 
   FrameSettings frameSettings(const scene::View& view) const {
-    FrameSettings s{settings_.width, settings_.height, view, settings_.background, settings_.maxInterfaces};
-    s.backgroundAlpha = settings_.backgroundAlpha;
-    s.optics = settings_.optics;
+    FrameSettings s = settings_.frame;
+    s.view = view;
     return s;
   }
 

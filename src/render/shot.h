@@ -57,13 +57,11 @@ struct ShotFrame {
 
 /// What every frame of the shot shares.
 struct ShotSettings {
-  uint32_t width = 0, height = 0;
+  /// Each frame's settings (size, background, interfaces, optics), its
+  /// camera apart: the frame's own, or `view`'s at its pose.
+  FrameSettings frame;
   /// The camera at a frame's pose where the frame names none.
   std::function<scene::View(const scene::Pose&)> view;
-  glm::vec3 background{0.0f};
-  float backgroundAlpha = 1.0f;
-  uint32_t maxInterfaces = gpu::kDefaultMaxInterfaces;
-  scene::Optics optics;
   /// auto or one of methods(); auto on more than one worker is trace (each
   /// device could time the two differently, and a shot's frames must agree).
   std::string method = "auto";

@@ -128,4 +128,61 @@ View resolveView(const Scene& scene, const Pose& pose, const ViewRequest& reques
                     "framed view of the scene");
 }
 
+// A camera frame from a host's view and projection matrices (OpenGL's
+// conventions). The trace's ray through a pixel (shared/trace.h) has slopes
+// sx = ndc.x * halfHeight * aspect + shift.x, sy = ndc.y * halfHeight + shift.y;
+// an off-centre projection is exactly such a window of slopes (perspective)
+// or of offsets (orthographic).
+View viewFromMatrices(const glm::dmat4& view, const glm::dmat4& projection, uint32_t width, uint32_t height) {
+  for (int c = 0; c < 4; ++c) {
+    for (int r = 0; r < 4; ++r) {
+      if (!std::isfinite(view[c][r]) || !std::isfinite(projection[c][r])) {
+        throw std::invalid_argument("view: the camera matrices are not finite");
+      }
+    }
+  }
+  glm::dmat4 toWorld = glm::inverse(view);
+  const glm::dmat4& p = projection;  // p[column][row]
+  View v;
+  v.description = "the host's camera matrices";
+  v.right = glm::dvec3(toWorld[0]);
+  v.up = glm::dvec3(toWorld[1]);
+  v.forward = -glm::dvec3(toWorld[2]);
+  v.eye = glm::dvec3(toWorld[3]);
+  double lr = glm::length(v.right), lu = glm::length(v.up), lf = glm::length(v.forward);
+  if (!(lr > 0.0 && lu > 0.0 && lf > 0.0) || !std::isfinite(lr * lu * lf)) {
+    throw std::invalid_argument("view: the view matrix is singular");
+  }
+  v.right /= lr, v.up /= lu, v.forward /= lf;
+  if (std::abs(glm::dot(v.right, v.up)) > 1e-4 || std::abs(glm::dot(v.right, v.forward)) > 1e-4 ||
+      std::abs(glm::dot(v.up, v.forward)) > 1e-4) {
+    throw std::invalid_argument("view: the view matrix shears (its axes are not at right angles)");
+  }
+  if (p[0][3] != 0.0 || p[1][3] != 0.0 || p[0][1] != 0.0 || p[1][0] != 0.0) {
+    throw std::invalid_argument(
+        "view: the projection is not a perspective or orthographic one (it mixes x and y, or x and y into w)");
+  }
+  bool perspective = p[2][3] < 0.0 && p[3][3] == 0.0;
+  v.orthographic = p[2][3] == 0.0 && p[3][3] != 0.0;
+  if (!perspective && !v.orthographic) {
+    throw std::invalid_argument("view: the projection is neither perspective (w = -z) nor orthographic (w = 1)");
+  }
+  if (!(p[0][0] > 0.0 && p[1][1] > 0.0)) throw std::invalid_argument("view: the projection flips or collapses x or y");
+  double w = perspective ? -p[2][3] : p[3][3];  // clip w per unit of -z, or the constant w
+  double sx = p[0][0] / w, sy = p[1][1] / w;
+  double aspect = double(width) / double(height);
+  if (std::abs(sy / sx / aspect - 1.0) > 1e-3) {
+    throw std::invalid_argument("view: the projection's aspect " + std::to_string(sy / sx) + " is not the view's " +
+                std::to_string(width) + "x" + std::to_string(height) + " (" + std::to_string(aspect) +
+                "): snell's pixels are square");
+  }
+  v.halfHeight = 1.0 / sy;
+  if (perspective) {
+    v.shift = glm::dvec2(p[2][0] / p[0][0], p[2][1] / p[1][1]);
+  } else {
+    v.shift = glm::dvec2(-p[3][0] / p[0][0], -p[3][1] / p[1][1]);
+  }
+  return v;
+}
+
 }  // namespace snell::scene

@@ -52,6 +52,13 @@ struct View {
 /// camera index does not exist or no node carries it, or the look-at is degenerate.
 View resolveView(const Scene& scene, const Pose& pose, const ViewRequest& request);
 
+/// A camera from a host's view matrix (world to camera) and projection, in
+/// OpenGL's conventions (a camera looking down -z), for a width x height image:
+/// a perspective or an orthographic projection, off-centre or not. Throws
+/// std::invalid_argument saying what the matrices are not: finite, rigid, such
+/// a projection, of the image's aspect (snell's pixels are square).
+View viewFromMatrices(const glm::dmat4& view, const glm::dmat4& projection, uint32_t width, uint32_t height);
+
 /// World-space bounds of everything drawn at the pose (deformation included);
 /// an empty scene gives min > max.
 void sceneBounds(const Scene& scene, const Pose& pose, glm::dvec3& lo, glm::dvec3& hi);

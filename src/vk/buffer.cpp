@@ -12,7 +12,7 @@ namespace snell::vk {
 namespace {
 
 VkDeviceMemory allocate(Context& context, const VkMemoryRequirements& needs, MemoryDomain domain, const std::string& name,
-                        bool deviceAddress = false) {
+                        bool deviceAddress = false, const void* next = nullptr) {
   VkMemoryPropertyFlags required = 0;
   VkMemoryPropertyFlags preferred = 0;
   switch (domain) {
@@ -39,7 +39,8 @@ VkDeviceMemory allocate(Context& context, const VkMemoryRequirements& needs, Mem
   VkMemoryAllocateFlagsInfo flags{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_FLAGS_INFO};
   flags.flags = VK_MEMORY_ALLOCATE_DEVICE_ADDRESS_BIT;
   VkMemoryAllocateInfo info{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
-  info.pNext = deviceAddress ? &flags : nullptr;
+  flags.pNext = next;
+  info.pNext = deviceAddress ? &flags : next;
   info.allocationSize = needs.size;
   info.memoryTypeIndex = type;
   VkDeviceMemory memory = context.allocateMemory(info, name);
@@ -149,6 +150,9 @@ Image::Image(Context& context, const ImageDesc& desc)
   info.tiling = VK_IMAGE_TILING_OPTIMAL;
   info.usage = desc.usage;
   info.initialLayout = VK_IMAGE_LAYOUT_UNDEFINED;
+  VkExternalMemoryImageCreateInfo external{VK_STRUCTURE_TYPE_EXTERNAL_MEMORY_IMAGE_CREATE_INFO};
+  external.handleTypes = VK_EXTERNAL_MEMORY_HANDLE_TYPE_OPAQUE_FD_BIT;
+  if (desc.exportable) info.pNext = &external;
   VkImageFormatProperties limits{};
   VkResult supported = vkGetPhysicalDeviceImageFormatProperties(context.physicalDevice(), info.format, info.imageType,
                                                                 info.tiling, info.usage, 0, &limits);
@@ -161,9 +165,14 @@ Image::Image(Context& context, const ImageDesc& desc)
   }
   VK_CHECK(vkCreateImage(context.device(), &info, nullptr, &image_));
   try {
-    VkMemoryRequirements needs{};
-    vkGetImageMemoryRequirements(context.device(), image_, &needs);
-    memory_ = allocate(context, needs, MemoryDomain::Device, desc.name);
+    if (desc.exportable) {
+      allocateExportable(context, desc.name);
+    } else {
+      VkMemoryRequirements needs{};
+      vkGetImageMemoryRequirements(context.device(), image_, &needs);
+      memory_ = allocate(context, needs, MemoryDomain::Device, desc.name);
+      memorySize_ = needs.size;
+    }
     VK_CHECK(vkBindImageMemory(context.device(), image_, memory_, 0));
     VkImageViewCreateInfo viewInfo{VK_STRUCTURE_TYPE_IMAGE_VIEW_CREATE_INFO};
     viewInfo.image = image_;
@@ -177,6 +186,33 @@ Image::Image(Context& context, const ImageDesc& desc)
   }
   context.setName(VK_OBJECT_TYPE_IMAGE, image_, desc.name);
   context.setName(VK_OBJECT_TYPE_IMAGE_VIEW, view_, desc.name + " view");
+}
+
+// Exported memory is allocated for export, and on its own where the driver
+// prefers it (an importer must say the same of it).
+void Image::allocateExportable(Context& context, const std::string& name) {
+  VkMemoryDedicatedRequirements dedicatedNeeds{VK_STRUCTURE_TYPE_MEMORY_DEDICATED_REQUIREMENTS};
+  VkMemoryRequirements2 needs{VK_STRUCTURE_TYPE_MEMORY_REQUIREMENTS_2, &dedicatedNeeds};
+  VkImageMemoryRequirementsInfo2 which{VK_STRUCTURE_TYPE_IMAGE_MEMORY_REQUIREMENTS_INFO_2};
+  which.image = image_;
+  vkGetImageMemoryRequirements2(context.device(), &which, &needs);
+  dedicated_ = dedicatedNeeds.prefersDedicatedAllocation || dedicatedNeeds.requiresDedicatedAllocation;
+  VkMemoryDedicatedAllocateInfo dedicatedInfo{VK_STRUCTURE_TYPE_MEMORY_DEDICATED_ALLOCATE_INFO};
+  dedicatedInfo.image = image_;
+  VkExportMemoryAllocateInfo exportInfo{VK_STRUCTURE_TYPE_EXPORT_MEMORY_ALLOCATE_INFO, dedicated_ ? &dedicatedInfo : nullptr};
+  exportInfo.handleTypes = VK_EXTERNAL_MEMORY_HANDLE_TYPE_OPAQUE_FD_BIT;
+  memory_ = allocate(context, needs.memoryRequirements, MemoryDomain::Device, name, false, &exportInfo);
+  memorySize_ = needs.memoryRequirements.size;
+}
+
+int Image::exportMemory() const {
+  auto getFd = context_->deviceFunction<PFN_vkGetMemoryFdKHR>("vkGetMemoryFdKHR");
+  VkMemoryGetFdInfoKHR info{VK_STRUCTURE_TYPE_MEMORY_GET_FD_INFO_KHR};
+  info.memory = memory_;
+  info.handleType = VK_EXTERNAL_MEMORY_HANDLE_TYPE_OPAQUE_FD_BIT;
+  int fd = -1;
+  VK_CHECK(getFd(context_->device(), &info, &fd));
+  return fd;
 }
 
 Image::~Image() { release(); }
@@ -194,6 +230,8 @@ Image& Image::operator=(Image&& other) noexcept {
     width_ = other.width_;
     height_ = other.height_;
     name_ = std::move(other.name_);
+    memorySize_ = other.memorySize_;
+    dedicated_ = other.dedicated_;
   }
   return *this;
 }
@@ -211,6 +249,61 @@ void Image::release() {
     context->freeMemory(memory);
   });
   context_ = nullptr;
+}
+
+ExportableSemaphore::ExportableSemaphore(Context& context, const std::string& name) : context_(&context) {
+  if (!exportsSemaphores(context)) {
+    throw VulkanError(context.facts().name + " cannot export semaphores as file descriptors (VK_KHR_external_semaphore_fd)");
+  }
+  VkExportSemaphoreCreateInfo exportInfo{VK_STRUCTURE_TYPE_EXPORT_SEMAPHORE_CREATE_INFO};
+  exportInfo.handleTypes = VK_EXTERNAL_SEMAPHORE_HANDLE_TYPE_OPAQUE_FD_BIT;
+  VkSemaphoreCreateInfo info{VK_STRUCTURE_TYPE_SEMAPHORE_CREATE_INFO, &exportInfo};
+  VK_CHECK(vkCreateSemaphore(context.device(), &info, nullptr, &semaphore_));
+  context.setName(VK_OBJECT_TYPE_SEMAPHORE, semaphore_, name);
+}
+
+ExportableSemaphore::~ExportableSemaphore() { release(); }
+
+ExportableSemaphore::ExportableSemaphore(ExportableSemaphore&& other) noexcept { *this = std::move(other); }
+
+ExportableSemaphore& ExportableSemaphore::operator=(ExportableSemaphore&& other) noexcept {
+  if (this != &other) {
+    release();
+    context_ = std::exchange(other.context_, nullptr);
+    semaphore_ = std::exchange(other.semaphore_, VK_NULL_HANDLE);
+  }
+  return *this;
+}
+
+void ExportableSemaphore::release() {
+  if (!context_) return;
+  VkDevice device = context_->device();
+  VkSemaphore semaphore = std::exchange(semaphore_, VK_NULL_HANDLE);
+  if (semaphore) context_->retire([device, semaphore] { vkDestroySemaphore(device, semaphore, nullptr); });
+  context_ = nullptr;
+}
+
+int ExportableSemaphore::exportFd() const {
+  auto getFd = context_->deviceFunction<PFN_vkGetSemaphoreFdKHR>("vkGetSemaphoreFdKHR");
+  VkSemaphoreGetFdInfoKHR info{VK_STRUCTURE_TYPE_SEMAPHORE_GET_FD_INFO_KHR};
+  info.semaphore = semaphore_;
+  info.handleType = VK_EXTERNAL_SEMAPHORE_HANDLE_TYPE_OPAQUE_FD_BIT;
+  int fd = -1;
+  VK_CHECK(getFd(context_->device(), &info, &fd));
+  return fd;
+}
+
+bool exportsSemaphores(const Context& context) {
+  if (!context.enabled(VK_KHR_EXTERNAL_SEMAPHORE_FD_EXTENSION_NAME)) return false;
+  VkPhysicalDeviceExternalSemaphoreInfo info{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_EXTERNAL_SEMAPHORE_INFO};
+  info.handleType = VK_EXTERNAL_SEMAPHORE_HANDLE_TYPE_OPAQUE_FD_BIT;
+  VkExternalSemaphoreProperties properties{VK_STRUCTURE_TYPE_EXTERNAL_SEMAPHORE_PROPERTIES};
+  vkGetPhysicalDeviceExternalSemaphoreProperties(context.physicalDevice(), &info, &properties);
+  return (properties.externalSemaphoreFeatures & VK_EXTERNAL_SEMAPHORE_FEATURE_EXPORTABLE_BIT) != 0;
+}
+
+Buffer storageBuffer(Context& context, VkDeviceSize bytes, const std::string& name) {
+  return Buffer(context, {std::max<VkDeviceSize>(bytes, 16), BufferDesc{}.usage, MemoryDomain::Device, name});
 }
 
 uint32_t formatBytes(VkFormat format) {

@@ -1,5 +1,6 @@
-// RAII buffers and images with memory domains. Destruction is deferred until
-// the GPU has finished every submission made before it.
+// RAII buffers and images with memory domains, and the exportable semaphores
+// a host shares frames by. Destruction is deferred until the GPU has finished
+// every submission made before it.
 #pragma once
 
 #include "vk/context.h"
@@ -74,7 +75,15 @@ struct ImageDesc {
   VkImageUsageFlags usage =
       VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT;
   std::string name;
+  /// Its memory can be handed to another API (OpenGL, another Vulkan) as an
+  /// opaque file descriptor (VK_KHR_external_memory_fd, which the context
+  /// must have enabled): Image::exportMemory.
+  bool exportable = false;
 };
+
+/// A device-local storage buffer (transfers both ways) of `bytes`, or of 16
+/// where there are none: Vulkan has no empty buffers.
+Buffer storageBuffer(Context& context, VkDeviceSize bytes, const std::string& name);
 
 /// The aspect of an image of `format`: depth for D32_SFLOAT, else colour.
 VkImageAspectFlags aspectOf(VkFormat format);
@@ -102,7 +111,15 @@ class Image {
   /// Bytes one pixel takes in the formats snell uses.
   uint32_t bytesPerPixel() const;
 
+  /// An exportable image's memory as a new file descriptor the caller owns
+  /// (an importer takes it over); its size and whether it is a dedicated
+  /// allocation, which an importer must state to match.
+  int exportMemory() const;
+  VkDeviceSize memorySize() const { return memorySize_; }
+  bool dedicatedMemory() const { return dedicated_; }
+
  private:
+  void allocateExportable(Context& context, const std::string& name);
   void release();
   Context* context_ = nullptr;
   VkImage image_ = VK_NULL_HANDLE;
@@ -112,6 +129,35 @@ class Image {
   uint32_t width_ = 0;
   uint32_t height_ = 0;
   std::string name_;
+  VkDeviceSize memorySize_ = 0;
+  bool dedicated_ = false;
 };
+
+/// A binary semaphore another API (OpenGL, another Vulkan) can wait on and
+/// signal: exportable as an opaque file descriptor (VK_KHR_external_semaphore_fd).
+class ExportableSemaphore {
+ public:
+  ExportableSemaphore() = default;
+  /// Throws VulkanError where the context cannot export semaphores (exportsSemaphores).
+  ExportableSemaphore(Context& context, const std::string& name);
+  ~ExportableSemaphore();
+  ExportableSemaphore(ExportableSemaphore&& other) noexcept;
+  ExportableSemaphore& operator=(ExportableSemaphore&& other) noexcept;
+  ExportableSemaphore(const ExportableSemaphore&) = delete;
+  ExportableSemaphore& operator=(const ExportableSemaphore&) = delete;
+
+  VkSemaphore handle() const { return semaphore_; }
+  /// A new file descriptor the caller owns, which an importer takes over.
+  int exportFd() const;
+
+ private:
+  void release();
+  Context* context_ = nullptr;
+  VkSemaphore semaphore_ = VK_NULL_HANDLE;
+};
+
+/// Whether `context` can export semaphores as opaque file descriptors: the
+/// extension is enabled and the driver exports that handle type.
+bool exportsSemaphores(const Context& context);
 
 }  // namespace snell::vk

@@ -145,6 +145,13 @@ class Commands {
 /// Copies bytes into a buffer: directly when it is mapped, else through a staging
 /// buffer and a submission that is waited for.
 void upload(Context& context, const Buffer& destination, const void* data, VkDeviceSize bytes, VkDeviceSize offset = 0);
+/// A storage buffer (storageBuffer) holding `data`.
+template <typename T>
+Buffer uploadedBuffer(Context& context, const std::vector<T>& data, const std::string& name) {
+  Buffer buffer = storageBuffer(context, data.size() * sizeof(T), name);
+  if (!data.empty()) upload(context, buffer, data.data(), data.size() * sizeof(T));
+  return buffer;
+}
 /// Copies a buffer's first `bytes` to host memory, through a readback buffer.
 void download(Context& context, const Buffer& source, void* data, VkDeviceSize bytes, VkDeviceSize offset = 0);
 /// Fills a whole image from tightly packed pixels; leaves it in GENERAL layout.

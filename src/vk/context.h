@@ -2,7 +2,9 @@
 // created by snell or adopted from a host application that keeps ownership.
 #pragma once
 
+#include "snell/host_device.h"
 #include "vk/device_selection.h"
+#include "vk/error.h"
 #include "vk/pipeline_cache.h"
 
 #include <vulkan/vulkan.h>
@@ -67,17 +69,10 @@ struct ContextDesc {
   bool robustBufferAccess = false;
 };
 
-/// Handles a host application created; snell uses them and never destroys them.
-/// The device must have been created with Vulkan 1.3 and its features
-/// subgroupSizeControl, computeFullSubgroups and maintenance4 enabled, on a queue family with
-/// compute; `enabled13` states what the host enabled so snell can check it.
-struct AdoptedDevice {
-  VkInstance instance = VK_NULL_HANDLE;
-  VkPhysicalDevice physicalDevice = VK_NULL_HANDLE;
-  VkDevice device = VK_NULL_HANDLE;
-  uint32_t queueFamily = 0;
-  VkQueue queue = VK_NULL_HANDLE;
-  VkPhysicalDeviceVulkan13Features enabled13{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_3_FEATURES};
+/// Handles a host application created (snell::HostDevice, whose rules hold);
+/// snell uses them and never destroys them. `enabled13` states what the host
+/// enabled so snell can check it.
+struct AdoptedDevice : snell::HostDevice {
   /// Whether the host enabled fillModeNonSolid (snell's wireframes need it).
   bool fillModeNonSolid = false;
 };
@@ -184,6 +179,15 @@ class Context {
   /// Memory type for `typeBits` with `required` flags, preferring `preferred`;
   /// UINT32_MAX when none has them.
   uint32_t findMemoryType(uint32_t typeBits, VkMemoryPropertyFlags required, VkMemoryPropertyFlags preferred) const;
+
+  /// A device-level entry point of an enabled extension; throws VulkanError
+  /// naming it where the driver has none.
+  template <typename Function>
+  Function deviceFunction(const char* name) const {
+    auto f = reinterpret_cast<Function>(vkGetDeviceProcAddr(device_, name));
+    if (!f) throw VulkanError(std::string(name) + " is missing: its extension is not enabled on " + facts_.name);
+    return f;
+  }
 
   /// vkAllocateMemory with snell's accounting: memory in the device-local heaps
   /// counts against memoryLimit(), and an allocation past it, or one the driver

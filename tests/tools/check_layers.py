@@ -62,9 +62,10 @@ def layer_of_folder(relative: str) -> int | None:
     return None
 
 
-# Leaf headers of the public API that state shared defaults and include
-# nothing: they sit in the bottom layer, so any layer may include them.
-SHARED_PUBLIC = {"snell/defaults.h"}
+# Leaf headers of the public API that every layer shares (the defaults, and
+# the handles of a host's device), including none of snell's: they sit in the
+# bottom layer, so any layer may include them.
+SHARED_PUBLIC = {"snell/defaults.h", "snell/host_device.h"}
 
 
 def layer_of_include(target: str) -> int | None:
