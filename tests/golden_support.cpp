@@ -85,10 +85,7 @@ scene::Scene eyeWithoutCorneaTip() {
 scene::Scene prismScene() {
   scene::Scene s;
   s.source = "prism";
-  scene::Material glass;
-  glass.name = "glass";
-  glass.transmission = 1.0f;
-  glass.ior = 1.5f;
+  scene::Material glass = scene::clearGlass("glass", 1.5f);
   scene::Material red, blue, green;
   red.baseColorFactor = {0.9f, 0.15f, 0.1f, 1};
   blue.baseColorFactor = {0.1f, 0.2f, 0.9f, 1};
@@ -167,10 +164,7 @@ scene::Scene iorStepScene() {
     checker.rgba.insert(checker.rgba.end(), {v, uint8_t(v / 2), uint8_t(255 - v), 255});
   }
   s.textures = {step, checker};
-  scene::Material glass;
-  glass.name = "stepped glass";
-  glass.transmission = 1.0f;
-  glass.ior = 1.0f;
+  scene::Material glass = scene::clearGlass("stepped glass", 1.0f);
   glass.iorTexture.texture = 0;
   glass.iorScale = 0.5f;
   scene::Material wall;
@@ -202,10 +196,7 @@ render::CompositeFrame compositeOf(render::Renderer& renderer, const scene::Pose
 }
 
 void addGlassBox(scene::Scene& s, glm::vec3 lo, glm::vec3 hi, float ior) {
-  scene::Material glass;
-  glass.name = "glass box";
-  glass.transmission = 1.0f;
-  glass.ior = ior;
+  scene::Material glass = scene::clearGlass("glass box", ior);
   s.materials.push_back(glass);
   std::vector<glm::vec3> positions;
   std::vector<uint32_t> indices;

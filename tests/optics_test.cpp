@@ -69,10 +69,7 @@ scene::Scene slabScene(scene::Material glass) {
 }
 
 scene::Material glassOf(float ior) {
-  scene::Material glass;
-  glass.name = "glass";
-  glass.transmission = 1.0f;
-  glass.ior = ior;
+  scene::Material glass = scene::clearGlass("glass", ior);
   return glass;
 }
 

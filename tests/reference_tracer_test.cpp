@@ -520,13 +520,19 @@ TEST(ReferenceTracer, MorphedItemIsTracedWhereItsTargetsMoveIt) {
   EXPECT_NEAR(image.distance[image.index(1, 1)], 2.0 - 0.75, 1e-12);
 }
 
+// The reference's settings for a width x height picture of `scene` at `pose`, framed as snell frames it.
+ref::ReferenceSettings framed(const scene::Scene& scene, const scene::Pose& pose, uint32_t width, uint32_t height) {
+  ref::ReferenceSettings settings;
+  settings.width = width;
+  settings.height = height;
+  settings.view = scene::resolveView(scene, pose, {});
+  return settings;
+}
+
 TEST(ReferenceTracer, ThreadCountDoesNotChangeTheImage) {
   scene::Scene eye = scene::makeEye({.resolution = 16});
   scene::Pose pose = scene::evaluate(eye, 0.0);
-  ref::ReferenceSettings settings;
-  settings.width = 32;
-  settings.height = 24;
-  settings.view = scene::resolveView(eye, pose, {});
+  ref::ReferenceSettings settings = framed(eye, pose, 32, 24);
   settings.threads = 1;
   ref::ReferenceImage one = ref::renderReference(eye, pose, settings);
   settings.threads = 3;
@@ -539,11 +545,7 @@ TEST(ReferenceTracer, ThreadCountDoesNotChangeTheImage) {
 TEST(ReferenceTracer, ProceduralEyeShowsTheIrisThroughTheCorneaWithoutNaN) {
   scene::Scene eye = scene::makeEye({.resolution = 16});
   scene::Pose pose = scene::evaluate(eye, 0.0);
-  ref::ReferenceSettings settings;
-  settings.width = 64;
-  settings.height = 48;
-  settings.view = scene::resolveView(eye, pose, {});
-  ref::ReferenceImage image = ref::renderReference(eye, pose, settings);
+  ref::ReferenceImage image = ref::renderReference(eye, pose, framed(eye, pose, 64, 48));
   // The cornea's tip is one refractive surface over the iris: a ray crosses
   // it once and ends on the iris or pupil behind it.
   size_t throughCornea = 0, opaque = 0;

@@ -215,10 +215,7 @@ class CorneaLens : public GpuTest {
   Parity parity(uint32_t level, scene::SubdivisionNormals normals) {
     scene::Scene s;
     s.source = "a cornea over a checkerboard";
-    scene::Material glass;
-    glass.name = "cornea";
-    glass.transmission = 1.0f;
-    glass.ior = 1.376f;
+    scene::Material glass = scene::clearGlass("cornea", 1.376f);
     scene::SubdivisionCage cage = stress::corneaCage(6, 24, 1.0f, 0.5f, level);
     cage.normals = normals;
     scene::Shape cornea;

@@ -112,10 +112,7 @@ TEST_F(SingleSided, ARayThroughGlassPassesABackFaceAsARayWithoutGlassDoes) {
   // A pane of glass of IOR 1 before the quad's back: nothing bends, so what
   // lies behind is what no pane would show.
   scene::Scene s = quadBetweenWalls(false);
-  scene::Material glass;
-  glass.name = "glass";
-  glass.transmission = 1.0f;
-  glass.ior = 1.0f;
+  scene::Material glass = scene::clearGlass("glass", 1.0f);
   scene::Shape pane;
   pane.name = "pane";
   scene::addQuad(pane, {-1, -1, -1}, {-1, 1, -1}, {1, 1, -1}, {1, -1, -1});

@@ -134,10 +134,7 @@ double changed(const io::Rgb8Image& a, const io::Rgb8Image& b) {
 // A slab of glass before the wall, its faces rippled by a normal map (or not).
 scene::Scene rippledGlass(bool mapped) {
   scene::Scene s = wallScene(mapped ? "rippled glass" : "flat glass");
-  scene::Material glass;
-  glass.name = "glass";
-  glass.transmission = 1.0f;
-  glass.ior = 1.5f;
+  scene::Material glass = scene::clearGlass("glass", 1.5f);
   if (mapped) {
     glass.normalTexture.texture = addTextureTo(s, ripples(64, 0.6));
     glass.normalScale = 0.8f;

@@ -46,18 +46,23 @@ scene::Texture checker(uint32_t size, uint32_t seed) {
   return t;
 }
 
+// A material lit by texture `texture` alone: black, the texture its emission.
+scene::Material litByTexture(const std::string& name, int texture = 0) {
+  scene::Material m;
+  m.name = name;
+  m.baseColorFactor = {0, 0, 0, 1};
+  m.emissiveFactor = glm::vec3(1.0f);
+  m.emissiveTexture.texture = texture;
+  return m;
+}
+
 // `count` quads side by side facing +Z, quad i self-lit by texture i.
 scene::Scene texturedQuads(uint32_t count, uint32_t size) {
   scene::Scene s;
   s.source = "textured quads";
   for (uint32_t i = 0; i < count; ++i) {
     s.textures.push_back(checker(size, i));
-    scene::Material m;
-    m.name = "quad " + std::to_string(i);
-    m.baseColorFactor = {0, 0, 0, 1};
-    m.emissiveFactor = glm::vec3(1.0f);
-    m.emissiveTexture.texture = int(i);
-    s.materials.push_back(m);
+    s.materials.push_back(litByTexture("quad " + std::to_string(i), int(i)));
     float x = 2.2f * (float(i) - 0.5f * float(count - 1));
     // addFlatShape's uv is (x / 2 + 0.5, y / 2 + 0.5): the quad spans [-1, 1] before it moves.
     addFlatShape(s, {{-1, -1, 0}, {1, -1, 0}, {1, 1, 0}, {-1, 1, 0}}, {0, 1, 2, 0, 2, 3}, int(i),
@@ -233,11 +238,7 @@ FloorShot checkerFloor(bool slab) {
   scene::Scene& s = shot.scene;
   s.source = slab ? "checker floor behind glass" : "checker floor";
   s.textures.push_back(checkerboard(64, 8));
-  scene::Material floor;
-  floor.name = "floor";
-  floor.baseColorFactor = {0, 0, 0, 1};
-  floor.emissiveFactor = glm::vec3(1.0f);
-  floor.emissiveTexture.texture = 0;
+  scene::Material floor = litByTexture("floor");
   floor.doubleSided = true;  // laid down below, it faces the ground
   s.materials.push_back(floor);
   // addFlatShape's uv is (x / 2 + 0.5, y / 2 + 0.5) before the node moves
@@ -322,18 +323,10 @@ FloorShot magnifiedCard(bool lens) {
   scene::Scene& s = shot.scene;
   s.source = lens ? "a card behind a magnifying ball" : "a card";
   s.textures.push_back(checkerboard(128, 4));
-  scene::Material card;
-  card.name = "card";
-  card.baseColorFactor = {0, 0, 0, 1};
-  card.emissiveFactor = glm::vec3(1.0f);
-  card.emissiveTexture.texture = 0;
-  s.materials.push_back(card);
+  s.materials.push_back(litByTexture("card"));
   addFlatShape(s, {{-3, -3, -1.3f}, {3, -3, -1.3f}, {3, 3, -1.3f}, {-3, 3, -1.3f}}, {0, 1, 2, 0, 2, 3}, 0);
   if (lens) {
-    scene::Material glass;
-    glass.name = "magnifier";
-    glass.transmission = 1.0f;
-    glass.ior = 1.5f;
+    scene::Material glass = scene::clearGlass("magnifier", 1.5f);
     scene::Shape ball = scene::uvSphere(96, 1.0f);
     ball.material = scene::addMaterial(s, glass);
     scene::addRootShape(s, ball);

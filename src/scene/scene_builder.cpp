@@ -9,6 +9,14 @@
 
 namespace snell::scene {
 
+Material clearGlass(const std::string& name, float ior) {
+  Material m;
+  m.name = name;
+  m.transmission = 1.0f;
+  m.ior = ior;
+  return m;
+}
+
 int addMaterial(Scene& scene, const Material& material) {
   scene.materials.push_back(material);
   return int(scene.materials.size()) - 1;

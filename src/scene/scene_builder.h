@@ -8,10 +8,13 @@
 #include <glm/glm.hpp>
 
 #include <cstdint>
+#include <string>
 #include <vector>
 
 namespace snell::scene {
 
+/// Clear glass called `name`: transmission 1 at `ior`, glTF's defaults otherwise.
+Material clearGlass(const std::string& name, float ior);
 /// Appends `material`; returns its index.
 int addMaterial(Scene& scene, const Material& material);
 /// Appends `shape` in a mesh of its own under a root node placed by `world`;

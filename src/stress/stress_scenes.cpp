@@ -8,16 +8,15 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <string>
+#include <utility>
 
 namespace snell::stress {
 
 namespace {
 
 scene::Material glass(float ior) {
-  scene::Material m;
-  m.name = "glass";
-  m.transmission = 1.0f;
-  m.ior = ior;
+  scene::Material m = scene::clearGlass("glass", ior);
   m.baseColorFactor = {0.95f, 0.97f, 1.0f, 1.0f};
   return m;
 }
@@ -109,22 +108,28 @@ void addIorTexture(scene::Material& m, int texture) {
   m.iorScale = 0.05f;
 }
 
-scene::Scene sphereScene(uint32_t segments, float ior) {
+namespace {
+
+// One glass shape (its material the first) over the checker backdrop, as
+// most of the grid's cases are.
+scene::Scene glassOverBackdrop(const std::string& source, scene::Shape shape, float ior, float half, float depth) {
   scene::Scene s;
-  s.source = "stress sphere";
-  scene::Shape shape = scene::uvSphere(segments, 1.0f);
+  s.source = source;
   shape.material = scene::addMaterial(s, glass(ior));
   scene::addRootShape(s, shape);
-  addBackdrop(s, 3.0f, -3.0f);
+  addBackdrop(s, half, depth);
   return s;
 }
 
+}  // namespace
+
+scene::Scene sphereScene(uint32_t segments, float ior) {
+  return glassOverBackdrop("stress sphere", scene::uvSphere(segments, 1.0f), ior, 3.0f, -3.0f);
+}
+
 scene::Scene cubeScene(uint32_t n, float ior) {
-  scene::Scene s;
-  s.source = "stress cube";
   scene::Shape shape;
   shape.name = "cube";
-  shape.material = scene::addMaterial(s, glass(ior));
   // Six faces, each an (n+1)^2 vertex grid; the faces' border vertices are
   // welded so that the cube is one closed, indexed surface.
   auto vertex = [&](glm::vec3 p) {
@@ -157,17 +162,12 @@ scene::Scene cubeScene(uint32_t n, float ior) {
   // Smooth normals (addShape averages them): flat ones would need split
   // vertices, which open the cube. Near its edges the interpolated normal
   // bends rays as a slightly rounded cube would; both tracers see the same.
-  scene::addRootShape(s, shape);
-  addBackdrop(s, 4.0f, -4.0f);
-  return s;
+  return glassOverBackdrop("stress cube", std::move(shape), ior, 4.0f, -4.0f);
 }
 
 scene::Scene slabScene(float thickness, float ior) {
-  scene::Scene s;
-  s.source = "stress slab";
   scene::Shape shape;
   shape.name = "slab";
-  shape.material = scene::addMaterial(s, glass(ior));
   float t = thickness;
   glm::vec3 c[8] = {{-1, -1, 0}, {1, -1, 0}, {1, 1, 0}, {-1, 1, 0}, {-1, -1, t}, {1, -1, t}, {1, 1, t}, {-1, 1, t}};
   shape.positions.assign(c, c + 8);
@@ -178,17 +178,12 @@ scene::Scene slabScene(float thickness, float ior) {
   shape.normals.assign(8, glm::vec3(0.0f));
   for (int i = 0; i < 4; ++i) shape.normals[size_t(i)] = {0, 0, -1};
   for (int i = 4; i < 8; ++i) shape.normals[size_t(i)] = {0, 0, 1};
-  scene::addRootShape(s, shape);
-  addBackdrop(s, 2.0f, -1.0f);
-  return s;
+  return glassOverBackdrop("stress slab", std::move(shape), ior, 2.0f, -1.0f);
 }
 
 scene::Scene degenerateScene() {
-  scene::Scene s;
-  s.source = "stress degenerate triangles";
   scene::Shape shape;
   shape.name = "degenerate";
-  shape.material = scene::addMaterial(s, glass(1.5f));
   scene::addQuad(shape, {-0.5f, -0.5f, 0}, {0.5f, -0.5f, 0}, {0.5f, 0.5f, 0}, {-0.5f, 0.5f, 0});
   uint32_t n = uint32_t(shape.positions.size());
   // Zero area: three collinear points, and a triangle with a repeated vertex.
@@ -200,22 +195,15 @@ scene::Scene degenerateScene() {
   uint32_t m = uint32_t(shape.positions.size());
   shape.positions.insert(shape.positions.end(), {{-0.5f, -0.2f, 0.1f}, {0.5f, -0.2f, 0.1f}, {0.0f, -0.2f + 1e-7f, 0.1f}});
   shape.indices.insert(shape.indices.end(), {m, m + 1, m + 2});
-  scene::addRootShape(s, shape);
-  addBackdrop(s, 1.0f, -1.0f);
-  return s;
+  return glassOverBackdrop("stress degenerate triangles", std::move(shape), 1.5f, 1.0f, -1.0f);
 }
 
 scene::Scene collapsedScene() {
-  scene::Scene s;
-  s.source = "stress collapsed shape";
   scene::Shape shape;
   shape.name = "point";
-  shape.material = scene::addMaterial(s, glass(1.5f));
   shape.positions.assign(30, glm::vec3(0.1f, 0.2f, 0.3f));
   for (uint32_t i = 0; i < 30; ++i) shape.indices.push_back(i);
-  scene::addRootShape(s, shape);
-  addBackdrop(s, 1.0f, -1.0f);
-  return s;
+  return glassOverBackdrop("stress collapsed shape", std::move(shape), 1.5f, 1.0f, -1.0f);
 }
 
 scene::Scene gridScene(uint64_t count) {

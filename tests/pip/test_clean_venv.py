@@ -17,6 +17,7 @@ from pathlib import Path
 import numpy as np
 import OpenImageIO as oiio
 from pxr import Gf, Sdf, Usd, UsdGeom, UsdLux, UsdShade
+from usd_card import define_card
 
 CLEAN = Path(os.environ.get("SNELL_PIP_CLEAN_PYTHON", ""))
 CLEAN_BIN = CLEAN.parent
@@ -48,13 +49,7 @@ def textured_card(folder: Path) -> Path:
     write_png(folder / "checker.png", TEXELS)
     path = folder / "card.usda"
     stage = Usd.Stage.CreateNew(str(path))
-    UsdGeom.SetStageUpAxis(stage, "Y")
-    UsdGeom.SetStageMetersPerUnit(stage, 1.0)
-    card = UsdGeom.Mesh.Define(stage, "/World/card")
-    card.CreatePointsAttr([Gf.Vec3f(-1, -1, 0), Gf.Vec3f(1, -1, 0), Gf.Vec3f(1, 1, 0), Gf.Vec3f(-1, 1, 0)])
-    card.CreateFaceVertexCountsAttr([4])
-    card.CreateFaceVertexIndicesAttr([0, 1, 2, 3])
-    card.CreateSubdivisionSchemeAttr("none")
+    card = define_card(stage)
     st = UsdGeom.PrimvarsAPI(card).CreatePrimvar("st", Sdf.ValueTypeNames.TexCoord2fArray, UsdGeom.Tokens.vertex)
     st.Set([(0, 0), (1, 0), (1, 1), (0, 1)])
     material = UsdShade.Material.Define(stage, "/World/checker")

@@ -48,17 +48,12 @@ def test_snell_usd_is_a_console_script_of_the_package(tmp_path):
 
 
 def test_snell_usd_renders_a_stage_usd_core_wrote(tmp_path):
-    from pxr import Gf, Usd, UsdGeom
+    from pxr import Usd
+    from usd_card import define_card
 
     stage_path = tmp_path / "card.usda"
     stage = Usd.Stage.CreateNew(str(stage_path))
-    UsdGeom.SetStageUpAxis(stage, "Y")
-    UsdGeom.SetStageMetersPerUnit(stage, 1.0)
-    card = UsdGeom.Mesh.Define(stage, "/World/card")
-    card.CreatePointsAttr([Gf.Vec3f(-1, -1, 0), Gf.Vec3f(1, -1, 0), Gf.Vec3f(1, 1, 0), Gf.Vec3f(-1, 1, 0)])
-    card.CreateFaceVertexCountsAttr([4])
-    card.CreateFaceVertexIndicesAttr([0, 1, 2, 3])
-    card.CreateSubdivisionSchemeAttr("none")
+    define_card(stage)
     stage.GetRootLayer().Save()
     out = tmp_path / "card.png"
     done = subprocess.run([str(BIN / "snell-usd"), "--quiet", "render", str(stage_path), "-o", str(out),

@@ -54,95 +54,92 @@ def tree(root: Path, files: dict[str, str]) -> Path:
     return root
 
 
+def the_violation(root: Path, files: dict[str, str]) -> str:
+    """The one message check_layers gives a tree of `files`, which breaks one rule once."""
+    found = check_layers.violations(tree(root, files))
+    assert len(found) == 1, found
+    return found[0]
+
+
 def test_a_clean_tree_has_no_violations(tmp_path: Path) -> None:
     assert check_layers.violations(tree(tmp_path, CLEAN)) == []
 
 
 def test_a_cpp_include_of_a_layer_above_is_reported(tmp_path: Path) -> None:
-    found = check_layers.violations(tree(tmp_path, {"src/vk/buffer.h": '#include "render/bvh.h"\n'}))
-    assert len(found) == 1
-    assert "src/vk/buffer.h" in found[0] and "render/bvh.h" in found[0]
-    assert "the vk layer may not include the render layer above it" in found[0]
+    message = the_violation(tmp_path, {"src/vk/buffer.h": '#include "render/bvh.h"\n'})
+    assert "src/vk/buffer.h" in message and "render/bvh.h" in message
+    assert "the vk layer may not include the render layer above it" in message
 
 
 def test_a_usd_module_importing_bpy_lazily_is_reported(tmp_path: Path) -> None:
     files = {"python/snell/usd/_stage.py": "def frame():\n    import bpy\n"}
-    found = check_layers.violations(tree(tmp_path, files))
-    assert len(found) == 1
-    assert found[0].startswith("python/snell/usd/_stage.py:2: imports bpy (import bpy)")
-    assert "snell.usd (python/snell/usd/) may not import Blender or the add-on" in found[0]
+    message = the_violation(tmp_path, files)
+    assert message.startswith("python/snell/usd/_stage.py:2: imports bpy (import bpy)")
+    assert "snell.usd (python/snell/usd/) may not import Blender or the add-on" in message
 
 
 def test_a_usd_module_importing_the_add_on_is_reported(tmp_path: Path) -> None:
     files = {"python/snell/usd/_stage.py": "from snell_blender.camera import to_snell\n",
              "blender/snell_blender/__init__.py": "",
              "blender/snell_blender/camera.py": ""}
-    found = check_layers.violations(tree(tmp_path, files))
-    assert len(found) == 1
-    assert "python/snell/usd/_stage.py:1: imports snell_blender.camera.to_snell" in found[0]
-    assert "may not import Blender or the add-on (snell_blender)" in found[0]
+    message = the_violation(tmp_path, files)
+    assert "python/snell/usd/_stage.py:1: imports snell_blender.camera.to_snell" in message
+    assert "may not import Blender or the add-on (snell_blender)" in message
 
 
 def test_the_core_package_importing_snell_usd_is_reported(tmp_path: Path) -> None:
     files = {"python/snell/__init__.py": "from .usd import Stage\n", "python/snell/usd/__init__.py": ""}
-    found = check_layers.violations(tree(tmp_path, files))
-    assert len(found) == 1
-    assert "python/snell/__init__.py:1: imports snell.usd.Stage (from .usd import Stage)" in found[0]
-    assert "the core snell package may not import snell.usd, the layer above it" in found[0]
+    message = the_violation(tmp_path, files)
+    assert "python/snell/__init__.py:1: imports snell.usd.Stage (from .usd import Stage)" in message
+    assert "the core snell package may not import snell.usd, the layer above it" in message
 
 
 def test_the_add_on_importing_snell_private_module_is_reported(tmp_path: Path) -> None:
     files = {"blender/snell_blender/__init__.py": "", "blender/snell_blender/sync.py": "import snell._snell\n"}
-    found = check_layers.violations(tree(tmp_path, files))
-    assert len(found) == 1
-    assert "blender/snell_blender/sync.py:1: imports snell._snell (import snell._snell)" in found[0]
-    assert "the add-on imports snell only through its public modules" in found[0]
-    assert "not the private _snell" in found[0]
+    message = the_violation(tmp_path, files)
+    assert "blender/snell_blender/sync.py:1: imports snell._snell (import snell._snell)" in message
+    assert "the add-on imports snell only through its public modules" in message
+    assert "not the private _snell" in message
 
 
 def test_the_add_on_importing_a_private_module_of_snell_usd_is_reported(tmp_path: Path) -> None:
     files = {"blender/snell_blender/__init__.py": "",
              "blender/snell_blender/shot.py": "def feed():\n    from snell.usd._reader import read\n"}
-    found = check_layers.violations(tree(tmp_path, files))
-    assert len(found) == 1
-    assert "blender/snell_blender/shot.py:2: imports snell.usd._reader.read" in found[0]
-    assert "not the private _reader" in found[0]
+    message = the_violation(tmp_path, files)
+    assert "blender/snell_blender/shot.py:2: imports snell.usd._reader.read" in message
+    assert "not the private _reader" in message
 
 
 def test_an_add_on_import_cycle_is_reported(tmp_path: Path) -> None:
     files = {"blender/snell_blender/__init__.py": "from . import engine\n",
              "blender/snell_blender/engine.py": "from . import sync\n",
              "blender/snell_blender/sync.py": "def scene():\n    from .engine import settings\n"}
-    found = check_layers.violations(tree(tmp_path, files))
-    assert len(found) == 1
-    assert "import cycle engine -> sync -> engine" in found[0]
-    assert "blender/snell_blender/engine.py:1 from . import sync" in found[0]
-    assert "blender/snell_blender/sync.py:2 from .engine import settings" in found[0]
-    assert "the add-on's modules may not import one another in a cycle" in found[0]
+    message = the_violation(tmp_path, files)
+    assert "import cycle engine -> sync -> engine" in message
+    assert "blender/snell_blender/engine.py:1 from . import sync" in message
+    assert "blender/snell_blender/sync.py:2 from .engine import settings" in message
+    assert "the add-on's modules may not import one another in a cycle" in message
 
 
 def test_a_shared_shader_including_common_is_reported(tmp_path: Path) -> None:
     files = {"shaders/shared/trace.h": '#include "../common/optics.glsl"\n', "shaders/common/optics.glsl": ""}
-    found = check_layers.violations(tree(tmp_path, files))
-    assert len(found) == 1
-    assert found[0].startswith('shaders/shared/trace.h:1: includes "../common/optics.glsl" '
+    message = the_violation(tmp_path, files)
+    assert message.startswith('shaders/shared/trace.h:1: includes "../common/optics.glsl" '
                                "(shaders/common/optics.glsl)")
-    assert "shaders/shared/ may include only shaders/shared/" in found[0]
+    assert "shaders/shared/ may include only shaders/shared/" in message
 
 
 def test_a_pass_shader_including_another_pass_folder_is_reported(tmp_path: Path) -> None:
     files = {"shaders/raster/raster_fragment.frag": '#include "../comp/bvh/bvh_node.glsl"\n'}
-    found = check_layers.violations(tree(tmp_path, files))
-    assert len(found) == 1
-    assert 'shaders/raster/raster_fragment.frag:1: includes "../comp/bvh/bvh_node.glsl"' in found[0]
-    assert "shaders/raster/ may include only itself, its subfolders, shaders/common/ and shaders/shared/" in found[0]
+    message = the_violation(tmp_path, files)
+    assert 'shaders/raster/raster_fragment.frag:1: includes "../comp/bvh/bvh_node.glsl"' in message
+    assert "shaders/raster/ may include only itself, its subfolders, shaders/common/ and shaders/shared/" in message
 
 
 def test_a_pass_subfolder_including_its_parent_is_reported(tmp_path: Path) -> None:
     files = {"shaders/comp/bvh/bvh_refit.comp": '#include "../trace_common.glsl"\n'}
-    found = check_layers.violations(tree(tmp_path, files))
-    assert len(found) == 1
-    assert "shaders/comp/bvh/bvh_refit.comp:1" in found[0] and "(shaders/comp/trace_common.glsl)" in found[0]
+    message = the_violation(tmp_path, files)
+    assert "shaders/comp/bvh/bvh_refit.comp:1" in message and "(shaders/comp/trace_common.glsl)" in message
 
 
 def test_the_script_exits_1_and_prints_each_violation(tmp_path: Path) -> None:
