@@ -22,8 +22,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-CommandRun snell(const std::string& arguments) { return runCommand(std::string(SNELL_BINARY) + " " + arguments); }
-
 std::string readText(const fs::path& path) {
   std::ifstream in(path, std::ios::binary);
   std::stringstream text;

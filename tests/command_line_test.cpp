@@ -29,8 +29,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-CommandRun snell(const std::string& arguments) { return runCommand(std::string(SNELL_BINARY) + " " + arguments); }
-
 // Standard output alone: lavapipe writes its own warning to standard error.
 CommandRun snellStdout(const std::string& arguments) {
   return runCommand(std::string(SNELL_BINARY) + " " + arguments + " 2>/dev/null");

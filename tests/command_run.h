@@ -25,6 +25,10 @@ inline CommandRun runCommand(const std::string& commandLine) {
   return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, output};
 }
 
+/// `snell ARGUMENTS`: the build's own binary (SNELL_BINARY, which every test
+/// target is given), run as runCommand runs a command line.
+inline CommandRun snell(const std::string& arguments) { return runCommand(std::string(SNELL_BINARY) + " " + arguments); }
+
 inline std::string shellQuoted(const std::string& path) { return "'" + path + "'"; }
 
 }  // namespace snell::test

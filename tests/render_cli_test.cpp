@@ -13,8 +13,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-CommandRun snell(const std::string& arguments) { return runCommand(std::string(SNELL_BINARY) + " " + arguments); }
-
 // The first frame of a run builds every tree; --stats says so and counts the
 // glass pixels that the masked viewport trace covered.
 TEST(RenderCommand, StatsReportTheFirstFramesBuildAndTracedPixels) {

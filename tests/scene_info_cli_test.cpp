@@ -10,8 +10,6 @@
 namespace snell::test {
 namespace {
 
-CommandRun snell(const std::string& arguments) { return runCommand(std::string(SNELL_BINARY) + " " + arguments); }
-
 TEST(SceneInfoCommand, DescribesAModelAndExitsZero) {
   CommandRun run = snell("info " + shellQuoted(model("TransmissionRoughnessTest/glTF-Binary/TransmissionRoughnessTest.glb")));
   EXPECT_EQ(run.exitCode, 0) << run.output;
