@@ -101,11 +101,31 @@ TEST_F(SingleSided, ADoubleSidedFaceIsSeenFromBothSides) {
   expectAll(middleFrom(context(), s, -1.5), kRed, "its back");
 }
 
-TEST_F(SingleSided, AMirroredInstancesFrontIsItsFrontInTheWorld) {
-  // Mirrored in x the quad's corners run clockwise seen from +z: its world front faces -z.
+TEST_F(SingleSided, AMirroredInstanceKeepsItsFront) {
+  // Mirrored in x the quad's corners run clockwise seen from +z, and it still
+  // faces +z, where its normal points: glTF makes a mirrored face's front
+  // clockwise, so a mirrored mesh is not drawn inside out.
   scene::Scene s = quadBetweenWalls(false, glm::scale(glm::mat4(1.0f), glm::vec3(-1.0f, 1.0f, 1.0f)));
-  expectAll(middleFrom(context(), s, 1.5), kGreen, "its world back: the green wall beyond it");
-  expectAll(middleFrom(context(), s, -1.5), kRed, "its world front");
+  expectAll(middleFrom(context(), s, 1.5), kRed, "its front");
+  expectAll(middleFrom(context(), s, -1.5), kBlue, "its back: the blue wall beyond it");
+}
+
+TEST_F(SingleSided, AMirroredGlassSphereRefractsAsTheSphereItMirrors) {
+  // A sphere mirrored in x is the same sphere: its inside stays inside, in
+  // the trace and in the reference alike.
+  auto scene = [](bool mirrored) {
+    scene::Scene s = quadBetweenWalls(true);
+    scene::Shape sphere = scene::uvSphere(24, 0.4f);
+    sphere.material = scene::addMaterial(s, scene::clearGlass("glass", 1.5f));
+    glm::mat4 world = glm::translate(glm::mat4(1.0f), glm::vec3(0.1f, 0.05f, 0.8f));
+    if (mirrored) world = glm::scale(world, glm::vec3(-1.0f, 1.0f, 1.0f));
+    scene::addRootShape(s, sphere, world);
+    return s;
+  };
+  Seen plain = middleFrom(context(), scene(false), 1.5), mirrored = middleFrom(context(), scene(true), 1.5);
+  EXPECT_LT(glm::length(mirrored.gpu - plain.gpu), 0.01f);
+  EXPECT_LT(glm::length(mirrored.reference - plain.reference), 0.01f);
+  EXPECT_LT(glm::length(mirrored.gpu - mirrored.reference), 0.01f);
 }
 
 TEST_F(SingleSided, ARayThroughGlassPassesABackFaceAsARayWithoutGlassDoes) {

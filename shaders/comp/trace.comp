@@ -93,8 +93,8 @@ float enterBox(ShearedRay r, vec3 lo, vec3 hi, float tMax) {
 
 // Watertight ray/triangle test; returns t (or kInf) and the barycentrics.
 // det > 0 where the ray meets the triangle's front (counter-clockwise seen
-// from the ray's origin): with cullSign 1 a back is missed, with -1 a front
-// (a mirrored instance's world back), with 0 neither.
+// from the ray's origin, in the instance's own space): with cullSign 1 a
+// back is missed, with 0 neither.
 float intersectTriangle(ShearedRay r, uint tri, float tMax, float cullSign, out vec3 bary) {
   precise vec3 A = vertexAt(indices[3u * tri]) - r.origin;
   precise vec3 B = vertexAt(indices[3u * tri + 1u]) - r.origin;
@@ -168,11 +168,11 @@ ShearedRay objectRay(uint instance, vec3 origin, vec3 dir) {
 
 // Which faces of the instance the ray passes (intersectTriangle's cullSign):
 // the backs of a single-sided material's, where the scene has one, on every
-// ray of the path: glass of IOR 1 must show what no glass shows.
+// ray of the path: glass of IOR 1 must show what no glass shows. Facing is
+// the instance's own: a mirroring transform keeps a face's front (glTF's rule).
 float cullSignOf(uint instance) {
   if (!surfaceUses(kSurfaceSingleSided)) return 0.0;
-  uint flags = instances[instance].flags;
-  return (flags & kInstanceCullBackFaces) == 0u ? 0.0 : (flags & kInstanceMirrored) != 0u ? -1.0 : 1.0;
+  return (instances[instance].flags & kInstanceCullBackFaces) == 0u ? 0.0 : 1.0;
 }
 
 // A triangle of the instance's tree: the closest hit so far if nearer.

@@ -64,12 +64,13 @@ void main() {
   precise float y = -(dot(rel, pc.up.xyz) - pc.shiftY * w) * pc.up.w;  // Vulkan's y points down the image, as row 0 is the top
   precise float depth = ortho ? clamp((pc.eye.w - z) / (pc.eye.w - pc.forward.w), 0.0, 1.0) : pc.forward.w;
   // A single-sided face seen from behind is not drawn, as the trace passes it
-  // (trace.comp: cullSignOf): every corner of it lands outside the view.
-  vec3 winding = cross(vectorToWorld(inst, p1 - p0), vectorToWorld(inst, p2 - p0));  // the world's front
-  vec3 corner0 = vec3(dot(inst.objectToWorld[0], vec4(p0, 1.0)), dot(inst.objectToWorld[1], vec4(p0, 1.0)),
-                      dot(inst.objectToWorld[2], vec4(p0, 1.0)));
+  // (trace.comp: cullSignOf): every corner of it lands outside the view. Its
+  // facing is tested in the instance's own space, as the trace tests it, where
+  // a mirroring transform turns nothing round.
+  vec4 eyeAt = vec4(ortho ? pc.forward.xyz : pc.eye.xyz, ortho ? 0.0 : 1.0);  // a direction, or a point
+  vec3 viewer = vec3(dot(inst.worldToObject[0], eyeAt), dot(inst.worldToObject[1], eyeAt), dot(inst.worldToObject[2], eyeAt));
   bool singleSided = (inst.flags & kInstanceCullBackFaces) != 0u;
-  bool fromBehind = dot(winding, ortho ? pc.forward.xyz : corner0 - pc.eye.xyz) > 0.0;
+  bool fromBehind = dot(cross(p1 - p0, p2 - p0), ortho ? viewer : p0 - viewer) > 0.0;
   bool culled = singleSided && fromBehind;
   gl_Position = culled ? vec4(2.0, 2.0, 0.5, 1.0) : vec4(x, y, depth, w);  // perspective: depth = near / z, reverse Z
 }

@@ -157,9 +157,6 @@ struct GpuInstance {
 // Its faces are seen from their front only (a single-sided material, glTF's
 // and USD's doubleSided false, that is not glass): rays pass their backs.
 SNELL_CONST kInstanceCullBackFaces = 1u;
-// Its transform mirrors (a negative determinant): its faces' fronts in the
-// world are their backs in its own space, where the trace tests them.
-SNELL_CONST kInstanceMirrored = 2u;
 
 SNELL_GPU_END
 #endif

@@ -87,12 +87,10 @@ void DriverTracer::recordUpdate(vk::Commands& commands, vk::UploadArena& arena,
     // culls them. The driver decides facing in the instance's own space by
     // the same sign as glTF's counter-clockwise front (its "clockwise" is
     // seen in a left-handed frame; the DriverRt test measured the other choice
-    // losing 25% of first hits); a mirroring transform turns the world's
-    // front round, so the driver's is flipped for it.
-    const uint32_t f = instances[i].flags;
-    const uint32_t noCulling = VK_GEOMETRY_INSTANCE_TRIANGLE_FACING_CULL_DISABLE_BIT_KHR;
-    const uint32_t flipFacing = VK_GEOMETRY_INSTANCE_TRIANGLE_FLIP_FACING_BIT_KHR;
-    t.flags = (f & gpu::kInstanceCullBackFaces) == 0 ? noCulling : (f & gpu::kInstanceMirrored) != 0 ? flipFacing : 0u;
+    // losing 25% of first hits), so a mirroring instance keeps its front, as
+    // glTF asks, with no flag.
+    const bool cull = (instances[i].flags & gpu::kInstanceCullBackFaces) != 0;
+    t.flags = cull ? 0u : uint32_t(VK_GEOMETRY_INSTANCE_TRIANGLE_FACING_CULL_DISABLE_BIT_KHR);
     t.accelerationStructureReference = blas_.at(instances[i].geometry)->address();
   }
   commands.beginPass(pass::kDriverTlas);

@@ -125,15 +125,21 @@ void PreparedScene::addItem(const scene::Scene& scene, const scene::DrawItem& it
     return set.size() == vertices ? glm::dvec2(set[v]) : glm::dvec2(0.0);
   };
 
+  // A mirroring transform turns a face's winding round in the world, not
+  // its front (glTF: its front is then clockwise); the reference tests
+  // facing in the world, so its corners are taken the other way round. The
+  // trace tests them in the instance's own space, where nothing turns.
+  const bool mirrored = glm::determinant(glm::dmat3(world)) < 0.0;
   for (size_t t = 0; t < shape.triangleCount(); ++t) {
     const uint32_t* index = &shape.indices[t * 3];
     if (index[0] >= vertices || index[1] >= vertices || index[2] >= vertices) continue;
     TriangleData d;
     for (int k = 0; k < 3; ++k) {
-      d.v[k] = positions[index[k]];
-      d.n[k] = normals[index[k]];
-      d.uv[0][k] = texcoords(shape.texcoords0, index[k]);
-      d.uv[1][k] = texcoords(shape.texcoords1, index[k]);
+      const uint32_t corner = index[mirrored && k > 0 ? 3 - k : k];
+      d.v[k] = positions[corner];
+      d.n[k] = normals[corner];
+      d.uv[0][k] = texcoords(shape.texcoords0, corner);
+      d.uv[1][k] = texcoords(shape.texcoords1, corner);
     }
     if (!finite(d.v[0]) || !finite(d.v[1]) || !finite(d.v[2])) continue;
     glm::dvec3 e1 = d.v[1] - d.v[0], e2 = d.v[2] - d.v[0];

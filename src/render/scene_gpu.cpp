@@ -377,8 +377,8 @@ std::vector<gpu::GpuInstance> SceneGpu::packInstances(const scene::Pose& pose, c
     rows(glm::inverse(toWorld), inst.worldToObject);
     inst.geometry = itemGeometry[i];
     inst.material = itemMaterial[i];
-    inst.flags = (itemSingleSided[i] ? gpu::kInstanceCullBackFaces : 0u) |
-                 (glm::determinant(glm::dmat3(toWorld)) < 0.0 ? gpu::kInstanceMirrored : 0u);
+    // Faces are tested in the instance's own space, where a mirroring transform turns no front round (glTF).
+    inst.flags = itemSingleSided[i] ? gpu::kInstanceCullBackFaces : 0u;
   }
   return instances;
 }

@@ -24,11 +24,12 @@ def geometric_normals(m) -> np.ndarray:
 
 
 def world_normals(contents, meshes, instance: int = 0) -> np.ndarray:
-    matrix = contents.snell_instances()[instance].transform
+    """Each triangle's front in the world, as snell takes it: its counter-clockwise normal in the mesh's own space,
+    carried by the inverse transpose (so a mirroring transform keeps a face's front where its normals point)."""
+    matrix = np.asarray(contents.snell_instances()[instance].transform)[:3, :3]
     m = meshes[contents.snell_instances()[instance].mesh]
-    p = np.asarray(m.positions, float) @ np.asarray(matrix)[:3, :3].T
-    p = p[np.asarray(m.indices)]
-    n = np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0])
+    p = np.asarray(m.positions, float)[np.asarray(m.indices)]
+    n = np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0]) @ np.linalg.inv(matrix)
     return n / np.linalg.norm(n, axis=1, keepdims=True)
 
 
@@ -119,14 +120,15 @@ def test_a_left_handed_mesh_is_wound_to_face_the_same_way(tmp_path):
     np.testing.assert_allclose(geometric_normals(meshes[1]), [[0, 0, 1]] * 2, atol=1e-6)
 
 
-def test_a_mirroring_transform_flips_the_winding(tmp_path):
+def test_a_mirroring_transform_keeps_each_faces_front_where_its_normals_point(tmp_path):
     stage = new_stage(tmp_path / "m.usda")
     quad(stage, "/World/Plain")
     mirror = UsdGeom.Xform.Define(stage, "/World/Mirror")
     mirror.AddScaleOp().Set(Gf.Vec3f(1, 1, -1))
     quad(stage, "/World/Mirror/Quad", z=1.0)
     contents, meshes = read(stage, tmp_path / "m.usda")
-    # In the world, the plain quad faces +Z; the mirrored one faces -Z, as its mirrored normals do.
+    # In the world, the plain quad faces +Z; the mirrored one faces -Z, as its mirrored normals do (Hydra's rule),
+    # its winding left as authored.
     np.testing.assert_allclose(world_normals(contents, meshes, 0), [[0, 0, 1]] * 2, atol=1e-6)
     np.testing.assert_allclose(world_normals(contents, meshes, 1), [[0, 0, -1]] * 2, atol=1e-6)
 

@@ -352,11 +352,10 @@ class StageContents:
         placed_by = skin.skeleton_prim if skin is not None and skin.skinned else prim
         frame = SkelFrame(time)
         matrix = placed(time) if placed is not None else self._matrix(placed_by, rigid, frame)
-        flip = np.linalg.det(matrix[:3, :3]) < 0.0
-        share = (key, tuple(m for _, _, m in parts), flip) if skin is None else None
+        share = (key, tuple(m for _, _, m in parts)) if skin is None else None
         source = self._shared.get(share) if share is not None else None
         if source is None:
-            source = self._make_source(mesh, topology, skin, parts, flip, time)
+            source = self._make_source(mesh, topology, skin, parts, time)
             if source is None:
                 return
             if share is not None:
@@ -369,7 +368,7 @@ class StageContents:
         self.placements.append(Placement(placed_by, source, instances, varying, matrix, rigid, placed))
 
     def _make_source(self, mesh: UsdGeom.Mesh, topology: Topology, skin: Optional[Skin], parts: list,
-                     flip: bool, time: Usd.TimeCode) -> Optional[MeshSource]:
+                     time: Usd.TimeCode) -> Optional[MeshSource]:
         prim = mesh.GetPrim()
         cage = None
         if prim.IsA(UsdGeom.Mesh):
@@ -387,10 +386,6 @@ class StageContents:
                 st, st_values = self._st(prim, record.st_primvar, topology, time, record.path)
             name = str(prim.GetPath()) if bind == prim else f"{prim.GetPath()} ({bind.GetName()})"
             part = source.add_part(name, triangles, material, st, st_values, corner_uvs)
-            if flip and part.cage is not None:
-                part.cage.left_handed = not part.cage.left_handed
-            elif flip:
-                part.indices = np.ascontiguousarray(part.indices[:, [0, 2, 1]])
             if part.uvs is not None:
                 self._undrawn_wraps(prim, part, record)
         self.sources.append(source)
