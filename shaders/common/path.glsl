@@ -39,9 +39,10 @@ struct Hit {
   vec3 bary;       // weights of v0, v1, v2
 };
 
-// The closest hit beyond tMin along the ray, not on triangle skipPrim of
-// instance skipInstance (the face the ray leaves); instance kNoHit on a miss.
-Hit traceClosest(vec3 origin, vec3 dir, uint skipInstance, uint skipPrim, float tMin);
+// The closest hit beyond |leaving| along the ray (leave() below; 0 for a
+// camera ray), not on triangle skipPrim of instance skipInstance (the face
+// the ray leaves); instance kNoHit on a miss.
+Hit traceClosest(vec3 origin, vec3 dir, uint skipInstance, uint skipPrim, float leaving);
 // The global index of the first triangle of the instance's geometry.
 uint firstTriangleOf(uint instance);
 
@@ -160,18 +161,21 @@ struct Path {
   vec3 landingTexel;
   float landingLod;
   vec3 landingWeight;
+  float shortestSegment;  // TraceAov::shortestSegment
 };
 
 // A ray leaving the surface of `hit` at `s` along dir: its offset origin and
-// the distance within which faces are the surface it leaves.
-vec3 leave(Surface s, vec3 dir, out float tMin) {
+// `leaving`, the distance within which faces are the surface it leaves,
+// signed by the side of that surface the ray goes to (+: the side ng points
+// to), for traceClosest.
+vec3 leave(Surface s, vec3 dir, out float leaving) {
   vec3 origin = offsetRay(s.position, dot(dir, s.ng) > 0.0 ? s.ng : -s.ng);
   // The offset is the hit point's error bound. A face within that distance
   // of the new origin meets the hit point within its rounding: the surface
   // the ray leaves, not a new one. Skipping the hit triangle alone let rays
   // through a cube's edges enter the face across the edge a second time
   // (bench stress: watertight cube).
-  tMin = length(origin - s.position);
+  leaving = dot(dir, s.ng) > 0.0 ? length(origin - s.position) : -length(origin - s.position);
   return origin;
 }
 
@@ -185,23 +189,24 @@ vec3 leave(Surface s, vec3 dir, out float tMin) {
 // opens by `spread` radians.
 bool tracePath(vec3 origin, vec3 dir, float width, float spread, int channel, out Path path) {
   path = Path(vec3(0.0), 0u, kOutcomeMiss, -1.0, kNoHit, kNoHit, vec2(uintBitsToFloat(0x7fc00000u)), kNoHit, vec3(0.0),
-              0.0, vec3(0.0));
+              0.0, vec3(0.0), kInf);
   bool fresnel = opticsOn(kOpticsFresnel);
   uint reflections = fresnel ? pc.reflections : 0u;
   vec3 throughput = vec3(1.0);
   mediaCount = 0u;
   uint skipInstance = kNoHit, skipPrim = kNoHit;
-  float tMin = 0.0;
+  float leaving = 0.0;  // a camera ray leaves no surface
   bool reflecting = false;  // this pass traces a reflected ray, weighted by `reflectedWeight`
   vec3 reflectedWeight = vec3(0.0);
   vec3 parkedOrigin = vec3(0.0), parkedDir = vec3(0.0);
-  float parkedTMin = 0.0, parkedWidth = 0.0, parkedSpread = 0.0;
+  float parkedLeaving = 0.0, parkedWidth = 0.0, parkedSpread = 0.0;
   // maxInterfaces + 1 segments of the path at most, and its reflected rays.
   uint passes = pc.maxInterfaces + 1u + min(reflections, pc.maxInterfaces);
   bool segmentZero = true;
   for (uint pass = 0u; pass < passes; ++pass) {
-    Hit hit = traceClosest(origin, dir, skipInstance, skipPrim, tMin);
+    Hit hit = traceClosest(origin, dir, skipInstance, skipPrim, leaving);
     ++segments;
+    if (traceFlag(kTraceFlagAov) && leaving != 0.0) path.shortestSegment = min(path.shortestSegment, hit.t);
     Surface s;
     GpuMaterial m;
     bool opaque = false;
@@ -252,7 +257,7 @@ bool tracePath(vec3 origin, vec3 dir, float width, float spread, int channel, ou
       reflecting = false;
       origin = parkedOrigin;
       dir = parkedDir;
-      tMin = parkedTMin;
+      leaving = parkedLeaving;
       width = parkedWidth;
       spread = parkedSpread;  // the skipped face is the same: the reflection left the face the path leaves
       continue;
@@ -297,7 +302,7 @@ bool tracePath(vec3 origin, vec3 dir, float width, float spread, int channel, ou
       throughput *= 1.0 - coverage;
       ++path.interfaces;
       width = hitWidth;
-      origin = leave(s, dir, tMin);
+      origin = leave(s, dir, leaving);
       skipInstance = hit.instance;
       skipPrim = hit.primitive;
       continue;
@@ -358,16 +363,16 @@ bool tracePath(vec3 origin, vec3 dir, float width, float spread, int channel, ou
       }
     }
     if (boundary) throughput *= m.baseColorFactor.rgb * texel;  // the base colour (baseColour()) of the texel above
-    origin = leave(s, dir, tMin);
+    origin = leave(s, dir, leaving);
     skipInstance = hit.instance;
     skipPrim = hit.primitive;
     if (reflected != vec3(0.0)) {  // trace the reflection next, then go on from here
       parkedOrigin = origin;
       parkedDir = dir;
-      parkedTMin = tMin;
+      parkedLeaving = leaving;
       parkedWidth = width;
       parkedSpread = spread;
-      origin = leave(s, reflected, tMin);
+      origin = leave(s, reflected, leaving);
       dir = reflected;
       spread = reflectedSpread;
       reflecting = true;
@@ -430,7 +435,8 @@ void tracePixel(uvec2 pixel) {
                                                   path.interfaces, path.outcome, visits, path.landing.x, path.landing.y,
                                                   path.landingMaterial, path.landingLod, shine.r, shine.g, shine.b,
                                                   weight.r, weight.g, weight.b, segments, boxTests, triangleTests,
-                                                  walkSteps, subgroupSteps, subgroupVisits, SNELL_SUBGROUP_SIZE, 0u);
+                                                  walkSteps, subgroupSteps, subgroupVisits, SNELL_SUBGROUP_SIZE,
+                                                  path.shortestSegment);
   }
 }
 

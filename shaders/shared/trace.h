@@ -236,7 +236,10 @@ struct TraceAov {
   uint subgroupSteps;   // 4
   uint subgroupVisits;  // 4
   uint subgroupSize;    // 4
-  uint pad0;            // 4
+  // The shortest segment a ray of the path ran after leaving a surface, kInf
+  // where none did: a ray that hit the surface it left (a self-hit) ran one
+  // of rounding's length.
+  float shortestSegment;  // 4
 };
 
 SNELL_CONST kNoHit = 0xffffffffu;

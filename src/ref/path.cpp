@@ -54,8 +54,11 @@ struct Tracer {
 
   /// What a reflected ray from p, its cone `width` wide there and opening by
   /// `spread`, sees: the opaque face it meets, else the environment.
-  glm::dvec3 reflected(const glm::dvec3& p, const glm::dvec3& d, uint32_t from, double width, double spread) const {
+  /// `shortest`: the shortest segment so far (PixelResult::shortestSegment), this one included.
+  glm::dvec3 reflected(const glm::dvec3& p, const glm::dvec3& d, uint32_t from, double width, double spread,
+                       double& shortest) const {
     Hit hit = prepared.intersect(p, d, tMinFrom(p), from);
+    shortest = std::min(shortest, hit.found() ? hit.t : kInfinity);
     if (hit.found()) {
       const TriangleData& tri = prepared.triangle(hit.triangle);
       const ResolvedMaterial& m = prepared.material(tri.material);
@@ -85,6 +88,7 @@ struct Tracer {
     uint32_t excluded = std::numeric_limits<uint32_t>::max();
     for (bool primary = true;; primary = false) {
       Hit hit = prepared.intersect(origin, d, tMin, excluded);
+      if (!primary) result.shortestSegment = std::min(result.shortestSegment, hit.found() ? hit.t : kInfinity);
       if (!hit.found()) {
         result.color += throughput * settings.background;
         result.outcome = gpu::kOutcomeMiss;
@@ -184,7 +188,7 @@ struct Tracer {
             --reflections;
             if (r > 0.0) {
               result.color += throughput * (r * reflected(p, unitOrZero(d + 2.0 * c * n), hit.triangle, width,
-                                                          spread + 2.0 * turn) +
+                                                          spread + 2.0 * turn, result.shortestSegment) +
                                             highlight(prepared, p, n, d, material.roughness, eta));
             }
           }

@@ -22,6 +22,7 @@ struct PixelResult {
   uint32_t outcome = gpu::kOutcomeMiss;
   double energyError = 0.0;
   glm::dvec2 landing{std::numeric_limits<double>::quiet_NaN()};
+  double shortestSegment = kInfinity;  ///< as TraceAov::shortestSegment
 };
 
 PixelResult trace(const PreparedScene& prepared, const glm::dvec3& origin, const glm::dvec3& d, double width,

@@ -27,6 +27,7 @@ ReferenceImage renderReference(const scene::Scene& scene, const scene::Pose& pos
   image.outcome.assign(pixels, gpu::kOutcomeMiss);
   image.energyError.assign(pixels, 0.0);
   image.landing.assign(pixels, glm::dvec2(std::numeric_limits<double>::quiet_NaN()));
+  image.shortestSegment.assign(pixels, detail::kInfinity);
   if (pixels == 0) return image;
   if (!settings.rays.empty() && settings.rays.size() != pixels) {
     throw std::invalid_argument("reference: " + std::to_string(settings.rays.size()) + " rays for " +
@@ -66,6 +67,7 @@ ReferenceImage renderReference(const scene::Scene& scene, const scene::Pose& pos
         image.outcome[i] = r.outcome;
         image.energyError[i] = r.energyError;
         image.landing[i] = r.landing;
+        image.shortestSegment[i] = r.shortestSegment;
       }
     }
   };

@@ -43,6 +43,8 @@ struct ReferenceImage {
   /// Where a path that crossed glass ended on an opaque face with a base
   /// colour texture: that texture's UV (transformed); NaN otherwise.
   std::vector<glm::dvec2> landing;
+  /// As TraceAov::shortestSegment: the shortest segment after leaving a surface; +inf where none.
+  std::vector<double> shortestSegment;
 
   size_t index(uint32_t x, uint32_t y) const { return size_t(y) * width + x; }
 };

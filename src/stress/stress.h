@@ -123,7 +123,12 @@ struct Result {
   uint64_t overOne = 0;      ///< pixels with a channel more than 1/255 off
   uint64_t nanCount = 0;     ///< GPU pixels with a NaN or infinite channel
   uint64_t leakCount = 0;    ///< aimed rays that slipped through, or entered a closed mesh and never left
-  uint64_t selfHitCount = 0; ///< aimed rays that crossed more faces than the reference (hit their own surface)
+  /// Aimed rays that hit their own surface: they crossed more faces than the
+  /// reference, and one of their segments after leaving a surface is far
+  /// shorter than any of the reference's (a path that parts from the
+  /// reference's where it passes an open edge or corner, which either
+  /// precision may pass on either side, crosses another count of faces too).
+  uint64_t selfHitCount = 0;
   /// Aimed rays whose first hit is not the reference's: none where the
   /// reference has one, or at another distance (Case::countMissedHits).
   uint64_t missedHits = 0;
