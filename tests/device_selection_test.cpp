@@ -39,6 +39,34 @@ TEST(DeviceSelection, PrefersDiscreteOverIntegratedOverCpu) {
   EXPECT_EQ(*chooseDevice(devices, "").chosen, 1u);
 }
 
+// RADV's null device (RADV_FORCE_FAMILY): a discrete GPU with no memory,
+// as readDeviceFacts describes it.
+DeviceFacts nullDevice(uint32_t index) {
+  DeviceFacts d = device(index, "Null hardware (RADV GFX1100)", VK_PHYSICAL_DEVICE_TYPE_DISCRETE_GPU, 0);
+  d.cannotRun = "it has no device-local memory";
+  return d;
+}
+
+TEST(DeviceSelection, ADeviceWithoutMemoryIsPassedOverForWorkAndTakenToCompile) {
+  std::vector<DeviceFacts> devices = {device(0, "llvmpipe (LLVM 15.0.6, 256 bits)", VK_PHYSICAL_DEVICE_TYPE_CPU),
+                                      nullDevice(1)};
+  DeviceChoice run = chooseDevice(devices, "");
+  ASSERT_TRUE(run.chosen);
+  EXPECT_EQ(*run.chosen, 0u);
+  EXPECT_NE(run.verdicts[1].find("rejected: it has no device-local memory"), std::string::npos) << run.verdicts[1];
+  DeviceChoice compile = chooseDevice(devices, "", "", DeviceUse::Compile);
+  ASSERT_TRUE(compile.chosen);
+  EXPECT_EQ(*compile.chosen, 1u);
+}
+
+TEST(DeviceSelection, ADeviceWithoutMemoryNamedForWorkIsRefusedWithTheReason) {
+  std::vector<DeviceFacts> devices = {nullDevice(0)};
+  DeviceChoice choice = chooseDevice(devices, "0");
+  EXPECT_FALSE(choice.chosen);
+  EXPECT_NE(choice.verdicts[0].find("no device-local memory"), std::string::npos) << choice.verdicts[0];
+  EXPECT_THROW(chooseDeviceList(devices, "0"), std::invalid_argument);
+}
+
 TEST(DeviceSelection, FallsBackToLavapipeWhenItIsAlone) {
   auto devices = laptop();
   devices.resize(1);

@@ -66,6 +66,25 @@ TEST(RenderCommand, TheDefaultMethodIsAutoAndSaysWhatItDrewWith) {
       << run.output;
 }
 
+// A device slower than the wait limit is reported, not waited on forever:
+// the error names the device, the limit and the setting, and writes nothing.
+TEST(RenderCommand, AFrameOverTheWaitLimitIsAnErrorNamingTheLimitAndItsSetting) {
+  fs::path out = fs::temp_directory_path() / "snell_render_timeout.png";
+  CommandRun run = runCommand("SNELL_GPU_TIMEOUT=0.000001 " + std::string(SNELL_BINARY) +
+                              " render --eye --method trace --size 320x240 -o " + shellQuoted(out.string()));
+  EXPECT_NE(run.exitCode, 0) << run.output;
+  EXPECT_NE(run.output.find("did not finish within 1e-06 s (SNELL_GPU_TIMEOUT=0.000001)"), std::string::npos)
+      << run.output;
+  EXPECT_FALSE(fs::exists(out));
+}
+
+TEST(RenderCommand, AWaitLimitThatIsNotANumberOfSecondsIsAClearError) {
+  CommandRun run = runCommand("SNELL_GPU_TIMEOUT=soon " + std::string(SNELL_BINARY) + " render --eye --size 8x8 -o " +
+                              shellQuoted((fs::temp_directory_path() / "snell_never.png").string()));
+  EXPECT_EQ(run.exitCode, 1) << run.output;
+  EXPECT_NE(run.output.find("SNELL_GPU_TIMEOUT=soon: expected seconds"), std::string::npos) << run.output;
+}
+
 TEST(SnellCommand, VersionPrintsTheVersionAndExitsZero) {
   CommandRun run = snell("--version");
   EXPECT_EQ(run.exitCode, 0) << run.output;

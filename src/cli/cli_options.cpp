@@ -35,7 +35,10 @@ environment:
   SNELL_VALIDATION=1       turn on the Khronos validation layer; any message it
                            reports makes the exit code 1
   SNELL_PIPELINE_CACHE=DIR where compiled pipelines are kept for the next run
-                           (default $XDG_CACHE_HOME/snell, else ~/.cache/snell; off: none))";
+                           (default $XDG_CACHE_HOME/snell, else ~/.cache/snell; off: none)
+  SNELL_GPU_TIMEOUT=SECONDS how long a submission may run before the device is
+                           reported as hung (default 60 on a GPU, 600 on a CPU
+                           device such as lavapipe))";
 
 namespace {
 

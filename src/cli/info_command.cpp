@@ -60,7 +60,7 @@ io::Json deviceEntry(const vk::DeviceReport& report, size_t i) {
   entry["type"] = vk::deviceTypeName(d.type);
   entry["min_subgroup_size"] = d.minSubgroupSize;
   entry["max_subgroup_size"] = d.maxSubgroupSize;
-  entry["unmet"] = d.unmet;
+  entry["unmet"] = vk::unmetFor(d);
   entry["chosen"] = report.choice.chosen == i;
   entry["verdict"] = report.choice.verdicts[i];
   return entry;

@@ -3,6 +3,7 @@
 
 #include "vk/error.h"
 
+#include <cstdio>
 #include <cstring>
 #include <limits>
 #include <stdexcept>
@@ -82,6 +83,7 @@ void Commands::submit() { submit(VK_NULL_HANDLE, 0, VK_NULL_HANDLE); }
 
 void Commands::submit(VkSemaphore wait, VkPipelineStageFlags waitStage, VkSemaphore signal) {
   if (!recording_) throw std::logic_error("Commands '" + name_ + "': submit() without begin()");
+  if (context_->compileOnly()) throw std::logic_error("Commands '" + name_ + "': a compile-only context runs nothing");
   if (passOpen_) endPass();
   VK_CHECK(vkEndCommandBuffer(buffer_));
   recording_ = false;
@@ -100,10 +102,17 @@ void Commands::submit(VkSemaphore wait, VkPipelineStageFlags waitStage, VkSemaph
 
 void Commands::wait() {
   if (!serial_) return;
-  // Bounded: a GPU that stops answering for a minute is reported, not waited on forever.
-  constexpr uint64_t kTimeoutNs = 60ull * 1000 * 1000 * 1000;
-  VkResult result = callUnlessFaulted("vkWaitForFences", [&] { return vkWaitForFences(context_->device(), 1, &fence_, VK_TRUE, kTimeoutNs); });
-  if (result == VK_TIMEOUT) throw VulkanError("Commands '" + name_ + "': the GPU did not finish within 60 s", result);
+  // Bounded: a device that stops answering is reported, not waited on forever.
+  const double seconds = context_->waitTimeoutSeconds();
+  const uint64_t timeoutNs = uint64_t(seconds * 1e9);
+  VkResult result = callUnlessFaulted("vkWaitForFences", [&] { return vkWaitForFences(context_->device(), 1, &fence_, VK_TRUE, timeoutNs); });
+  if (result == VK_TIMEOUT) {
+    char limit[32];
+    std::snprintf(limit, sizeof limit, "%g s", seconds);
+    throw VulkanError("Commands '" + name_ + "': " + context_->facts().name + " did not finish within " + limit + " (" +
+                          context_->waitTimeoutWhy() + ")",
+                      result);
+  }
   VK_CHECK(result);
   context_->noteCompleted(serial_);
   serial_ = 0;

@@ -24,14 +24,22 @@ ComputeProgram::ComputeProgram(Context& context, const ComputeProgramDesc& desc)
                       std::to_string(caps.maxSubgroupSize));
   }
 
+  uint32_t required = desc.requiredSubgroupSize;
+  if (required && (required < caps.minSubgroupSize || required > caps.maxSubgroupSize || (required & (required - 1)))) {
+    throw VulkanError("program '" + name_ + "' asks for subgroups of " + std::to_string(required) + " lanes; the device has " +
+                      std::to_string(caps.minSubgroupSize) + "-" + std::to_string(caps.maxSubgroupSize));
+  }
   VkPipelineShaderStageCreateFlags stageFlags =
       desc.requireFullSubgroups ? VK_PIPELINE_SHADER_STAGE_CREATE_REQUIRE_FULL_SUBGROUPS_BIT : 0;
   VkPipelineCreateFlags pipelineFlags = caps.pipelineStatistics ? VK_PIPELINE_CREATE_CAPTURE_STATISTICS_BIT_KHR : 0;
   // The compile runs on its own thread; what it reads is copied into it or lives as long as this program.
   pipeline_.emplace(context, name_, [&context, module = layout_.module(0), layout = layout_.pipelineLayout(),
                                       specialization = Specialization(desc.specialization), stageFlags,
-                                      pipelineFlags](VkPipeline* pipeline) mutable {
+                                      pipelineFlags, required](VkPipeline* pipeline) mutable {
+    VkPipelineShaderStageRequiredSubgroupSizeCreateInfo subgroupSize{
+        VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_REQUIRED_SUBGROUP_SIZE_CREATE_INFO, nullptr, required};
     VkPipelineShaderStageCreateInfo stage{VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO};
+    stage.pNext = required ? &subgroupSize : nullptr;
     stage.flags = stageFlags;
     stage.stage = VK_SHADER_STAGE_COMPUTE_BIT;
     stage.module = module;
@@ -48,41 +56,11 @@ ComputeProgram::ComputeProgram(Context& context, const ComputeProgramDesc& desc)
 // The pipeline goes first (a compile still running finishes); the layout member retires the module and layouts after it.
 ComputeProgram::~ComputeProgram() = default;
 
-std::vector<std::string> ComputeProgram::statistics() const {
-  std::vector<std::string> lines;
-  if (!context_->caps().pipelineStatistics) return lines;
-  VkDevice device = context_->device();
-  auto getProperties = reinterpret_cast<PFN_vkGetPipelineExecutablePropertiesKHR>(
-      vkGetDeviceProcAddr(device, "vkGetPipelineExecutablePropertiesKHR"));
-  auto getStatistics = reinterpret_cast<PFN_vkGetPipelineExecutableStatisticsKHR>(
-      vkGetDeviceProcAddr(device, "vkGetPipelineExecutableStatisticsKHR"));
-  if (!getProperties || !getStatistics) return lines;
-  VkPipelineInfoKHR pipelineInfo{VK_STRUCTURE_TYPE_PIPELINE_INFO_KHR};
-  pipelineInfo.pipeline = pipeline_->get();
-  uint32_t executables = 0;
-  VK_CHECK(getProperties(device, &pipelineInfo, &executables, nullptr));
-  for (uint32_t e = 0; e < executables; ++e) {
-    VkPipelineExecutableInfoKHR executable{VK_STRUCTURE_TYPE_PIPELINE_EXECUTABLE_INFO_KHR};
-    executable.pipeline = pipeline_->get();
-    executable.executableIndex = e;
-    uint32_t count = 0;
-    VK_CHECK(getStatistics(device, &executable, &count, nullptr));
-    std::vector<VkPipelineExecutableStatisticKHR> stats(count, {VK_STRUCTURE_TYPE_PIPELINE_EXECUTABLE_STATISTIC_KHR});
-    VK_CHECK(getStatistics(device, &executable, &count, stats.data()));
-    for (const VkPipelineExecutableStatisticKHR& s : stats) {
-      std::string value;
-      switch (s.format) {
-        case VK_PIPELINE_EXECUTABLE_STATISTIC_FORMAT_BOOL32_KHR: value = s.value.b32 ? "true" : "false"; break;
-        case VK_PIPELINE_EXECUTABLE_STATISTIC_FORMAT_INT64_KHR: value = std::to_string(s.value.i64); break;
-        case VK_PIPELINE_EXECUTABLE_STATISTIC_FORMAT_UINT64_KHR: value = std::to_string(s.value.u64); break;
-        case VK_PIPELINE_EXECUTABLE_STATISTIC_FORMAT_FLOAT64_KHR: value = std::to_string(s.value.f64); break;
-        default: value = "?";
-      }
-      lines.push_back(std::string(s.name) + " = " + value);
-    }
-  }
-  return lines;
+std::vector<PipelineStatistic> ComputeProgram::executableStatistics() const {
+  return pipelineStatistics(*context_, pipeline_->get());
 }
+
+std::vector<std::string> ComputeProgram::statistics() const { return statisticLines(executableStatistics()); }
 
 void ComputeProgram::record(Commands& commands, std::span<const BufferBinding> buffers, const void* push,
                             size_t pushBytes, uint64_t groups, const Buffer* indirect,

@@ -8,6 +8,7 @@
 #include "vk/commands.h"
 #include "vk/context.h"
 #include "vk/descriptors.h"
+#include "vk/pipeline_statistics.h"
 #include "vk/program_layout.h"
 #include "vk/spirv_reflect.h"
 
@@ -30,6 +31,10 @@ struct ComputeProgramDesc {
   /// Every subgroup is full and the subgroup numbering is dense; needed by
   /// shaders that rank or scan in (gl_SubgroupID, gl_SubgroupInvocationID) order.
   bool requireFullSubgroups = false;
+  /// Compile for subgroups of exactly this many lanes (VK_EXT_subgroup_size_control,
+  /// core in 1.3), within the device's range; 0: the driver's choice. The
+  /// renderer leaves it to the driver; `snell bench pipelines --wave32` asks.
+  uint32_t requiredSubgroupSize = 0;
 };
 
 class ComputeProgram {
@@ -45,6 +50,8 @@ class ComputeProgram {
   /// "name = value" lines the driver reports for this pipeline (registers,
   /// spills, ...); empty unless the context captures pipeline statistics.
   std::vector<std::string> statistics() const;
+  /// The same, one entry per statistic (waits for the compile).
+  std::vector<PipelineStatistic> executableStatistics() const;
   /// Its compile has finished (so a dispatch does not wait for it).
   bool ready() const { return pipeline_->ready(); }
   /// Waits for its compile (and throws what the compile threw).

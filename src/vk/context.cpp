@@ -188,6 +188,7 @@ std::unique_ptr<Context> Context::create(const ContextDesc& desc) {
   c.instance_ = createInstance(
       {desc.applicationName, desc.validation, desc.synchronizationValidation, desc.instanceExtensions}, debugUtils);
   c.validation_ = desc.validation;
+  c.compileOnly_ = desc.compileOnly;
   c.pipelineStatisticsRequested_ = desc.pipelineStatistics;
 
   if (debugUtils) {
@@ -218,7 +219,7 @@ std::unique_ptr<Context> Context::create(const ContextDesc& desc) {
   std::vector<DeviceFacts> facts = readAllFacts(c.instance_, handles);
   std::string why;
   std::string override = resolveOverride(desc.deviceOverride, desc.environment, facts, why);
-  DeviceChoice choice = chooseDevice(facts, override, why);
+  DeviceChoice choice = chooseDevice(facts, override, why, desc.compileOnly ? DeviceUse::Compile : DeviceUse::Run);
   if (!choice.chosen) {
     DeviceReport report{facts, choice, override, why};
     throw VulkanError("no Vulkan device meets snell's requirements (" + why + "):\n" + report.table());
@@ -421,8 +422,26 @@ void Context::initialise(VkPhysicalDevice physicalDevice, const DeviceFacts& fac
     }
     memoryLimit_ = std::min<uint64_t>(memoryLimit_ ? memoryLimit_ : bytes, bytes);
   }
+  // A CPU driver runs a frame on the host's cores, beside whatever else they
+  // run: a busy 2-core machine took 66 s over one frame of a million aimed
+  // rays that a GPU traces in milliseconds. It is not hung, so it waits longer.
+  waitTimeoutSeconds_ = facts.type == VK_PHYSICAL_DEVICE_TYPE_CPU ? 600.0 : 60.0;
+  waitTimeoutWhy_ = std::string(facts.type == VK_PHYSICAL_DEVICE_TYPE_CPU ? "a CPU device's limit" : "a GPU's limit") +
+                    "; SNELL_GPU_TIMEOUT=SECONDS sets another";
+  if (const char* limit = std::getenv("SNELL_GPU_TIMEOUT"); limit && *limit) {
+    char* end = nullptr;
+    double seconds = std::strtod(limit, &end);
+    if (*end != '\0' || !(seconds > 0.0) || !(seconds <= 1e6)) {
+      throw VulkanError(std::string("SNELL_GPU_TIMEOUT=") + limit + ": expected seconds, above 0 and at most 1000000");
+    }
+    waitTimeoutSeconds_ = seconds;
+    waitTimeoutWhy_ = std::string("SNELL_GPU_TIMEOUT=") + limit;
+  }
   setName(VK_OBJECT_TYPE_DEVICE, device_, "snell device");
   setName(VK_OBJECT_TYPE_QUEUE, queue_, "snell queue");
+  // A compile-only context measures the compiler: every pipeline is compiled
+  // afresh (a null device's UUID is all zeros, too, whatever it stands for).
+  if (compileOnly_) return;
   pipelineCache_ = std::make_unique<PipelineCache>(device_, physicalDevice);
   if (!pipelineCache_->warning().empty()) std::fprintf(stderr, "snell: note: %s\n", pipelineCache_->warning().c_str());
 }
@@ -434,7 +453,9 @@ Context::~Context() {
   }
   compileReady_.notify_all();
   for (std::thread& t : compilers_) t.join();  // programs waited for their own compiles; any left finish here
-  if (device_) vkDeviceWaitIdle(device_);  // the host's device too: our handles die with us
+  // The host's device too: our handles die with us. Not where nothing was
+  // submitted: a null device (compile only) has no queue to wait on.
+  if (device_ && submitted_) vkDeviceWaitIdle(device_);
   for (Retired& r : retired_) r.destroy();
   retired_.clear();
   if (pipelineCache_) {

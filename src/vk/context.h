@@ -49,6 +49,10 @@ struct ContextDesc {
   DeviceEnvironment environment;
   /// Ask the driver for per-pipeline statistics where it offers them.
   bool pipelineStatistics = false;
+  /// Only pipelines are made (`snell bench pipelines`): nothing is submitted,
+  /// no pipeline comes from or goes to the disk cache, and a device without
+  /// device-local memory, such as RADV's null device, qualifies.
+  bool compileOnly = false;
   /// Extra extensions a window needs (a surface on the instance, the swapchain
   /// on the device); creation fails naming any the system lacks.
   std::vector<std::string> instanceExtensions, deviceExtensions;
@@ -150,6 +154,8 @@ class Context {
   const std::string& deviceWhy() const { return deviceWhy_; }
   const DeviceCaps& caps() const { return caps_; }
   bool ownsDevice() const { return owned_; }
+  /// Made with ContextDesc::compileOnly: submitting work is a logic error.
+  bool compileOnly() const { return compileOnly_; }
   /// Whether an optional device extension (ContextDesc::optionalDeviceExtensions) was enabled.
   bool enabled(const std::string& extension) const {
     return std::find(optionalEnabled_.begin(), optionalEnabled_.end(), extension) != optionalEnabled_.end();
@@ -206,6 +212,13 @@ class Context {
   /// naming `what` with the bytes needed and available.
   void checkFits(uint64_t bytes, const std::string& what) const;
 
+  /// How long a submission may run before waiting on it reports the device
+  /// as hung: 60 s on a GPU, 600 s on a CPU device (lavapipe, SwiftShader),
+  /// or SNELL_GPU_TIMEOUT (seconds); and which of these it is, in words
+  /// (with how to set another).
+  double waitTimeoutSeconds() const { return waitTimeoutSeconds_; }
+  const std::string& waitTimeoutWhy() const { return waitTimeoutWhy_; }
+
   /// The pipeline cache every pipeline is made through, kept on disk between processes.
   VkPipelineCache pipelineCache() const { return pipelineCache_ ? pipelineCache_->handle() : VK_NULL_HANDLE; }
   const PipelineCache* diskCache() const { return pipelineCache_.get(); }
@@ -245,6 +258,7 @@ class Context {
   uint32_t queueFamily_ = 0;
   std::vector<std::string> optionalEnabled_;
   bool owned_ = false;
+  bool compileOnly_ = false;
   bool validation_ = false;
   bool pipelineStatisticsRequested_ = false;
   DeviceFacts facts_;
@@ -263,6 +277,8 @@ class Context {
   std::vector<Retired> retired_;
 
   uint64_t memoryLimit_ = 0;
+  double waitTimeoutSeconds_ = 60.0;
+  std::string waitTimeoutWhy_;
   std::atomic<uint64_t> memoryInUse_{0}, memoryPeak_{0};
   std::mutex memoryMutex_;
   std::unordered_map<VkDeviceMemory, uint64_t> counted_;  ///< device-local allocations and their sizes

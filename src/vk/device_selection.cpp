@@ -102,6 +102,10 @@ DeviceFacts readDeviceFacts(VkPhysicalDevice device, uint32_t index) {
   for (uint32_t h = 0; h < memory.memoryHeapCount; ++h) {
     if (memory.memoryHeaps[h].flags & VK_MEMORY_HEAP_DEVICE_LOCAL_BIT) facts.deviceLocalBytes += memory.memoryHeaps[h].size;
   }
+  if (facts.deviceLocalBytes == 0) {
+    facts.cannotRun = "it has no device-local memory (a null device, such as RADV_FORCE_FAMILY's, only compiles "
+                      "pipelines: 'snell bench pipelines')";
+  }
 
   uint32_t familyCount = 0;
   vkGetPhysicalDeviceQueueFamilyProperties(device, &familyCount, nullptr);
@@ -170,8 +174,18 @@ DeviceFacts readDeviceFacts(VkPhysicalDevice device, uint32_t index) {
   return facts;
 }
 
+bool qualifies(const DeviceFacts& d, DeviceUse use) {
+  return d.unmet.empty() && (use == DeviceUse::Compile || d.cannotRun.empty());
+}
+
+std::vector<std::string> unmetFor(const DeviceFacts& d, DeviceUse use) {
+  std::vector<std::string> unmet = d.unmet;
+  if (use == DeviceUse::Run && !d.cannotRun.empty()) unmet.push_back(d.cannotRun);
+  return unmet;
+}
+
 DeviceChoice chooseDevice(std::span<const DeviceFacts> devices, const std::string& override,
-                          const std::string& source) {
+                          const std::string& source, DeviceUse use) {
   DeviceChoice choice;
   uint32_t overrideIndex = 0;
   bool byIndex = isIndex(override, overrideIndex);
@@ -189,7 +203,7 @@ DeviceChoice chooseDevice(std::span<const DeviceFacts> devices, const std::strin
 
   for (uint32_t i = 0; i < devices.size(); ++i) {
     const DeviceFacts& d = devices[i];
-    if (!named(d) || !d.unmet.empty()) continue;
+    if (!named(d) || !qualifies(d, use)) continue;
     if (!choice.chosen || rank(d) < rank(devices[*choice.chosen])) choice.chosen = i;
   }
 
@@ -199,9 +213,10 @@ DeviceChoice chooseDevice(std::span<const DeviceFacts> devices, const std::strin
     if (choice.chosen && i == *choice.chosen) {
       verdict = override.empty() ? "chosen: the highest-ranked device that meets every requirement"
                                  : "chosen: named by " + (source.empty() ? "SNELL_DEVICE=" + override : source);
-    } else if (!d.unmet.empty()) {
+    } else if (!qualifies(d, use)) {
       verdict = "rejected: ";
-      for (size_t u = 0; u < d.unmet.size(); ++u) verdict += (u ? "; " : "") + d.unmet[u];
+      std::vector<std::string> unmet = unmetFor(d, use);
+      for (size_t u = 0; u < unmet.size(); ++u) verdict += (u ? "; " : "") + unmet[u];
     } else if (!named(d)) {
       verdict = "not chosen: " + (source.empty() ? "SNELL_DEVICE=" + override : source) + " names another device";
     } else {
@@ -280,7 +295,7 @@ std::vector<uint32_t> chooseDeviceList(std::span<const DeviceFacts> devices, con
     DeviceChoice best = chooseDevice(devices, "");
     if (!best.chosen) throw VulkanError("--devices all: no Vulkan device meets snell's requirements ('snell info --devices' says why)");
     for (const DeviceFacts& d : devices) {
-      if (d.unmet.empty() && d.type == devices[*best.chosen].type) chosen.push_back(d.index);
+      if (qualifies(d) && d.type == devices[*best.chosen].type) chosen.push_back(d.index);
     }
     return chosen;
   }
@@ -298,7 +313,9 @@ std::vector<uint32_t> chooseDeviceList(std::span<const DeviceFacts> devices, con
       throw std::invalid_argument("--devices " + list + ": no device " + entry + " ('snell info --devices' lists " +
                         std::to_string(devices.size()) + ")");
     }
-    if (!it->unmet.empty()) throw std::invalid_argument("--devices " + list + ": " + it->name + " does not qualify: " + it->unmet.front());
+    if (!qualifies(*it)) {
+      throw std::invalid_argument("--devices " + list + ": " + it->name + " does not qualify: " + unmetFor(*it).front());
+    }
     chosen.push_back(it->index);
   }
   return chosen;

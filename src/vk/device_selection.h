@@ -36,7 +36,20 @@ struct DeviceFacts {
   bool pipelineStatistics = false;
   /// Requirements this device does not meet, in words; empty when it qualifies.
   std::vector<std::string> unmet;
+  /// Why it cannot run work although it meets the rest, in words; empty when it
+  /// can. A device without device-local memory (RADV's null device under
+  /// RADV_FORCE_FAMILY) still compiles pipelines: DeviceUse::Compile takes it.
+  std::string cannotRun;
 };
+
+/// What a device is chosen for: running work, or only compiling pipelines
+/// (`snell bench pipelines`), which needs no memory.
+enum class DeviceUse { Run, Compile };
+
+/// Whether `d` meets every requirement of `use`.
+bool qualifies(const DeviceFacts& d, DeviceUse use = DeviceUse::Run);
+/// The requirements of `use` that `d` does not meet, in words.
+std::vector<std::string> unmetFor(const DeviceFacts& d, DeviceUse use = DeviceUse::Run);
 
 /// Reads the facts of one physical device and checks snell's requirements:
 /// Vulkan 1.3, a compute queue, subgroup basic/ballot/arithmetic/shuffle in compute
@@ -60,7 +73,7 @@ struct DeviceChoice {
 /// to the larger device-local memory, then to the lower index. `source` says
 /// where the override came from, for the verdicts ("SNELL_DEVICE=..." if empty).
 DeviceChoice chooseDevice(std::span<const DeviceFacts> devices, const std::string& override,
-                          const std::string& source = "");
+                          const std::string& source = "", DeviceUse use = DeviceUse::Run);
 
 /// A launcher's GPU list as a device override. Slurm and CUDA launchers name
 /// GPUs by CUDA_VISIBLE_DEVICES (indices or GPU-UUIDs) or SLURM_STEP_GPUS

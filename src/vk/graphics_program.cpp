@@ -108,12 +108,17 @@ GraphicsProgram::GraphicsProgram(Context& context, const GraphicsProgramDesc& de
     info.pColorBlendState = &blend;
     info.pDynamicState = &dynamic;
     info.layout = layout;
-  return vkCreateGraphicsPipelines(context.device(), context.pipelineCache(), 1, &info, nullptr, pipeline);
+    info.flags = context.caps().pipelineStatistics ? VK_PIPELINE_CREATE_CAPTURE_STATISTICS_BIT_KHR : 0;
+    return vkCreateGraphicsPipelines(context.device(), context.pipelineCache(), 1, &info, nullptr, pipeline);
   });
 }
 
 // The pipeline goes first (a compile still running finishes); the layout member retires the modules and layouts after it.
 GraphicsProgram::~GraphicsProgram() = default;
+
+std::vector<PipelineStatistic> GraphicsProgram::executableStatistics() const {
+  return pipelineStatistics(*context_, pipeline_->get());
+}
 
 void GraphicsProgram::bind(Commands& commands, std::span<const BufferBinding> resources, VkRect2D area) const {
   layout_.bind(commands, VK_PIPELINE_BIND_POINT_GRAPHICS, pipeline_->get(), resources);

@@ -9,6 +9,7 @@
 #include "vk/commands.h"
 #include "vk/context.h"
 #include "vk/descriptors.h"
+#include "vk/pipeline_statistics.h"
 #include "vk/program_layout.h"
 #include "vk/spirv_reflect.h"
 
@@ -18,6 +19,7 @@
 #include <optional>
 #include <span>
 #include <string>
+#include <vector>
 
 namespace snell::vk {
 
@@ -47,6 +49,9 @@ class GraphicsProgram {
   GraphicsProgram& operator=(const GraphicsProgram&) = delete;
 
   const std::string& name() const { return name_; }
+  /// The driver's statistics of each of its stages (waits for the compile;
+  /// empty unless the context captures statistics).
+  std::vector<PipelineStatistic> executableStatistics() const;
 
   /// Binds the pipeline and its resources (one per binding the shaders
   /// declare) inside a rendering scope, with the viewport and scissor covering `area`.

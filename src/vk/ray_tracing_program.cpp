@@ -61,6 +61,7 @@ RayTracingProgram::RayTracingProgram(Context& context, const RayTracingProgramDe
   pipelineInfo.pGroups = groups;
   pipelineInfo.maxPipelineRayRecursionDepth = 1;  // the ray generation shader loops; hits do not recurse
   pipelineInfo.layout = layout_.pipelineLayout();
+  pipelineInfo.flags = context.caps().pipelineStatistics ? VK_PIPELINE_CREATE_CAPTURE_STATISTICS_BIT_KHR : 0;
   auto create = reinterpret_cast<PFN_vkCreateRayTracingPipelinesKHR>(
       vkGetDeviceProcAddr(device, "vkCreateRayTracingPipelinesKHR"));
   auto handlesOf = reinterpret_cast<PFN_vkGetRayTracingShaderGroupHandlesKHR>(
@@ -70,6 +71,7 @@ RayTracingProgram::RayTracingProgram(Context& context, const RayTracingProgramDe
   VK_CHECK(context.compile(
       [&] { return create(device, VK_NULL_HANDLE, context.pipelineCache(), 1, &pipelineInfo, nullptr, &pipeline_); }));
   context.setName(VK_OBJECT_TYPE_PIPELINE, pipeline_, name_);
+  if (context.compileOnly()) return;  // nothing is traced: no shader binding table
 
   // The shader binding table: one record per group, each region aligned as the device asks.
   VkPhysicalDeviceRayTracingPipelinePropertiesKHR properties{
@@ -92,6 +94,10 @@ RayTracingProgram::RayTracingProgram(Context& context, const RayTracingProgramDe
   raygenRegion_ = {base, region, region};  // the ray generation region's stride must equal its size
   missRegion_ = {base + region, stride, stride};
   hitRegion_ = {base + 2 * region, stride, stride};
+}
+
+std::vector<PipelineStatistic> RayTracingProgram::executableStatistics() const {
+  return pipelineStatistics(*context_, pipeline_);
 }
 
 RayTracingProgram::~RayTracingProgram() {

@@ -8,6 +8,7 @@
 #include "vk/commands.h"
 #include "vk/context.h"
 #include "vk/descriptors.h"
+#include "vk/pipeline_statistics.h"
 #include "vk/program_layout.h"
 #include "vk/spirv_reflect.h"
 
@@ -32,6 +33,9 @@ class RayTracingProgram {
   ~RayTracingProgram();
   RayTracingProgram(const RayTracingProgram&) = delete;
   RayTracingProgram& operator=(const RayTracingProgram&) = delete;
+
+  /// The driver's statistics of each of its shaders (empty unless the context captures statistics).
+  std::vector<PipelineStatistic> executableStatistics() const;
 
   /// Launches width x height ray generation invocations.
   template <typename Push>
