@@ -21,9 +21,13 @@
 # ratio of the first build's time to each other's, and whether each build draws the three trace
 # scenes with the same pixels (`snell render --stats-json`'s image hash, first round);
 # $OUT/compare.json holds every measurement (ROWS=registers adds the driver's register and spill counts
-# of each build's trace pipelines, $OUT/registers.log). BUILDS (names, space-separated) limits `run` to some of
-# the carried builds, and NAME+VAR=VALUE runs build NAME with VAR=VALUE set (an experiment's switch);
-# ROWS limits it to some rows (same, trace, viewport).
+# of each build's trace pipelines, $OUT/registers.log). ROWS=pipelines compiles each build's trace
+# specialisations (`snell bench pipelines --trace-spirv`, with the newest carried snell that has the
+# command) on the GPU's driver and, on AMD's compiler through RADV's null device (gfx1100), here at
+# `build` (the GPU machine has no RADV), and puts both side by side in $OUT/pipelines.md. BUILDS
+# (names, space-separated) limits `run` to some of the carried builds, and NAME+VAR=VALUE runs build
+# NAME with VAR=VALUE set (an experiment's switch); ROWS limits it to some rows (same, trace, viewport,
+# registers, pipelines).
 set -uo pipefail
 cd "$(dirname "$0")/.."
 
@@ -61,6 +65,8 @@ build_one() {
   (cd "$src" && cmake --preset device -DSNELL_BUILD_TESTS=OFF -DCMAKE_CXX_COMPILER_LAUNCHER=ccache >/dev/null &&
      cmake --build --preset device -j "$(nproc)" --target snell >/dev/null) || { echo "compare: $name did not build" >&2; return 1; }
   strip -o ".carry/snell-$name" "$src/build/device/snell"
+  # Its trace as SPIR-V, for ROWS=pipelines.
+  glslangValidator --quiet --target-env vulkan1.3 -g0 -o ".carry/trace-$name.spv" "$src/shaders/comp/trace.comp"
   # Libraries of Debian's that the GPU machine's image does not have.
   ldd "$src/build/device/snell" | awk '/=> \// {print $3}' | while read -r lib; do
     case $(basename "$lib") in
@@ -68,6 +74,15 @@ build_one() {
       *) cp -u "$lib" .carry/lib/ ;;
     esac
   done
+}
+
+# The newest carried snell that has `bench pipelines` (it compiles any build's trace: --trace-spirv).
+pipelines_tool() {
+  local f
+  for f in $(ls -t .carry/snell-* 2>/dev/null); do
+    "$f" bench pipelines --help >/dev/null 2>&1 && { echo "$f"; return 0; }
+  done
+  return 1
 }
 
 # Runs build NAME, or NAME+VAR=VALUE: that build with VAR=VALUE in its environment (an experiment's switch).
@@ -150,6 +165,17 @@ run_all() {
       fi
     done | tee -a "$log"
   done
+  if [[ $rows == *pipelines* ]]; then  # registers and spills: the GPU's driver here, AMD's from `build`
+    local tool
+    tool=$(pipelines_tool) || { echo "compare: no carried snell has 'bench pipelines'" >&2; return 1; }
+    for b in "${builds[@]}"; do
+      "$tool" bench pipelines --only trace: --trace-spirv ".carry/trace-${b%%+*}.spv" \
+        --json "$OUT/pipelines-${b%%+*}-gpu.json" >/dev/null 2>>"$OUT/pipelines.log"
+      cp ".carry/pipelines-${b%%+*}-gfx1100.json" "$OUT/" 2>/dev/null
+    done
+    python3 bench/pipelines_table.py "$OUT" "${builds[@]%%+*}" | tee "$OUT/pipelines.md"
+    [[ $rows == pipelines ]] && return 0
+  fi
   python3 bench/compare_table.py "$log" --json "$OUT/compare.json" --order "${builds[*]}" | tee "$OUT/compare.md"
 }
 
@@ -159,6 +185,14 @@ case ${1:-} in
     (($#)) || { usage >&2; exit 2; }
     carry_runtime
     for spec in "$@"; do build_one "$spec" || exit $?; done
+    # AMD's statistics of each build's trace (ROWS=pipelines), which need no GPU: here, once all are built.
+    if tool=$(pipelines_tool); then
+      for spec in "$@"; do
+        name=${spec%%=*}
+        "$tool" bench pipelines --amd gfx1100 --only trace: --trace-spirv ".carry/trace-$name.spv" \
+          --json ".carry/pipelines-$name-gfx1100.json" >/dev/null || echo "compare: no AMD statistics of $name" >&2
+      done
+    fi
     ls -la .carry/ .carry/lib
     ;;
   run) shift; run_all "$@" ;;

@@ -30,6 +30,7 @@ void addBenchStress(CLI::App& bench, Runner& run);
 void addBenchScale(CLI::App& bench, Runner& run);
 void addBenchMethods(CLI::App& bench, Runner& run);
 void addBenchShot(CLI::App& bench, Runner& run);
+void addBenchPipelines(CLI::App& bench, Runner& run);
 
 /// What `snell render ARGS` would draw, found as it would find it: the
 /// options parse and agree, the scene and environment load. Throws

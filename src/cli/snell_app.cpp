@@ -39,6 +39,7 @@ std::unique_ptr<CLI::App> makeSnellApp(Runner& run) {
   addBenchScale(*bench, run);
   addBenchMethods(*bench, run);
   addBenchShot(*bench, run);
+  addBenchPipelines(*bench, run);
   return app;
 }
 

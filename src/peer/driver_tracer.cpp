@@ -24,6 +24,10 @@ static_assert(offsetof(DriverTracePush, topLevel) == 128 && sizeof(DriverTracePu
 
 }  // namespace
 
+vk::RayTracingProgramDesc DriverTracer::programDesc(uint32_t surface) {
+  return {"driver trace", kSpvDriverTrace, kSpvDriverTraceMiss, kSpvDriverTraceHit, {{gpu::kTraceSpecSurface, surface}}};
+}
+
 DriverTracer::DriverTracer(vk::Context& context, const vk::Buffer& positions, uint32_t vertexCount,
                            const vk::Buffer& indices, const std::vector<DriverGeometry>& geometries,
                            uint32_t instanceCapacity, uint32_t surface)
@@ -38,9 +42,7 @@ DriverTracer::DriverTracer(vk::Context& context, const vk::Buffer& positions, ui
     first.push_back(g.firstTriangle);
   }
   tlas_ = std::make_unique<DriverTlas>(context, instanceCapacity);
-  program_ = std::make_unique<vk::RayTracingProgram>(
-      context, vk::RayTracingProgramDesc{"driver trace", kSpvDriverTrace, kSpvDriverTraceMiss, kSpvDriverTraceHit,
-                                         {{gpu::kTraceSpecSurface, surface}}});
+  program_ = std::make_unique<vk::RayTracingProgram>(context, programDesc(surface));
   geometryFirst_ = vk::Buffer(context, {std::max<size_t>(first.size(), 1) * 4,
                                         VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
                                         vk::MemoryDomain::Device, "driver geometry first triangles"});

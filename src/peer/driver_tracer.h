@@ -34,6 +34,9 @@ class DriverTracer {
                const std::vector<DriverGeometry>& geometries, uint32_t instanceCapacity, uint32_t surface);
   ~DriverTracer();
 
+  /// Its ray tracing pipeline for a scene whose materials use `surface`.
+  static vk::RayTracingProgramDesc programDesc(uint32_t surface);
+
   /// Builds every bottom level the first time, then updates the `moved`
   /// geometries in place, and rebuilds the top level over `instances` when
   /// either changed or `instancesChanged`. Passes: driver blas build, driver

@@ -48,30 +48,37 @@ struct BvhBuilder::Scratch {
   RadixSort::Scratch sort32, sort64;
 };
 
-BvhBuilder::BvhBuilder(vk::Context& context, BvhTuning tuning)
-    : context_(context), sort32_(context, KeyWidth::Bits32), sort64_(context, KeyWidth::Bits64) {
-  auto program = [&](const char* name, std::span<const uint32_t> spirv, std::vector<vk::SpecConstant> spec) {
-    return std::make_unique<vk::ComputeProgram>(context, vk::ComputeProgramDesc{name, spirv, std::move(spec), false});
+std::vector<vk::ComputeProgramDesc> BvhBuilder::programDescs(const vk::Context& context, BvhTuning tuning) {
+  auto program = [](const char* name, std::span<const uint32_t> spirv, std::vector<vk::SpecConstant> spec) {
+    return vk::ComputeProgramDesc{name, spirv, std::move(spec), false};
   };
-  boxes_ = program("bvh build boxes", kSpvBvhBuildBoxes, {{gpu::kBvhSpecWorkgroupSize, 64}});
-  morton_ = program("bvh morton", kSpvBvhMorton, {{gpu::kBvhSpecWorkgroupSize, 64}});
   // H-PLOC's teams are subgroups, each clustering one window. One team per
   // workgroup: lavapipe needs it (above), and on an H100 a 1M-triangle sphere
   // built in 1.13 ms with 32 invocations against 1.22 ms with 128, 10M in 8.3
   // against 8.9 ms (same run, bench/results/scale.md).
   const vk::DeviceCaps& caps = context.caps();
   uint32_t hplocWidth = tuning.hplocWorkgroup ? tuning.hplocWorkgroup : caps.maxSubgroupSize;
-  hploc_ = std::make_unique<vk::ComputeProgram>(
-      context, vk::ComputeProgramDesc{"bvh hploc",
-                                      kSpvBvhHploc,
-                                      {{gpu::kBvhSpecWorkgroupSize, hplocWidth},
-                                       {gpu::kBvhSpecSlots, (gpu::kBvhWindow + caps.minSubgroupSize - 1) / caps.minSubgroupSize},
-                                       {gpu::kBvhSpecTeams, hplocWidth / caps.minSubgroupSize}},
-                                      true});
-  refit_ = program("bvh refit", kSpvBvhRefit,
-                   {{gpu::kBvhSpecWorkgroupSize, tuning.refitWorkgroup ? tuning.refitWorkgroup : handOffWorkgroup(context)}});
-  restructure_ = program("bvh restructure", kSpvBvhRestructure, {{gpu::kBvhSpecWorkgroupSize, handOffWorkgroup(context)}});
-  quantise_ = program("bvh quantise", kSpvBvhQuantise, {{gpu::kBvhSpecWorkgroupSize, 64}});
+  return {
+      program("bvh build boxes", kSpvBvhBuildBoxes, {{gpu::kBvhSpecWorkgroupSize, 64}}),
+      program("bvh morton", kSpvBvhMorton, {{gpu::kBvhSpecWorkgroupSize, 64}}),
+      vk::ComputeProgramDesc{"bvh hploc",
+                             kSpvBvhHploc,
+                             {{gpu::kBvhSpecWorkgroupSize, hplocWidth},
+                              {gpu::kBvhSpecSlots, (gpu::kBvhWindow + caps.minSubgroupSize - 1) / caps.minSubgroupSize},
+                              {gpu::kBvhSpecTeams, hplocWidth / caps.minSubgroupSize}},
+                             true},
+      program("bvh refit", kSpvBvhRefit,
+              {{gpu::kBvhSpecWorkgroupSize, tuning.refitWorkgroup ? tuning.refitWorkgroup : handOffWorkgroup(context)}}),
+      program("bvh restructure", kSpvBvhRestructure, {{gpu::kBvhSpecWorkgroupSize, handOffWorkgroup(context)}}),
+      program("bvh quantise", kSpvBvhQuantise, {{gpu::kBvhSpecWorkgroupSize, 64}}),
+  };
+}
+
+BvhBuilder::BvhBuilder(vk::Context& context, BvhTuning tuning)
+    : context_(context), sort32_(context, KeyWidth::Bits32), sort64_(context, KeyWidth::Bits64) {
+  std::vector<vk::ComputeProgramDesc> descs = programDescs(context, tuning);
+  std::unique_ptr<vk::ComputeProgram>* programs[] = {&boxes_, &morton_, &hploc_, &refit_, &restructure_, &quantise_};
+  for (size_t i = 0; i < descs.size(); ++i) *programs[i] = std::make_unique<vk::ComputeProgram>(context, descs[i]);
   placeholder_ = vk::storageBuffer(context, 16, "bvh placeholder");
 }
 

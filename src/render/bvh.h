@@ -105,6 +105,10 @@ class BvhBuilder {
   explicit BvhBuilder(vk::Context& context, BvhTuning tuning = {});
   ~BvhBuilder();
 
+  /// Its pipelines on `context`'s device, in build order (build boxes,
+  /// Morton codes, H-PLOC, refit, restructure, quantise); the sorts are RadixSort's.
+  static std::vector<vk::ComputeProgramDesc> programDescs(const vk::Context& context, BvhTuning tuning = {});
+
   /// Allocates a forest whose group g holds primitives [sum of earlier sizes, + groupSizes[g]).
   Bvh makeBvh(const std::vector<uint32_t>& groupSizes, BvhLeaves leaves, const std::string& name) const;
 

@@ -19,11 +19,14 @@ constexpr uint32_t kWorkgroupSize = 64;
 
 }  // namespace
 
+vk::ComputeProgramDesc DeformPass::programDesc() {
+  return {"deform", kSpvDeform, {{gpu::kDeformSpecWorkgroupSize, kWorkgroupSize}}, false};
+}
+
 DeformPass::DeformPass(vk::Context& context, const scene::Scene& scene, const scene::Pose& pose,
                        const std::function<DeformSlot(int item)>& slots)
     : context_(context), scene_(scene) {
-  program_ = std::make_unique<vk::ComputeProgram>(
-      context, vk::ComputeProgramDesc{"deform", kSpvDeform, {{gpu::kDeformSpecWorkgroupSize, kWorkgroupSize}}, false});
+  program_ = std::make_unique<vk::ComputeProgram>(context, programDesc());
   shapes_.resize(scene.shapes.size());
   std::vector<float> restPositions, restNormals, morphDeltas;
   std::vector<glm::uvec4> joints;

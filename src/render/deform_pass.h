@@ -53,6 +53,8 @@ class DeformPass {
   /// joint's world position, so they keep float precision however far the
   /// character is from the world's origin, and move only when it does.
   static glm::dvec3 anchorOf(const scene::DrawItem& item);
+  /// Its pipeline, as every deform pass makes it.
+  static vk::ComputeProgramDesc programDesc();
 
   /// Records one dispatch deforming the outputs listed (indices into
   /// outputs(); every one when `which` is empty) to `pose`, then a barrier

@@ -25,17 +25,23 @@ uint32_t fullSubgroupWorkgroupSize(const vk::DeviceCaps& caps, uint32_t preferre
   return size;
 }
 
-PrefixSum::PrefixSum(vk::Context& context) : context_(context) {
+std::vector<vk::ComputeProgramDesc> PrefixSum::programDescs(const vk::Context& context) {
   const vk::DeviceCaps& caps = context.caps();
   uint32_t workgroup = fullSubgroupWorkgroupSize(caps, 256);
-  tile_ = workgroup * kItemsPerThread;
   std::vector<vk::SpecConstant> spec = {
       {gpu::kScanSpecWorkgroupSize, workgroup},
       {gpu::kScanSpecItemsPerThread, kItemsPerThread},
       {gpu::kScanSpecMaxSubgroups, workgroup / caps.minSubgroupSize},
   };
-  reduce_ = std::make_unique<vk::ComputeProgram>(context, vk::ComputeProgramDesc{"scan_reduce", kSpvScanReduce, spec, true});
-  scanBlock_ = std::make_unique<vk::ComputeProgram>(context, vk::ComputeProgramDesc{"scan_block", kSpvScanBlock, spec, true});
+  return {vk::ComputeProgramDesc{"scan_reduce", kSpvScanReduce, spec, true},
+          vk::ComputeProgramDesc{"scan_block", kSpvScanBlock, spec, true}};
+}
+
+PrefixSum::PrefixSum(vk::Context& context) : context_(context) {
+  tile_ = fullSubgroupWorkgroupSize(context.caps(), 256) * kItemsPerThread;
+  std::vector<vk::ComputeProgramDesc> descs = programDescs(context);
+  reduce_ = std::make_unique<vk::ComputeProgram>(context, descs[0]);
+  scanBlock_ = std::make_unique<vk::ComputeProgram>(context, descs[1]);
 }
 
 PrefixSum::Scratch PrefixSum::makeScratch(uint64_t count) const {

@@ -19,6 +19,9 @@ class PrefixSum {
  public:
   explicit PrefixSum(vk::Context& context);
 
+  /// Its two pipelines on `context`'s device (reduce, scan a block).
+  static std::vector<vk::ComputeProgramDesc> programDescs(const vk::Context& context);
+
   /// Buffers for the block sums of every level a scan of `count` elements needs.
   struct Scratch {
     uint64_t capacity = 0;

@@ -26,42 +26,59 @@ uint32_t sharedBytes(uint32_t workgroup, uint32_t keysPerThread, uint32_t minSub
 
 }  // namespace
 
-RadixSort::RadixSort(vk::Context& context, KeyWidth width, RadixSortTuning tuning)
-    : context_(context), width_(width), scan_(context) {
-  const vk::DeviceCaps& caps = context.caps();
+RadixSortTuning RadixSort::shapeFor(const vk::DeviceCaps& caps, KeyWidth width, RadixSortTuning tuning) {
   // Keys per invocation trade registers (occupancy) against tile size (fewer
   // blocks, longer runs per digit when scattering); then the widest workgroup
   // whose shared memory fits. Measured on an H200 at 2^24 pairs: 512 x 12 for
   // 32-bit keys and 384 x 10 for 64-bit keys were the fastest shapes
   // (bench/results/sort-nvidia-h200.md); lavapipe's 32 KiB gives 128 x 12 / 10.
-  keysPerThread_ = tuning.keysPerThread ? tuning.keysPerThread : (width == KeyWidth::Bits32 ? 12u : 10u);
-  workgroupSize_ = tuning.workgroupSize;
-  while (!workgroupSize_ && keysPerThread_ > 1) {
+  RadixSortTuning shape;
+  shape.keysPerThread = tuning.keysPerThread ? tuning.keysPerThread : (width == KeyWidth::Bits32 ? 12u : 10u);
+  shape.workgroupSize = tuning.workgroupSize;
+  while (!shape.workgroupSize && shape.keysPerThread > 1) {
     for (uint32_t preferred : {512u, 384u, 256u, 128u, 64u}) {
       if (preferred > caps.maxComputeWorkgroupInvocations || preferred % caps.maxSubgroupSize != 0) continue;
-      if (sharedBytes(preferred, keysPerThread_, caps.minSubgroupSize, width) <= caps.maxComputeSharedMemoryBytes) {
-        workgroupSize_ = preferred;
+      if (sharedBytes(preferred, shape.keysPerThread, caps.minSubgroupSize, width) <= caps.maxComputeSharedMemoryBytes) {
+        shape.workgroupSize = preferred;
         break;
       }
     }
-    if (!workgroupSize_) keysPerThread_ = tuning.keysPerThread ? 1 : keysPerThread_ - 1;
+    if (!shape.workgroupSize) shape.keysPerThread = tuning.keysPerThread ? 1 : shape.keysPerThread - 1;
   }
-  if (!workgroupSize_ || sharedBytes(workgroupSize_, keysPerThread_, caps.minSubgroupSize, width) > caps.maxComputeSharedMemoryBytes) {
+  if (!shape.workgroupSize ||
+      sharedBytes(shape.workgroupSize, shape.keysPerThread, caps.minSubgroupSize, width) > caps.maxComputeSharedMemoryBytes) {
     throw vk::VulkanError("the radix sort does not fit in " + std::to_string(caps.maxComputeSharedMemoryBytes) +
                           " bytes of shared memory");
   }
-  if (uint64_t(workgroupSize_) * keysPerThread_ > 65536) {
+  if (uint64_t(shape.workgroupSize) * shape.keysPerThread > 65536) {
     throw vk::VulkanError("radix sort tiles hold at most 65536 keys (ranks are 16-bit); asked for " +
-                          std::to_string(workgroupSize_) + " x " + std::to_string(keysPerThread_));
+                          std::to_string(shape.workgroupSize) + " x " + std::to_string(shape.keysPerThread));
   }
+  return shape;
+}
+
+std::vector<vk::ComputeProgramDesc> RadixSort::programDescs(const vk::Context& context, KeyWidth width,
+                                                            RadixSortTuning tuning) {
+  const vk::DeviceCaps& caps = context.caps();
+  RadixSortTuning shape = shapeFor(caps, width, tuning);
   std::vector<vk::SpecConstant> spec = {
-      {gpu::kSortSpecWorkgroupSize, workgroupSize_},
-      {gpu::kSortSpecKeysPerThread, keysPerThread_},
-      {gpu::kSortSpecMaxSubgroups, workgroupSize_ / caps.minSubgroupSize},
+      {gpu::kSortSpecWorkgroupSize, shape.workgroupSize},
+      {gpu::kSortSpecKeysPerThread, shape.keysPerThread},
+      {gpu::kSortSpecMaxSubgroups, shape.workgroupSize / caps.minSubgroupSize},
       {gpu::kSortSpecKeyWords, static_cast<uint32_t>(width)},
   };
-  histogram_ = std::make_unique<vk::ComputeProgram>(context, vk::ComputeProgramDesc{"sort_histogram", kSpvSortHistogram, spec, true});
-  scatter_ = std::make_unique<vk::ComputeProgram>(context, vk::ComputeProgramDesc{"sort_scatter", kSpvSortScatter, spec, true});
+  return {vk::ComputeProgramDesc{"sort_histogram", kSpvSortHistogram, spec, true},
+          vk::ComputeProgramDesc{"sort_scatter", kSpvSortScatter, spec, true}};
+}
+
+RadixSort::RadixSort(vk::Context& context, KeyWidth width, RadixSortTuning tuning)
+    : context_(context), width_(width), scan_(context) {
+  RadixSortTuning shape = shapeFor(context.caps(), width, tuning);
+  workgroupSize_ = shape.workgroupSize;
+  keysPerThread_ = shape.keysPerThread;
+  std::vector<vk::ComputeProgramDesc> descs = programDescs(context, width, tuning);
+  histogram_ = std::make_unique<vk::ComputeProgram>(context, descs[0]);
+  scatter_ = std::make_unique<vk::ComputeProgram>(context, descs[1]);
 }
 
 std::vector<std::string> RadixSort::statistics() const {

@@ -30,6 +30,13 @@ class RadixSort {
  public:
   RadixSort(vk::Context& context, KeyWidth width, RadixSortTuning tuning = {});
 
+  /// The workgroup size and keys per invocation it runs with on a device
+  /// (`tuning`'s where set); throws vk::VulkanError where none fits.
+  static RadixSortTuning shapeFor(const vk::DeviceCaps& caps, KeyWidth width, RadixSortTuning tuning = {});
+  /// Its two pipelines on `context`'s device (histogram, scatter); the scan is PrefixSum's.
+  static std::vector<vk::ComputeProgramDesc> programDescs(const vk::Context& context, KeyWidth width,
+                                                          RadixSortTuning tuning = {});
+
   /// Ping-pong buffers, digit histogram and scan scratch for up to `capacity` pairs.
   struct Scratch {
     uint64_t capacity = 0;

@@ -39,10 +39,7 @@ DepthRange fitDepthRange(const scene::View& view, const glm::dvec3& lo, const gl
   return range;
 }
 
-RasterPass::RasterPass(vk::Context& context)
-    : context_(context),
-      noMap_(context, {sizeof(gpu::RefractionTexel), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, vk::MemoryDomain::Device,
-                       "no refraction map"}) {
+std::vector<vk::GraphicsProgramDesc> RasterPass::programDescs(const vk::Context& context) {
   vk::GraphicsProgramDesc desc;
   desc.name = "raster";
   desc.vertexSpirv = kSpvRasterVertex;
@@ -53,15 +50,13 @@ RasterPass::RasterPass(vk::Context& context)
   depthOnly.name = "raster depth";
   depthOnly.fragmentSpirv = kSpvRasterDepth;
   depthOnly.colorWrite = false;
-  depth_ = std::make_unique<vk::GraphicsProgram>(context, depthOnly);
   vk::GraphicsProgramDesc mask = desc;
   mask.name = "raster depth and mask";
   mask.fragmentSpirv = kSpvRasterMask;
   mask.colorFormat = kMaskFormat;
-  mask_ = std::make_unique<vk::GraphicsProgram>(context, mask);
   desc.depthCompare = VK_COMPARE_OP_EQUAL;  // only the fragment the pre-pass kept
   desc.depthWrite = false;
-  fill_ = std::make_unique<vk::GraphicsProgram>(context, desc);
+  std::vector<vk::GraphicsProgramDesc> descs = {depthOnly, mask, desc};
   if (context.caps().fillModeNonSolid) {
     desc.name = "raster wireframe";
     desc.polygonMode = VK_POLYGON_MODE_LINE;
@@ -69,8 +64,20 @@ RasterPass::RasterPass(vk::Context& context)
     desc.depthWrite = false;
     desc.depthBias = 4.0f;  // reverse Z: towards the camera, over the face's own depth
     desc.blend = true;
-    wire_ = std::make_unique<vk::GraphicsProgram>(context, desc);
+    descs.push_back(desc);
   }
+  return descs;
+}
+
+RasterPass::RasterPass(vk::Context& context)
+    : context_(context),
+      noMap_(context, {sizeof(gpu::RefractionTexel), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, vk::MemoryDomain::Device,
+                       "no refraction map"}) {
+  std::vector<vk::GraphicsProgramDesc> descs = programDescs(context);
+  depth_ = std::make_unique<vk::GraphicsProgram>(context, descs[0]);
+  mask_ = std::make_unique<vk::GraphicsProgram>(context, descs[1]);
+  fill_ = std::make_unique<vk::GraphicsProgram>(context, descs[2]);
+  if (descs.size() > 3) wire_ = std::make_unique<vk::GraphicsProgram>(context, descs[3]);
 }
 
 RasterPass::~RasterPass() = default;

@@ -91,6 +91,11 @@ class RasterPass {
   explicit RasterPass(vk::Context& context);
   ~RasterPass();
 
+  /// Its pipelines on `context`'s device: the depth pre-pass, the pre-pass
+  /// with the transmissive mask, the shading pass and, where the device draws
+  /// lines, the wireframe.
+  static std::vector<vk::GraphicsProgramDesc> programDescs(const vk::Context& context);
+
   /// The depth pre-pass into `depth` (kDepthFormat, GENERAL, cleared). With
   /// `mask` (kMaskFormat, GENERAL) it also writes 1 where the nearest face
   /// is transmissive and 0 elsewhere; without, `colorTarget` (kCompositeFormat)

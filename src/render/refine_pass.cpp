@@ -81,14 +81,17 @@ RefinePass::RefinePass(vk::Context& context, const scene::Scene& scene, const Sc
     ownCage_ = vk::storageBuffer(context, VkDeviceSize(cageVertices) * 12, name + " subdivision cages");
     cage_ = &ownCage_;
   }
-  auto program = [&](uint32_t stage, const char* what) {
-    return std::make_unique<vk::ComputeProgram>(
-        context, vk::ComputeProgramDesc{what, kSpvRefine,
-                                        {{gpu::kRefineSpecWorkgroupSize, kWorkgroupSize}, {gpu::kRefineSpecStage, stage}},
-                                        false});
+  std::vector<vk::ComputeProgramDesc> descs = programDescs();
+  refine_ = std::make_unique<vk::ComputeProgram>(context, descs[0]);
+  limit_ = std::make_unique<vk::ComputeProgram>(context, descs[1]);
+}
+
+std::vector<vk::ComputeProgramDesc> RefinePass::programDescs() {
+  auto program = [](uint32_t stage, const char* what) {
+    return vk::ComputeProgramDesc{
+        what, kSpvRefine, {{gpu::kRefineSpecWorkgroupSize, kWorkgroupSize}, {gpu::kRefineSpecStage, stage}}, false};
   };
-  refine_ = program(gpu::kRefineStageRefine, "refine");
-  limit_ = program(gpu::kRefineStageLimit, "refine limit");
+  return {program(gpu::kRefineStageRefine, "refine"), program(gpu::kRefineStageLimit, "refine limit")};
 }
 
 uint32_t RefinePass::cageFirst(int shape) const {

@@ -27,6 +27,8 @@ class RefinePass {
   /// are read from cageBuffer(), at cageFirst(shape): the pass's own, which
   /// the caller fills (kept vertices), or the host's (a scene of host buffers).
   RefinePass(vk::Context& context, const scene::Scene& scene, const SceneGpu& gpu);
+  /// Its two pipelines (refine, then limit positions and normals).
+  static std::vector<vk::ComputeProgramDesc> programDescs();
 
   /// No shape of the scene is a subdivision surface.
   bool empty() const { return shapes_.empty(); }

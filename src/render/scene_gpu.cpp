@@ -108,7 +108,7 @@ void uploadTextures(vk::Context& context, const scene::Scene& scene, const Textu
   const VkDeviceSize ringBytes = std::clamp<VkDeviceSize>(total, 4, kTextureStagingRingBytes);
   vk::Buffer staging(context, {ringBytes, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, vk::MemoryDomain::Upload,
                                name + " texture staging ring"});
-  vk::ComputeProgram mips(context, vk::ComputeProgramDesc{"texture mips", kSpvTextureMips, {}, false});
+  vk::ComputeProgram mips(context, textureMipsDesc());
   vk::Commands commands(context, "upload " + name + " textures");
   commands.begin();
   VkDeviceSize offset = 0;
@@ -232,6 +232,8 @@ static void checkHostShapes(const scene::Scene& scene, const HostBuffers& host) 
     }
   }
 }
+
+vk::ComputeProgramDesc textureMipsDesc() { return {"texture mips", kSpvTextureMips, {}, false}; }
 
 SceneGpu uploadScene(vk::Context& context, const scene::Scene& scene, const scene::Pose& pose,
                      const HostBuffers* host) {

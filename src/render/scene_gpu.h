@@ -10,6 +10,7 @@
 #include "shared/trace.h"
 #include "vk/buffer.h"
 #include "vk/commands.h"
+#include "vk/compute_program.h"
 #include "vk/context.h"
 #include "vk/descriptors.h"
 
@@ -103,5 +104,8 @@ struct HostBuffers {
 /// normals are the host's buffers, and every shape must be a host shape.
 SceneGpu uploadScene(vk::Context& context, const scene::Scene& scene, const scene::Pose& pose,
                      const HostBuffers* host = nullptr);
+
+/// The pipeline the upload makes each texture's mip levels with.
+vk::ComputeProgramDesc textureMipsDesc();
 
 }  // namespace snell::render

@@ -30,8 +30,7 @@ uint32_t opticsOfScene(const scene::Scene& scene) {
 
 TracePass::TracePass(vk::Context& context, const scene::Scene& scene, const SceneGpu& gpu)
     : context_(context), sceneOptics_(opticsOfScene(scene)), sceneSurface_(gpu.surface) {
-  compact_ = std::make_unique<vk::ComputeProgram>(context, vk::ComputeProgramDesc{"trace compact", kSpvTraceCompact,
-                                                                                  {}, false});
+  compact_ = std::make_unique<vk::ComputeProgram>(context, compactDesc());
   placeholder_ = vk::Buffer(context, {sizeof(gpu::TracePixelListHeader), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
                                       vk::MemoryDomain::Device, "placeholder"});
   driverMoved_.assign(gpu.geometries.size(), 0);
@@ -65,18 +64,36 @@ const vk::Buffer& TracePass::hitRecords(const FrameSettings& settings) {
   return hitRecords_;
 }
 
-const vk::ComputeProgram& TracePass::program(uint32_t optics, uint32_t flags, uint32_t lanes) {
-  uint64_t key = uint64_t(optics) << 32 | uint64_t(lanes) << 16 | flags;
-  auto found = programs_.find(key);
-  if (found != programs_.end()) return *found->second;
+bool TracePass::manyLanesNeedWave32(const vk::DeviceFacts& device) {
+  // RDNA1 and RDNA2 (gfx10), which RADV names by chip; RDNA3 is "GFX11xx", GCN "VEGA..".
+  if (device.driverId != VK_DRIVER_ID_MESA_RADV) return false;
+  for (const char* chip : {"NAVI1", "NAVI2", "VANGOGH", "REMBRANDT", "MENDOCINO", "CYAN_SKILLFISH", "GFX103"}) {
+    if (device.name.find(chip) != std::string::npos) return true;
+  }
+  return false;
+}
+
+vk::ComputeProgramDesc TracePass::programDesc(const vk::DeviceFacts& device, uint32_t optics, uint32_t flags,
+                                              uint32_t lanes, uint32_t surface) {
   // Several lanes a pixel must share a subgroup: full subgroups keep them together.
   vk::ComputeProgramDesc desc{"trace",
                               kSpvTrace,
                               {{gpu::kTraceSpecOptics, optics},
                                {gpu::kTraceSpecFlags, flags},
                                {gpu::kTraceSpecLanes, lanes},
-                               {gpu::kTraceSpecSurface, sceneSurface_}},
+                               {gpu::kTraceSpecSurface, surface}},
                               lanes > 1};
+  if (lanes > 1 && manyLanesNeedWave32(device)) desc.requiredSubgroupSize = 32;
+  return desc;
+}
+
+vk::ComputeProgramDesc TracePass::compactDesc() { return {"trace compact", kSpvTraceCompact, {}, false}; }
+
+const vk::ComputeProgram& TracePass::program(uint32_t optics, uint32_t flags, uint32_t lanes) {
+  uint64_t key = uint64_t(optics) << 32 | uint64_t(lanes) << 16 | flags;
+  auto found = programs_.find(key);
+  if (found != programs_.end()) return *found->second;
+  vk::ComputeProgramDesc desc = programDesc(context_.facts(), optics, flags, lanes, sceneSurface_);
   return *programs_.emplace(key, std::make_unique<vk::ComputeProgram>(context_, desc)).first->second;
 }
 

@@ -90,6 +90,20 @@ class TracePass {
   uint64_t recordDriver(vk::Commands& commands, const TraceInputs& in, const FrameSettings& settings,
                         const TraceTarget& target);
 
+  /// The trace pipeline specialised to the optics a view traces with
+  /// (gpu::kOptics*), its flags (gpu::kTraceFlag*), the lanes a pixel and the
+  /// surface features a scene's materials use (gpu::kSurface*), as every
+  /// trace pass makes it on `device`; and the masked trace's compaction.
+  static vk::ComputeProgramDesc programDesc(const vk::DeviceFacts& device, uint32_t optics, uint32_t flags,
+                                            uint32_t lanes, uint32_t surface);
+  /// Whether the several-lanes walk must be compiled for 32-lane subgroups:
+  /// on AMD's RDNA1 and RDNA2 (gfx10) through RADV. Mesa 22.3's compiler
+  /// (Debian 12's) corrupts its own heap compiling it in wave64, the default
+  /// (`snell bench pipelines --amd gfx1030`: every gfx10 part aborts, gfx9
+  /// and gfx11 compile, and so does wave32, which the walk allows).
+  static bool manyLanesNeedWave32(const vk::DeviceFacts& device);
+  static vk::ComputeProgramDesc compactDesc();
+
   /// The optics bits (gpu::kOptics*) a view of `settings` traces with: those it asks for that the scene can show.
   uint32_t opticsFor(const FrameSettings& settings) const;
   /// The driver's statistics of each trace pipeline made so far (registers,
