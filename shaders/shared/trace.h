@@ -14,8 +14,10 @@
 //
 // Hits. The closest triangle with t > 0 along the ray; a secondary ray never
 // hits the triangle it leaves, nor any face that meets its origin within the
-// hit point's rounding (the GPU: closer than the offset the ray starts from;
-// the reference: closer than 1e-9 of the scene's size). Triangle tests are
+// hit point's rounding (the GPU: closer than the offset the ray starts from,
+// or whose plane passes within that offset of its origin where the ray would
+// cross it towards the side it went to, as the face across an edge it
+// crossed does; the reference: closer than 1e-9 of the scene's size). Triangle tests are
 // watertight in both: a ray through a shared edge or vertex hits one of its triangles. Barycentrics (b0, b1, b2) of
 // p = b0 v0 + b1 v1 + b2 v2. In world space:
 //   Ng = normalize(cross(v1 - v0, v2 - v0)), the geometric normal;
