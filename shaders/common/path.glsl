@@ -17,6 +17,12 @@
 #endif
 
 const float kInf = 1.0 / 0.0;  // folded to +infinity at compile time
+// The largest finite float16. A colour beyond it is no colour that rgba16f
+// holds: Vulkan lets a driver store it as the largest finite value
+// (lavapipe) or infinity, and SwiftShader stored NaN (bench stress: scale:
+// eye x 0.0001, whose point lights shine 10^8 times as bright at 10^-4 of
+// the distance). Clamped here, every driver stores what lavapipe did.
+const float kHalfMax = 65504.0;
 
 // What the pipeline was specialised for (shared/trace.h: kTraceSpecOptics), and what this dispatch draws.
 layout(constant_id = kTraceSpecOptics) const uint kSpecOptics = 0xffffffffu;
@@ -426,7 +432,7 @@ void tracePixel(uvec2 pixel) {
   // Every lane of the subgroup is here (main calls this once, outside any branch that lanes take apart).
   uint subgroupVisits = traceFlag(kTraceFlagAov) ? SNELL_SUBGROUP_MAX(visits) : 0u;
   if (!(SNELL_PIXEL_WRITER)) return;
-  imageStore(outImage, ivec2(pixel), vec4(path.colour, 1.0));
+  imageStore(outImage, ivec2(pixel), vec4(clamp(path.colour, -kHalfMax, kHalfMax), 1.0));
   if (traceFlag(kTraceFlagAov)) {
     // The colour less its landing's textured part is the shine (every channel's path, so dispersion too).
     vec3 shine = path.interfaces > 0u ? path.colour - path.landingWeight * path.landingTexel : vec3(0.0);
