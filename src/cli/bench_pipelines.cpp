@@ -226,8 +226,10 @@ int runPipelines(const Options& o) {
   bool statistics = context->caps().pipelineStatistics;
   if (!statistics) {
     std::printf("%s reports no pipeline statistics (it lacks VK_KHR_pipeline_executable_properties): each pipeline "
-                "is compiled and timed only\n",
-                facts.name.c_str());
+                "is created and timed only%s\n",
+                facts.name.c_str(),
+                facts.driverId == VK_DRIVER_ID_MESA_LLVMPIPE ? " (llvmpipe generates its code at the first dispatch)"
+                                                              : "");
   }
 
   std::vector<render::CataloguedPipeline> catalogue = render::pipelineCatalogue(*context);
