@@ -25,6 +25,10 @@ std::string hex(uint32_t bits) {
   return text;
 }
 
+// The benchmarks' scenes (the spheres over their backdrop, the eye): base
+// colour textures and single-sided faces.
+constexpr uint32_t kBenchSurface = gpu::kSurfaceTextures | gpu::kSurfaceSingleSided;
+
 CataloguedPipeline computeEntry(std::string pass, std::string variant, vk::ComputeProgramDesc desc) {
   CataloguedPipeline p;
   p.pass = std::move(pass);
@@ -41,9 +45,6 @@ std::vector<CataloguedPipeline> traceCatalogue(const vk::Context& context) {
   const uint32_t viewOptics = gpu::kOpticsFresnel | gpu::kOpticsTextureLod;
   const uint32_t allOptics = gpu::kOpticsFresnel | gpu::kOpticsEnvironmentMap | gpu::kOpticsTextureLod |
                              gpu::kOpticsDispersion | gpu::kOpticsVolume;
-  // The benchmarks' scenes (the spheres over their backdrop, the eye): base
-  // colour textures and single-sided faces.
-  const uint32_t benchSurface = gpu::kSurfaceTextures | gpu::kSurfaceSingleSided;
   std::vector<CataloguedPipeline> entries;
   auto add = [&](std::string variant, uint32_t optics, uint32_t flags, uint32_t lanes, uint32_t surface) {
     CataloguedPipeline p = computeEntry("trace", variant + ", surface " + hex(surface),
@@ -59,16 +60,16 @@ std::vector<CataloguedPipeline> traceCatalogue(const vk::Context& context) {
                                gpu::kSurfaceTextures | gpu::kSurfaceNormalMaps,
                                gpu::kSurfaceAlpha,
                                gpu::kSurfaceSingleSided,
-                               benchSurface,
+                               kBenchSurface,
                                gpu::kSurfaceAll};
   for (uint32_t surface : surfaces) add("full frame", viewOptics, 0u, 1u, surface);
-  add("full frame, AOVs", viewOptics, gpu::kTraceFlagAov, 1u, benchSurface);
-  add("ray list (stress grid)", viewOptics, gpu::kTraceFlagRayList | gpu::kTraceFlagAov, 1u, benchSurface);
+  add("full frame, AOVs", viewOptics, gpu::kTraceFlagAov, 1u, kBenchSurface);
+  add("ray list (stress grid)", viewOptics, gpu::kTraceFlagRayList | gpu::kTraceFlagAov, 1u, kBenchSurface);
   // The masked viewport's lanes a pixel: at most 8, and within the smallest subgroup.
   const uint32_t widest = std::min(8u, context.facts().minSubgroupSize);
   for (uint32_t lanes = 1; lanes <= widest; lanes *= 2) {
     add("masked, " + std::to_string(lanes) + (lanes == 1 ? " lane" : " lanes") + " a pixel", viewOptics,
-        gpu::kTraceFlagPixelList, lanes, benchSurface);
+        gpu::kTraceFlagPixelList, lanes, kBenchSurface);
   }
   add("full frame, every optics feature", allOptics, 0u, 1u, gpu::kSurfaceAll);
   return entries;
@@ -98,8 +99,8 @@ std::vector<CataloguedPipeline> pipelineCatalogue(const vk::Context& context) {
   if (context.caps().driverRayTracing) {
     CataloguedPipeline p;
     p.pass = "driver-rt";
-    p.variant = "the driver's ray tracing pipeline, surface " + hex(gpu::kSurfaceTextures | gpu::kSurfaceSingleSided);
-    p.rayTracing = peer::DriverTracer::programDesc(gpu::kSurfaceTextures | gpu::kSurfaceSingleSided);
+    p.variant = "the driver's ray tracing pipeline, surface " + hex(kBenchSurface);
+    p.rayTracing = peer::DriverTracer::programDesc(kBenchSurface);
     entries.push_back(std::move(p));
   }
   return entries;
