@@ -174,6 +174,18 @@ void enterChildren(BvhNode node, ShearedRay r, float tMax, out float tNear, out 
   farRef = swapOrder ? node.child[0] : node.child[1];
 }
 
+// A visit that entered no child, counted for the AOV (TraceAov::deadVisits),
+// and whether the nearest hit alone culled them: the ray enters one beyond
+// it. Only the AOV's pipelines test the node's children again.
+void countDeadVisit(BvhNode node, ShearedRay r, float tNear) {
+  if (!traceFlag(kTraceFlagAov) || tNear < kInf) return;
+  ++deadVisits;
+  float t0, t1;
+  uint ref0, ref1;
+  enterChildren(node, r, kInf, t0, t1, ref0, ref1);
+  if (t0 < kInf) ++culledVisits;
+}
+
 // The ray in an instance's object space.
 ShearedRay objectRay(uint instance, vec3 origin, vec3 dir) {
   GpuInstance inst = instances[instance];
@@ -197,6 +209,7 @@ float cullSignOf(uint instance) {
 // tMax: hit.t, or less where another lane of the pixel has a nearer hit.
 void testTriangle(ShearedRay r, uint instance, uint tri, uint skipPrim, uint first, uint end, float leaving, float tMax,
                   float cullSign, inout Hit hit) {
+  ++leafVisits;
   if (tri == skipPrim || tri < first || tri >= end) return;  // skipPrim: the face this ray leaves
   ++triangleTests;
   vec3 bary;
@@ -242,7 +255,9 @@ void traverseBlas(uint instance, vec3 origin, vec3 dir, uint skipPrim, float lea
     float tNear, tFar;
     uint nearRef, farRef;
     boxTests += 2u;
-    enterChildren(blasNode(ref), r, hit.t, tNear, tFar, nearRef, farRef);
+    BvhNode node = blasNode(ref);
+    enterChildren(node, r, hit.t, tNear, tFar, nearRef, farRef);
+    countDeadVisit(node, r, tNear);
     if (tFar < kInf) {
       if ((farRef & kBvhLeafBit) != 0u) leaves[leafCount++] = farRef & ~kBvhLeafBit;
       else if (sp < kStackSize) stack[sp++] = farRef;  // a full stack drops it: only a corrupted tree is that deep
@@ -282,7 +297,9 @@ Hit traverse(vec3 origin, vec3 dir, uint skipInstance, uint skipPrim, float leav
     float tNear, tFar;
     uint nearRef, farRef;
     boxTests += 2u;
-    enterChildren(tlasNode(ref), r, hit.t, tNear, tFar, nearRef, farRef);
+    BvhNode node = tlasNode(ref);
+    enterChildren(node, r, hit.t, tNear, tFar, nearRef, farRef);
+    countDeadVisit(node, r, tNear);
     // The nearer on top. A full stack drops them (only a corrupted tree is that deep): the ray still ends.
     if (tFar < kInf && sp < kStackSize) stack[sp++] = farRef;
     if (tNear < kInf && sp < kStackSize) stack[sp++] = nearRef;
@@ -328,6 +345,7 @@ Hit traverseLanes(vec3 origin, vec3 dir, uint skipInstance, uint skipPrim, float
   BvhGroup top = tlasGroups[0];
   if (top.root == kBvhNone) return hit;
   uint visitsBefore = visits, boxesBefore = boxTests, trianglesBefore = triangleTests;
+  uint deadBefore = deadVisits, culledBefore = culledVisits, leavesBefore = leafVisits;
   uint nodeEnd = top.count - 1u;
   ShearedRay world = shearRay(origin, dir);
   ShearedRay r = world;
@@ -359,7 +377,9 @@ Hit traverseLanes(vec3 origin, vec3 dir, uint skipInstance, uint skipPrim, float
           if (root != kBvhNone) ref = root, inst = instance;
         } else if (node < nodeEnd) {
           boxTests += 2u;
-          enterChildren(tlasNode(node), world, tMax, tNear, tFar, nearRef, farRef);
+          BvhNode n = tlasNode(node);
+          enterChildren(n, world, tMax, tNear, tFar, nearRef, farRef);
+          countDeadVisit(n, world, tNear);
           if (tNear < kInf) ref = nearRef;
           if (tFar < kInf) farRefGiven = farRef;
         }
@@ -377,7 +397,9 @@ Hit traverseLanes(vec3 origin, vec3 dir, uint skipInstance, uint skipPrim, float
           leaves[leafCount++] = node & ~kBvhLeafBit;
         } else if (node >= group.first && node + 1u < end) {
           boxTests += 2u;
-          enterChildren(blasNode(node), r, tMax, tNear, tFar, nearRef, farRef);
+          BvhNode n = blasNode(node);
+          enterChildren(n, r, tMax, tNear, tFar, nearRef, farRef);
+          countDeadVisit(n, r, tNear);
           if (tNear < kInf) {
             if ((nearRef & kBvhLeafBit) != 0u) leaves[leafCount++] = nearRef & ~kBvhLeafBit;
             else ref = nearRef, inst = nodeInst;
@@ -429,6 +451,9 @@ Hit traverseLanes(vec3 origin, vec3 dir, uint skipInstance, uint skipPrim, float
   visits = visitsBefore + clusterSum(visits - visitsBefore);
   boxTests = boxesBefore + clusterSum(boxTests - boxesBefore);
   triangleTests = trianglesBefore + clusterSum(triangleTests - trianglesBefore);
+  deadVisits = deadBefore + clusterSum(deadVisits - deadBefore);
+  culledVisits = culledBefore + clusterSum(culledVisits - culledBefore);
+  leafVisits = leavesBefore + clusterSum(leafVisits - leavesBefore);
   return holders == 0u ? Hit(kInf, kNoHit, kNoHit, vec3(0.0)) : taken;
 }
 

@@ -242,6 +242,14 @@ struct TraceAov {
   // where none did: a ray that hit the surface it left (a self-hit) ran one
   // of rounding's length.
   float shortestSegment;  // 4
+  // Where the walk spends visits that find nothing (bench cost; 0 from the
+  // driver's pipeline): node visits that enter no child, of those the ones
+  // whose children the ray does meet, but beyond the nearest hit (a walk
+  // that knew each entry's distance, or found the hit sooner, would skip
+  // them), and leaves reached, whose triangles make triangleTests.
+  uint deadVisits;    // 4
+  uint culledVisits;  // 4
+  uint leafVisits;  // 4
 };
 
 SNELL_CONST kNoHit = 0xffffffffu;

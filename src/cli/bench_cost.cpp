@@ -36,6 +36,10 @@ struct Options {
 
 struct CostCounters {
   double segments = 0, visits = 0, boxTests = 0, triangleTests = 0;
+  /// Visits that entered no child; of those, the ones whose children the ray
+  /// meets beyond the nearest hit (which a hit found sooner would have culled).
+  double deadVisits = 0, culledVisits = 0;
+  double leafVisits = 0;  ///< leaves reached, whose triangles make triangleTests
   uint32_t visitsP50 = 0, visitsP99 = 0, visitsMax = 0, segmentsMax = 0;
   /// The traversal loops' lanes at work: the share of a subgroup's lanes still
   /// walking, over the passes it made (0: not counted, as by the driver's pipeline).
@@ -58,13 +62,18 @@ CostCounters countersOf(const std::vector<gpu::TraceAov>& aov) {
     c.visits += a.nodeVisits;
     c.boxTests += a.boxTests;
     c.triangleTests += a.triangleTests;
+    c.deadVisits += a.deadVisits;
+    c.culledVisits += a.culledVisits;
+    c.leafVisits += a.leafVisits;
     c.segmentsMax = std::max(c.segmentsMax, a.segments);
     visits.push_back(a.nodeVisits);
   }
   if (subgroupLanes > 0) c.laneUtilisation = laneSteps / subgroupLanes;
   if (c.visits > 0) c.longestOverMean = longest / c.visits;
   double n = std::max<double>(double(aov.size()), 1.0);
-  c.segments /= n, c.visits /= n, c.boxTests /= n, c.triangleTests /= n;
+  for (double* v : {&c.segments, &c.visits, &c.boxTests, &c.triangleTests, &c.deadVisits, &c.culledVisits, &c.leafVisits}) {
+    *v /= n;
+  }
   if (!visits.empty()) {
     std::sort(visits.begin(), visits.end());
     c.visitsP50 = visits[visits.size() / 2];
@@ -145,6 +154,11 @@ int runCost(const Options& o) {
               cost.boxTests, cost.triangleTests);
   std::printf("per segment: %.2f node visits, %.2f child boxes, %.2f triangles\n", cost.visits / cost.segments,
               cost.boxTests / cost.segments, cost.triangleTests / cost.segments);
+  auto share = [](double part, double whole) { return whole > 0 ? 100.0 * part / whole : 0.0; };
+  std::printf("visits: %.2f child boxes tested a visit; %.1f%% dead (no child entered), %.1f%% dead only for the "
+              "nearest hit (children beyond it); %.2f triangles tested a leaf reached\n",
+              cost.visits > 0 ? cost.boxTests / cost.visits : 0.0, share(cost.deadVisits, cost.visits),
+              share(cost.culledVisits, cost.visits), cost.leafVisits > 0 ? cost.triangleTests / cost.leafVisits : 0.0);
   std::printf("lanes: %.1f%% of a subgroup's lanes walk in each pass of the traversal loops (subgroups of %u); "
               "a subgroup's longest walk is %.2fx its pixels' mean\n",
               100.0 * cost.laneUtilisation, pixels.aov.empty() ? 0u : pixels.aov.front().subgroupSize,
@@ -174,7 +188,12 @@ int runCost(const Options& o) {
                               {"node_visits_p99", cost.visitsP99},
                               {"node_visits_max", cost.visitsMax},
                               {"child_box_tests", cost.boxTests},
-                              {"triangle_tests", cost.triangleTests}};
+                              {"triangle_tests", cost.triangleTests},
+                              {"dead_visits", cost.deadVisits},
+                              {"late_pops", cost.culledVisits},
+                              {"leaf_visits", cost.leafVisits}};
+    j["child_tests_per_visit"] = cost.visits > 0 ? cost.boxTests / cost.visits : 0.0;
+    j["triangle_tests_per_leaf"] = cost.leafVisits > 0 ? cost.triangleTests / cost.leafVisits : 0.0;
     j["lane_utilisation"] = cost.laneUtilisation;
     j["subgroup_longest_over_mean_visits"] = cost.longestOverMean;
     j["subgroup_size"] = pixels.aov.empty() ? 0u : pixels.aov.front().subgroupSize;
@@ -197,7 +216,9 @@ void addBenchCost(CLI::App& bench, Runner& run) {
   describe(*sub,
       "Traces one still frame of the procedural eye (or SCENE), Fresnel on, and\n"
       "reports per pixel the closest-hit queries (segments), BVH node visits and\n"
-      "the child boxes and triangles tested. Then the hit-replay ablation: each\n"
+      "the child boxes and triangles tested, the visits that entered no child (of\n"
+      "those, the ones whose children lie beyond the nearest hit) and the\n"
+      "triangles tested a leaf reached. Then the hit-replay ablation: each\n"
       "segment's closest hit is recorded and the frame traced again reading them\n"
       "instead of traversing (the first 8 segments of a pixel; later ones are\n"
       "traced in both), which leaves the path's work without the traversal.\n"
