@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <fstream>
 #include <regex>
 #include <string>
 
@@ -55,6 +56,38 @@ TEST(BenchCost, TheHitReplayDrawsTheTracedPictureAndEachPixelsWorkIsCounted) {
       << run.output;
   EXPECT_GE(std::stod(m[1]), 1.0) << "every pixel traces at least its camera ray: " << run.output;
   EXPECT_GT(std::stod(m[2]), 0.0) << run.output;
+}
+
+// A glTF of no meshes (a file of cameras or lights): its background, as a
+// USD stage with nothing to draw; --strict makes it an error.
+fs::path writeSceneWithoutMeshes() {
+  fs::path file = fs::temp_directory_path() / "snell_no_meshes.gltf";
+  std::ofstream(file) << R"({"asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0]}],
+                             "nodes": [{"name": "an empty"}]})";
+  return file;
+}
+
+TEST(RenderCommand, ASceneWithNothingToDrawDrawsItsBackgroundWithANote) {
+  fs::path file = writeSceneWithoutMeshes(), out = fs::temp_directory_path() / "snell_no_meshes.png";
+  fs::remove(out);
+  CommandRun run = snell("render " + shellQuoted(file.string()) + " --size 8x6 -o " + shellQuoted(out.string()));
+  EXPECT_EQ(run.exitCode, 0) << run.output;
+  EXPECT_NE(run.output.find(file.string() + ": nothing to draw: no mesh with triangles; the background is drawn"),
+            std::string::npos)
+      << run.output;
+  EXPECT_TRUE(fs::exists(out));
+  fs::remove(out);
+}
+
+TEST(RenderCommand, StrictRefusesASceneWithNothingToDrawAndWritesNothing) {
+  fs::path file = writeSceneWithoutMeshes(), out = fs::temp_directory_path() / "snell_no_meshes_strict.png";
+  fs::remove(out);
+  CommandRun run =
+      snell("render " + shellQuoted(file.string()) + " --strict --size 8x6 -o " + shellQuoted(out.string()));
+  EXPECT_EQ(run.exitCode, 1) << run.output;
+  EXPECT_NE(run.output.find(file.string() + ": nothing to draw: no mesh with triangles (--strict)"), std::string::npos)
+      << run.output;
+  EXPECT_FALSE(fs::exists(out));
 }
 
 TEST(RenderCommand, TheDefaultMethodIsAutoAndSaysWhatItDrewWith) {

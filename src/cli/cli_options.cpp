@@ -4,6 +4,7 @@
 #include "io/environment.h"
 #include "render/renderer.h"
 #include "scene/procedural_eye.h"
+#include "scene/scene_summary.h"
 #include "vk/error.h"
 
 #include <algorithm>
@@ -299,6 +300,8 @@ void ShotOptions::addTo(CLI::App& app) {
       ->allow_extra_args(false)  // one extension per --ignore-extension: the scene file after it stays the scene
       ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
   addTextureBudget(app, load.textureBudget);
+  app.add_flag("--strict", strict,
+               "a scene with nothing to draw is an error (default: a note, and the background is drawn)");
 }
 
 void ShotOptions::require(const std::string& command) const {
@@ -310,6 +313,12 @@ scene::Scene ShotOptions::loadScene() const {
   scene::Scene scene = eye ? scene::makeEye() : scene::loadGltf(input, load);
   if (eye) scene.source = "procedural eye";
   for (const std::string& w : scene.warnings) note(w);
+  if (scene::summarize(scene).triangles == 0) {
+    // As snell-usd: an empty scene (a layout file, a glTF of cameras) draws its background.
+    std::string what = scene.source + ": nothing to draw: no mesh with triangles";
+    if (strict) throw scene::SceneError(what + " (--strict)");
+    note(what + "; the background is drawn");
+  }
   return scene;
 }
 

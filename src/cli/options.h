@@ -115,16 +115,20 @@ struct ShotOptions {
   uint32_t maxInterfaces = gpu::kDefaultMaxInterfaces;
   glm::vec3 background{scene::kDefaultBackground};
   scene::LoadOptions load;
+  /// A scene with nothing to draw (no triangles) is an error, not a note
+  /// with the background drawn.
+  bool strict = false;
 
   /// Adds SCENE, --eye, --size, --camera, --look-at, --fov, --time,
-  /// --max-interfaces, --background, --scene, --ignore-extension and
-  /// --texture-budget to `app`, writing into this (which must outlive the parse).
+  /// --max-interfaces, --background, --scene, --ignore-extension,
+  /// --texture-budget and --strict to `app`, writing into this (which must outlive the parse).
   void addTo(CLI::App& app);
   /// The --time option, for commands where it excludes others.
   CLI::Option* timeOption = nullptr;
   /// Throws UsageError unless exactly one of a file and --eye was given.
   void require(const std::string& command) const;
-  /// The scene, its load notes printed to stderr.
+  /// The scene, its load notes printed to stderr; one with nothing to draw
+  /// is a note (the background is drawn), or with --strict a SceneError.
   scene::Scene loadScene() const;
   /// The view asked for at `pose`; a view the scene cannot give is a UsageError.
   scene::View resolveView(const std::string& command, const scene::Scene& scene, const scene::Pose& pose) const;

@@ -44,8 +44,9 @@ def write_png(path: Path, rgb: np.ndarray) -> None:
                      chunk(b"IEND", b""))
 
 
-def textured_card(folder: Path) -> Path:
-    """A 2 m card facing +Z whose UsdPreviewSurface reads a 2x2 checker PNG through st, no camera."""
+def textured_card(folder: Path, texture: str = "checker.png") -> Path:
+    """A 2 m card facing +Z whose UsdPreviewSurface reads a texture (a 2x2 checker PNG, written here) through
+    st, no camera."""
     write_png(folder / "checker.png", TEXELS)
     path = folder / "card.usda"
     stage = Usd.Stage.CreateNew(str(path))
@@ -60,7 +61,8 @@ def textured_card(folder: Path) -> Path:
     reader.CreateInput("varname", Sdf.ValueTypeNames.Token).Set("st")
     image = UsdShade.Shader.Define(stage, "/World/checker/image")
     image.CreateIdAttr("UsdUVTexture")
-    image.CreateInput("file", Sdf.ValueTypeNames.Asset).Set("./checker.png")
+    image.CreateInput("file", Sdf.ValueTypeNames.Asset).Set(f"./{texture}")
+    image.CreateInput("fallback", Sdf.ValueTypeNames.Float4).Set(Gf.Vec4f(0.9, 0.1, 0.9, 1.0))
     image.CreateInput("st", Sdf.ValueTypeNames.Float2).ConnectToSource(reader.ConnectableAPI(), "result")
     rgb = image.CreateOutput("rgb", Sdf.ValueTypeNames.Float3)
     surface.CreateInput("diffuseColor", Sdf.ValueTypeNames.Color3f).ConnectToSource(rgb)
@@ -136,3 +138,23 @@ def test_an_exr_dome_in_the_plain_venv_is_a_warning_naming_it_and_the_dome_colou
     assert str(sky) in warning and "OpenImageIO's Python module" in warning, done.stderr
     assert "the dome's colour (0.5, 0.5, 1) is drawn instead" in warning, warning
     assert (tmp_path / "card.png").is_file()
+
+
+def test_an_exr_texture_in_the_plain_venv_is_a_warning_naming_it_and_its_fallback_is_drawn(tmp_path):
+    exr = tmp_path / "checker.exr"
+    out = oiio.ImageOutput.create(str(exr))
+    assert out is not None and out.open(str(exr), oiio.ImageSpec(2, 2, 3, "half"))
+    assert out.write_image(TEXELS.astype(np.float32) / 255.0) and out.close()
+    picture = tmp_path / "card.png"
+    done = run_clean(CLEAN_BIN / "snell-usd", "render", textured_card(tmp_path, "checker.exr"), "-o", picture,
+                     "--size", "16x16")
+    assert done.returncode == 0, done.stderr
+    warning = next((line for line in done.stderr.splitlines() if "/World/checker/image" in line), "")
+    assert str(exr) in warning and "OpenImageIO's Python module" in warning, done.stderr
+    assert "the input's fallback is drawn" in warning, warning
+    middle = oiio.ImageBuf(str(picture)).get_pixels(oiio.FLOAT)[8, 8]
+    assert middle[1] < 0.75 * min(middle[0], middle[2]), f"the fallback's magenta, lit: {middle}"
+    strict = run_clean(CLEAN_BIN / "snell-usd", "render", tmp_path / "card.usda", "-o", tmp_path / "strict.png",
+                       "--size", "16x16", "--strict")
+    assert strict.returncode == 1 and str(exr) in strict.stderr, strict.stderr
+    assert not (tmp_path / "strict.png").exists()

@@ -10,6 +10,7 @@ import sys
 
 import numpy as np
 import pytest
+from pxr import UsdGeom
 
 from conftest import read_image, snell_usd
 from stages import bind, new_stage, preview_material, quad, texture
@@ -116,6 +117,66 @@ def test_strict_refuses_a_stage_with_a_missing_texture_and_writes_nothing(tmp_pa
     done = snell_usd("render", broken, "-o", out / "f.####.exr", "--frames", "1-3", "--size", SIZE, "--strict")
     assert done.returncode == 1
     assert "/World/M/Texture_diffuseColor: texture file ./gone.png not found" in done.stderr
+    assert os.listdir(out) == []
+
+
+def undecodable_stage(folder) -> object:
+    """A card whose texture file is there but is no image: undecodable.usda in `folder`."""
+    (folder / "noise.png").write_bytes(b"these bytes are no PNG")
+    stage = new_stage(folder / "undecodable.usda")
+    card = quad(stage, "/World/Card")
+    material = preview_material(stage, "/World/M", diffuseColor=(0.2, 0.9, 0.2))
+    texture(stage, material, "./noise.png", fallback=(0.9, 0.1, 0.1, 1.0))
+    bind(card.GetPrim(), material)
+    stage.GetRootLayer().Save()
+    return folder / "undecodable.usda"
+
+
+def test_a_texture_that_cannot_be_decoded_is_a_warning_naming_the_file_and_its_fallback_is_drawn(tmp_path):
+    out = tmp_path / "f.exr"
+    done = snell_usd("render", undecodable_stage(tmp_path), "-o", out, "--size", SIZE)
+    assert done.returncode == 0, done.stderr
+    warning = next((line for line in done.stderr.splitlines() if "/World/M/Texture_diffuseColor" in line), "")
+    assert "warning" in warning and str(tmp_path / "noise.png") in warning, done.stderr
+    assert "the input's fallback is drawn" in warning, warning
+    middle = read_image(out)[24, 32]
+    assert middle[0] > 2 * middle[1], f"the fallback's red, not the texture's nor the green factor: {middle}"
+
+
+def test_strict_refuses_a_texture_that_cannot_be_decoded_and_writes_nothing(tmp_path):
+    out = tmp_path / "out"
+    out.mkdir()
+    done = snell_usd("render", undecodable_stage(tmp_path), "-o", out / "f.png", "--size", SIZE, "--strict")
+    assert done.returncode == 1, done.stderr
+    assert str(tmp_path / "noise.png") in done.stderr and "Traceback" not in done.stderr
+    assert os.listdir(out) == []
+
+
+def empty_stage(folder) -> object:
+    """A stage of hair alone, which snell does not draw: empty.usda in `folder`."""
+    stage = new_stage(folder / "empty.usda")
+    UsdGeom.BasisCurves.Define(stage, "/World/Hair")
+    stage.GetRootLayer().Save()
+    return folder / "empty.usda"
+
+
+def test_a_stage_with_nothing_to_draw_renders_its_background_with_a_warning(tmp_path):
+    out = tmp_path / "e.exr"
+    done = snell_usd("render", empty_stage(tmp_path), "-o", out, "--size", SIZE)
+    assert done.returncode == 0, done.stderr
+    assert "nothing to draw: no visible UsdGeomMesh or gprim with faces" in done.stderr, done.stderr
+    assert "the background is drawn" in done.stderr
+    background = [0.02, 0.02, 0.025]  # snell.View's default
+    np.testing.assert_allclose(read_image(out)[..., :3], np.broadcast_to(background, (48, 64, 3)),
+                               atol=1e-3)
+
+
+def test_strict_refuses_a_stage_with_nothing_to_draw_and_writes_nothing(tmp_path):
+    out = tmp_path / "out"
+    out.mkdir()
+    done = snell_usd("render", empty_stage(tmp_path), "-o", out / "e.png", "--size", SIZE, "--strict")
+    assert done.returncode == 1, done.stderr
+    assert "nothing to draw" in done.stderr and "Traceback" not in done.stderr
     assert os.listdir(out) == []
 
 

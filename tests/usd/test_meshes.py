@@ -191,12 +191,23 @@ def test_face_indices_past_the_points_are_an_error(tmp_path):
     assert meshes == [] and "refers to point 7; the mesh has 3 points" in str(contents.problems.errors[0])
 
 
-def test_a_stage_with_nothing_to_draw_is_refused(tmp_path, device):
-    stage = new_stage(tmp_path / "n.usda")
+def hair_alone(folder) -> object:
+    stage = new_stage(folder / "n.usda")
     UsdGeom.BasisCurves.Define(stage, "/World/Hair")
     stage.GetRootLayer().Save()
+    return folder / "n.usda"
+
+
+def test_a_stage_with_nothing_to_draw_opens_with_a_warning_and_draws_its_background(tmp_path, device):
+    with snell.usd.open(hair_alone(tmp_path), device=device) as opened:
+        assert any("nothing to draw: no visible UsdGeomMesh or gprim" in str(w) for w in opened.warnings)
+        pixels = opened.render(8, 6, background=(0.25, 0.5, 0.75))
+    np.testing.assert_allclose(pixels[..., :3], np.broadcast_to([0.25, 0.5, 0.75], (6, 8, 3)), atol=1e-6)
+
+
+def test_a_strict_open_refuses_a_stage_with_nothing_to_draw(tmp_path, device):
     with pytest.raises(snell.usd.StageError, match="nothing to draw: no visible UsdGeomMesh or gprim"):
-        snell.usd.open(tmp_path / "n.usda", device=device)
+        snell.usd.open(hair_alone(tmp_path), device=device, strict=True)
 
 
 def test_rigid_skinning_moves_the_instance_as_vertex_skinning_moves_the_points(tmp_path):

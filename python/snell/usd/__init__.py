@@ -50,9 +50,11 @@ def read(path: PathLike, *, time: Optional[float] = None, purpose: str = "previe
     'default' ('guide' never is); meters_per_unit overrides the stage's;
     strict: a broken stage (a mesh with faces but no points, a missing
     texture file) raises StageError instead of warning;
-    missing_textures_fail: a missing texture file is an error (default:
-    as strict; otherwise a warning, and the texture's fallback is drawn, as
-    usdview draws it); subdivision_level: the levels a subdivision surface
+    missing_textures_fail: what snell draws around is an error: a texture
+    file that is missing or cannot be decoded, and a stage with nothing to
+    draw when its Scene is made (default: as strict; otherwise a warning,
+    and the texture's fallback or the background is drawn, as usdview
+    draws them); subdivision_level: the levels a subdivision surface
     (subdivisionScheme other than none) is refined by, on the GPU (0: its
     cage is drawn as it is).
     """

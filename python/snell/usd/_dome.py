@@ -140,7 +140,7 @@ def read_dome(prim: Usd.Prim, time: Usd.TimeCode, to_snell: np.ndarray, up_axis:
     try:
         texture = _read_texture(asset.resolvedPath)
     except TextureReadError as e:
-        problems.warn(path, f"texture {e}: {fallback}")
+        problems.strict_error(path, f"texture {e}: {fallback}")
         return uniform
 
     # World directions to the dome's own (OpenEXR's) frame: snell's world back to the stage's, then the

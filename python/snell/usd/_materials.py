@@ -232,7 +232,8 @@ class MaterialTable:
             try:
                 image = read_texture(slot.request)
             except TextureReadError as e:
-                self.problems.fail(slot.prim, str(e))
+                # As a missing file: the input's fallback is drawn; strict readers (--strict) refuse the stage.
+                self.problems.strict_error(slot.prim, f"{e}: the input's fallback is drawn")
                 return -1, (1.0, 1.0, 1.0)
         else:
             image = TextureImage(np.zeros((1, 1, 4), np.uint8))

@@ -171,11 +171,14 @@ class Stage:
 
 def scene_of(contents: StageContents) -> tuple[Scene, list[Mesh]]:
     """The stage's snell.Scene at the time code read (its meshes, materials, textures, instances and lights),
-    and its meshes; StageError where nothing is drawn."""
+    and its meshes. A stage with nothing to draw draws its background, with a warning (snell render's rule for
+    a glTF without meshes); strict readers raise StageError."""
     meshes = contents.snell_meshes()
     if not meshes:
-        raise StageError(f"{contents.path}: nothing to draw: no visible UsdGeomMesh or gprim with faces"
-                         + _skipped_note(contents))
+        nothing = "nothing to draw: no visible UsdGeomMesh or gprim with faces" + _skipped_note(contents)
+        if contents.problems.strict_missing:
+            raise StageError(f"{contents.path}: {nothing}")
+        contents.problems.warn("", f"{nothing}; the background is drawn")
     scene = Scene.from_arrays(meshes, materials=contents.snell_materials(),
                               textures=contents.materials.snell_textures(), instances=contents.snell_instances(),
                               lights=contents.snell_lights(), name=contents.path)

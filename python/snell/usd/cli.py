@@ -59,16 +59,18 @@ bounds. --devices spreads the frames over GPUs through snell.render_frames,
 as snell render --devices does (without a camera the shot is framed on its
 first frame). SIGTERM or SIGINT drops the frame under way, keeps those
 written and exits 128+N; --skip-existing then picks up where it stopped. A stage
-snell cannot draw as it says (a mesh with faces but no points, a texture
-that cannot be decoded; with --strict a missing texture file too) is an
-error, and nothing is written."""
+snell cannot draw as it says (a mesh with faces but no points) is an error,
+and nothing is written. A texture file that is missing or cannot be decoded
+draws its input's fallback, and a stage with nothing to draw its background,
+each with a warning; --strict makes them errors."""
 
 INFO_DESCRIPTION = """\
 Lists what snell reads from a stage: its units and time range, the meshes
 drawn (with their parts and materials, skinning and deformation), the
 materials bound for --purpose, cameras and lights (with snell's units), what
 was skipped, and every warning. Exits 1 when the stage is broken where snell
-needs it (a mesh with faces but no points; with --strict a missing texture)."""
+needs it (a mesh with faces but no points; with --strict a texture that is missing
+or cannot be decoded)."""
 
 
 class _Parser(argparse.ArgumentParser):
@@ -144,8 +146,9 @@ def _parser() -> argparse.ArgumentParser:
                          help="levels a subdivision surface's cage is refined by, on the GPU (0 to 8; 0 draws the "
                               "cages as they are; default 2)")
     reading.add_argument("--strict", action="store_true",
-                         help="a missing texture file is an error (by default a warning, and the texture's "
-                              "fallback is drawn, as usdview draws it)")
+                         help="a texture file that is missing or cannot be decoded, or a stage with nothing to "
+                              "draw, is an error (by default a warning, and the texture's fallback or the "
+                              "background is drawn, as usdview draws them)")
 
     parser = _Parser(prog="snell-usd", parents=[_global_options(defaults=True)],
                      formatter_class=argparse.RawDescriptionHelpFormatter,
