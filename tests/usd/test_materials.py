@@ -426,11 +426,11 @@ def test_a_normal_from_something_other_than_a_texture_is_a_warning_naming_the_in
 def test_another_surface_shader_is_a_warning(tmp_path):
     def build(stage, prim):
         material = preview_material(stage, "/World/X")
-        UsdShade.Shader(stage.GetPrimAtPath("/World/X/Surface")).SetShaderId("ND_standard_surface_surfaceshader")
+        UsdShade.Shader(stage.GetPrimAtPath("/World/X/Surface")).SetShaderId("ND_gltf_pbr_surfaceshader")
         bind(prim, material)
 
     contents = read_quad(tmp_path, build)
-    assert "/World/X/Surface: the surface has id 'ND_standard_surface_surfaceshader'" in messages(contents)
+    assert "/World/X/Surface: the surface has id 'ND_gltf_pbr_surfaceshader'" in messages(contents)
     np.testing.assert_allclose(material_of(contents).fields["base_color"], (0.18, 0.18, 0.18, 1.0), rtol=1e-6)
 
 

@@ -25,6 +25,7 @@ import numpy as np
 from pxr import Usd, UsdShade
 
 from .. import Material, Texture, TextureTransform
+from ._mtlx import RENDER_CONTEXT, MtlxError, Surface, referenced_document, surface_of_document, surface_of_shader
 from ._problems import Problems
 from ._textures import IDENTITY_SCALE, NO_BIAS, TextureImage, TextureReadError, TextureRequest, read_texture
 
@@ -160,9 +161,29 @@ class MaterialTable:
         material, _ = UsdShade.MaterialBindingAPI(prim).ComputeBoundMaterial(materialPurpose=PURPOSES[self.purpose])
         return material if material and material.GetPrim().IsValid() else None
 
+    def mtlx_binding(self, prim: Usd.Prim) -> Optional[tuple[str, str, str]]:
+        """Where prim's binding leads into a .mtlx document USD could not compose: (the document as authored, as
+        resolved, the material's name); None where it binds a prim or no document."""
+        material, relationship = UsdShade.MaterialBindingAPI(prim).ComputeBoundMaterial(
+            materialPurpose=PURPOSES[self.purpose])
+        if (material and material.GetPrim().IsValid()) or not relationship:
+            return None
+        targets = relationship.GetTargets()
+        return referenced_document(prim.GetStage(), targets[0]) if targets else None
+
     def index_for(self, prim: Usd.Prim, mesh: Usd.Prim, double_sided: bool) -> int:
         """The snell material of prim (a mesh or one of its subsets), made on first use."""
         material = self.bound_material(prim)
+        document = self.mtlx_binding(prim) if material is None else None
+        if document is not None:
+            authored, resolved, name = document
+            path = f"{authored}:{name}"
+            key = (path, None, double_sided)
+            if key not in self._index:
+                if path not in self._read:
+                    self._read[path] = self._read_mtlx_document(prim, authored, resolved, name)
+                self._index[key] = self._append(self._copy(self._read[path], double_sided))
+            return self._index[key]
         if material is None:
             key: tuple = ("", None, double_sided)
             if key not in self._index:
@@ -178,11 +199,13 @@ class MaterialTable:
         if key not in self._index:
             if path not in self._read:
                 self._read[path] = self._read_material(material)
-            template = self._read[path]
-            record = replace(template, fields=dict(template.fields), double_sided=double_sided,
-                             slots={name: replace(slot) for name, slot in template.slots.items()})
-            self._index[key] = self._append(record)
+            self._index[key] = self._append(self._copy(self._read[path], double_sided))
         return self._index[key]
+
+    @staticmethod
+    def _copy(template: MaterialRecord, double_sided: bool) -> MaterialRecord:
+        return replace(template, fields=dict(template.fields), double_sided=double_sided,
+                       slots={name: replace(slot) for name, slot in template.slots.items()})
 
     def variant(self, index: int, base_color: tuple, texture: int = -1) -> int:
         """Material `index` with a mesh's own base colour (a constant primvar) or colour texture (a varying one,
@@ -245,19 +268,85 @@ class MaterialTable:
 
     def _read_material(self, material: UsdShade.Material) -> MaterialRecord:
         path = str(material.GetPath())
-        shader, _, _ = material.ComputeSurfaceSource()
+        shader, _, _ = material.ComputeSurfaceSource(RENDER_CONTEXT)  # snell's context first, then universal
         if not shader:
             contexts = [o.GetBaseName() for o in material.GetOutputs() if o.GetBaseName().endswith(":surface")]
             more = f" (only for render contexts: {', '.join(contexts)})" if contexts else ""
             self.problems.warn(path, f"has no universal surface output{more}: drawn with UsdPreviewSurface's fallbacks")
             return MaterialRecord(path=path, fields=_surface_fields({}), summary="no surface: fallbacks")
         shader_id = shader.GetShaderId()
+        surface = surface_of_shader(shader, self.time)
+        if surface is not None:
+            return self._read_mtlx_surface(path, surface)
         if shader_id != "UsdPreviewSurface":
             what = f"id '{shader_id}'" if shader_id else "no info:id (its implementation is a source or asset)"
             self.problems.warn(shader.GetPath(), f"the surface has {what}, not UsdPreviewSurface: "
                                                  "drawn with UsdPreviewSurface's fallbacks")
             return MaterialRecord(path=path, fields=_surface_fields({}), summary=f"unsupported surface {shader_id}")
         return self._read_preview_surface(path, shader)
+
+    def _read_mtlx_document(self, prim: Usd.Prim, authored: str, resolved: str, name: str) -> MaterialRecord:
+        path = f"{authored}:{name}"
+        try:
+            if not resolved:
+                raise MtlxError(f"MaterialX document {authored} not found")
+            surface = surface_of_document(resolved, authored, name)
+        except MtlxError as e:
+            # As a texture snell cannot read: the material's fallback is drawn; --strict refuses the stage.
+            self.problems.strict_error(prim.GetPath(), f"binds material '{name}' of {e}: drawn with "
+                                                       "UsdPreviewSurface's fallbacks")
+            return MaterialRecord(path=path, fields=_surface_fields({}), summary=f"MaterialX {path}: unread")
+        record = self._read_mtlx_surface(path, surface)
+        record.summary += f", from {authored}"
+        return record
+
+    def _read_mtlx_surface(self, path: str, surface: Surface) -> MaterialRecord:
+        """A MaterialX surface as snell's material (docs/usd.md, MaterialX): base colour and weight, specular
+        IOR and roughness, emission; transmission as glass, its colour a tint at the surface, or with a depth
+        (and not thin-walled) the colour at that distance through the volume; opacity as coverage."""
+        for said in surface.unmapped():
+            self.problems.warn(surface.where, said)
+        weight = float(surface.value("weight"))
+        colour = tuple(weight * float(c) for c in surface.value("colour"))
+        opacity_value = surface.value("opacity")
+        opacity = float(sum(opacity_value) / len(opacity_value) if isinstance(opacity_value, tuple) else opacity_value)
+        emissive = tuple(float(surface.value("emission")) * float(c) for c in surface.value("emission_colour"))
+        record = MaterialRecord(path=path, fields=_surface_fields({}))
+        record.fields.update(roughness=float(surface.value("roughness")), ior=float(surface.value("ior")),
+                             emissive=emissive, base_color=(*colour, 1.0))
+        transmission = float(surface.value("transmission"))
+        image = surface.image("colour")
+        if image is not None and transmission <= 0.0:
+            if image.resolved:
+                request = TextureRequest(image.resolved, image.color_space, output="rgb", kind="colour")
+                record.slots["base_color"] = TextureSlot(request, image.where, image.file, ("repeat", "repeat"), "st")
+                record.fields["base_color"] = (weight, weight, weight, 1.0)
+            else:
+                self.problems.strict_error(image.where, f"texture file {image.file} not found: the base colour "
+                                                        f"{_fmt(colour)} is used")
+        tint = tuple(float(c) for c in surface.value("tint"))
+        depth, thin = float(surface.value("depth")), bool(surface.value("thin"))
+        if transmission > 0.0:
+            record.fields["transmission"] = min(transmission, 1.0)
+            if depth > 0.0 and not thin:
+                record.fields.update(base_color=(1.0, 1.0, 1.0, 1.0), thickness=depth, attenuation_color=tint,
+                                     attenuation_distance=depth)
+            else:
+                record.fields["base_color"] = (*tint, 1.0)
+            record.fields["dispersion"] = _mtlx_dispersion(surface)
+            volume = f", absorbing to {_fmt(tint)} at {depth:g}" if "thickness" in record.fields else ""
+            kind = (f"glass (transmission {transmission:g}, ior {record.fields['ior']:g}) transmitting "
+                    f"{_fmt(tint)}{volume}{', thin-walled' if thin else ''}")
+        elif opacity < 1.0:
+            record.fields["base_color"] = (*record.fields["base_color"][:3], max(opacity, 0.0))
+            record.fields["alpha_mode"] = "blend"
+            kind = f"coverage: opacity {opacity:g} blends"
+        else:
+            kind = "opaque"
+        colour_text = ("" if transmission > 0.0 else
+                       f", texture {image.file}" if "base_color" in record.slots else f", colour {_fmt(colour)}")
+        record.summary = f"{surface.label}, {kind}{colour_text}, roughness {record.fields['roughness']:g}"
+        return record
 
     def _input(self, shader: UsdShade.Shader, name: str) -> tuple[Any, Optional[Source]]:
         """An input's value (None: unauthored) or the shader output it is connected to, through interfaces."""
@@ -607,6 +696,16 @@ def _channel_colour(values: np.ndarray, output: str) -> tuple[float, float, floa
     if output in ("r", "g", "b", "a"):
         return (float(values["rgba".index(output)]),) * 3
     return tuple(float(c) for c in values[:3])
+
+
+def _mtlx_dispersion(surface: Surface) -> float:
+    """snell's dispersion (KHR_materials_dispersion: 20 / Abbe number) of a MaterialX glass."""
+    if surface.kind == "open_pbr_surface":
+        scale = float(surface.constant("transmission_dispersion_scale"))
+        abbe = float(surface.constant("transmission_dispersion_abbe_number"))
+    else:  # standard_surface's transmission_dispersion is an Abbe number, 0 for none
+        scale, abbe = 1.0, float(surface.constant("transmission_dispersion"))
+    return scale * 20.0 / abbe if scale > 0.0 and abbe > 0.0 else 0.0
 
 
 def _surface_fields(values: dict[str, Any]) -> dict[str, Any]:

@@ -28,6 +28,7 @@ from ._lights import LightRecord, read_light, unsupported_light
 from ._materials import MaterialRecord, MaterialTable
 from ._meshes import (MeshSource, Part, Pose, Topology, material_subsets, read_normals, read_primvar,
                       read_subdivision, read_topology)
+from ._mtlx import referenced_document
 from ._problems import Problems, StageError
 from ._skinning import SkelFrame, Skin
 
@@ -234,7 +235,7 @@ class StageContents:
                 if not name.startswith("material:binding") or name.startswith("material:binding:collection"):
                     continue
                 for target in relationship.GetTargets():
-                    if not stage.GetPrimAtPath(target).IsValid():
+                    if not stage.GetPrimAtPath(target).IsValid() and referenced_document(stage, target) is None:
                         self.problems.warn(prim.GetPath(), f"{name} targets {target}, which does not exist: "
                                                            "USD binds nothing there")
             prim = prim.GetParent()
