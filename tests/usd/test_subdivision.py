@@ -7,10 +7,10 @@ import subprocess
 import sys
 
 import numpy as np
-from pxr import UsdGeom, UsdShade, Vt
+from pxr import Gf, UsdGeom, UsdShade, Vt
 
 import snell.usd
-from conftest import unexpected
+from conftest import read_image, snell_usd, unexpected
 from stages import bind, new_stage, preview_material, sphere_arrays
 
 CUBE_POINTS = [(x, y, z) for z in (-0.5, 0.5) for y in (-0.5, 0.5) for x in (-0.5, 0.5)]
@@ -39,7 +39,7 @@ def cube_stage(tmp_path, name: str = "cube.usda", **tags):
 
 
 def test_a_mesh_without_a_scheme_is_a_catmull_clark_surface_sent_as_its_cage(tmp_path):
-    contents = snell.usd.read(cube_stage(tmp_path))
+    contents = snell.usd.read(cube_stage(tmp_path), subdivision_level=2)
     assert unexpected(contents.problems.items) == []
     [m] = contents.snell_meshes()
     assert m.subdivision is not None and m.subdivision.scheme == "catmullClark" and m.subdivision.level == 2
@@ -111,7 +111,7 @@ def test_animated_points_are_sent_as_the_cage_each_frame(tmp_path, device):
     for t, scale in ((1, 1.0), (2, 1.3)):
         m.GetPointsAttr().Set(Vt.Vec3fArray.FromNumpy(np.asarray(CUBE_POINTS, np.float32) * scale), t)
     stage.GetRootLayer().Save()
-    with snell.usd.open(path, device=device) as opened:
+    with snell.usd.open(path, device=device, subdivision_level=2) as opened:
         opened.render(64, 64)
         opened.set_time(2)
         after = opened.render(64, 64)
@@ -134,7 +134,72 @@ def test_info_says_which_meshes_are_refined_and_by_how_many_levels(tmp_path):
                           capture_output=True, text=True, timeout=120)
     assert done.returncode == 0, done.stderr
     [entry] = json.loads(done.stdout)["meshes"]
-    assert entry["subdivision"] == {"scheme": "catmullClark", "level": 3}
+    assert entry["subdivision"] == {"scheme": "catmullClark", "level": 3, "vertices": 386, "triangles": 768,
+                                    "bytes": 32 * 386 + 52 * 768}
+    assert entry["parts"][0]["vertices"] == 386 and entry["parts"][0]["triangles"] == 768
     bad = subprocess.run([sys.executable, "-m", "snell.usd", "info", str(path), "--subdiv-level", "9"],
                          capture_output=True, text=True, timeout=120)
     assert bad.returncode == 2 and "a subdivision level is 0 to 8, not '9'" in bad.stderr
+
+
+def test_each_cages_level_follows_its_size_on_screen_and_info_counts_what_is_drawn(tmp_path):
+    """Unit cubes 6 m and 4 km from a 50 mm camera at 1920 x 1080: the near one's 2 m edges span some 1400 pixels
+    (3 levels, the most), the far one's about 2 (1 level, the fewest); info's refined counts are the scene's."""
+    path = tmp_path / "near_far.usda"
+    stage = new_stage(path)
+    for name, z in (("Near", 0.0), ("Far", -4000.0)):
+        subdivided(stage, f"/World/{name}", CUBE_POINTS, [4] * 6, CUBE_FACES).AddTranslateOp().Set(Gf.Vec3d(0, 0, z))
+    UsdGeom.Camera.Define(stage, "/World/Camera").AddTranslateOp().Set(Gf.Vec3d(0, 0, 6))
+    stage.GetRootLayer().Save()
+    contents = snell.usd.read(path)
+    levels = {s.path: s.cage.level for s in contents.sources}
+    assert levels == {"/World/Near": 3, "/World/Far": 1}, levels
+    scene, meshes = snell.usd._stage.scene_of(contents)
+    done = subprocess.run([sys.executable, "-m", "snell.usd", "info", str(path), "--json"], capture_output=True,
+                          text=True, timeout=120)
+    listed = {m["prim"]: m["parts"][0] for m in json.loads(done.stdout)["meshes"]}
+    for i, source in enumerate(contents.sources):
+        part = listed[source.path]
+        assert (part["vertices"], part["triangles"]) == (scene.drawn_vertex_count(i), scene.drawn_triangle_count(i))
+    assert snell.usd.read(path, subdivision_level=2).sources[1].cage.level == 2, "a level given fixes every cage"
+
+
+def test_the_triangle_budget_refines_the_largest_meshes_fewer_levels_with_one_warning_naming_them(tmp_path):
+    path = tmp_path / "crowd.usda"
+    stage = new_stage(path)
+    for i in range(3):
+        subdivided(stage, f"/World/Cube{i}", CUBE_POINTS, [4] * 6, CUBE_FACES).AddTranslateOp().Set(
+            Gf.Vec3d(3.0 * i, 0, 0))
+    UsdGeom.Camera.Define(stage, "/World/Camera").AddTranslateOp().Set(Gf.Vec3d(3, 0, 8))
+    stage.GetRootLayer().Save()
+    assert {s.cage.level for s in snell.usd.read(path).sources} == {3}
+    contents = snell.usd.read(path, triangle_budget=3 * 192)  # each cube 12 x 4^3 = 768 at 3 levels, 192 at 2
+    assert [s.cage.level for s in contents.sources] == [2, 2, 2]
+    said = [str(w) for w in contents.problems.items if "refined fewer levels" in str(w)]
+    assert len(said) == 1 and "/World/Cube0 (2), /World/Cube1 (2), /World/Cube2 (2)" in said[0], said
+
+
+def test_a_million_cage_triangles_over_twenty_meshes_render_at_1080p_on_a_2_gib_device(tmp_path, monkeypatch):
+    """20 wavy sheets of 24,649 quads each (985,960 cage triangles), seen close: the view asks 3 levels of each
+    (63M triangles); the budgets bring them to 1 or 0 (the cage as polygons) and it renders, with one warning."""
+    n = 158
+    y, x = np.mgrid[0:n, 0:n] / (n - 1)
+    points = np.stack([x - 0.5, 0.05 * np.sin(12 * x) * np.cos(9 * y), y - 0.5], -1).reshape(-1, 3)
+    i = np.arange(n * n).reshape(n, n)
+    quads = np.stack([i[:-1, :-1], i[1:, :-1], i[1:, 1:], i[:-1, 1:]], -1).reshape(-1)
+    path = tmp_path / "sheets.usdc"
+    stage = new_stage(path)
+    for k in range(20):
+        sheet = subdivided(stage, f"/World/Sheet{k}", points, [4] * (n - 1) ** 2, quads)
+        sheet.AddTranslateOp().Set(Gf.Vec3d((k % 5) - 2.0, 0.2 * (k // 5), -0.3 * (k // 5)))
+    camera = UsdGeom.Camera.Define(stage, "/World/Camera")
+    camera.AddTranslateOp().Set(Gf.Vec3d(0, 2.5, 3.0))
+    camera.AddRotateXOp().Set(-40.0)
+    stage.GetRootLayer().Save()
+    monkeypatch.setenv("SNELL_DEVICE_MEMORY_LIMIT", str(2 << 30))
+    done = snell_usd("render", path, "-o", tmp_path / "sheets.png", "--size", "1920x1080", timeout=600)
+    assert done.returncode == 0, done.stderr
+    said = [line for line in done.stderr.splitlines() if "refined fewer levels" in line]
+    assert len(said) == 1 and "/World/Sheet19 (" in said[0], done.stderr
+    picture = read_image(tmp_path / "sheets.png")
+    assert picture[540, 960, :3].max() > 0.1, "the sheets fill the middle of the picture"

@@ -255,6 +255,7 @@ class MeshSource:
         self.deforms = (self.points_attribute.ValueMightBeTimeVarying() or bool(normals and normals.varying)
                         or bool(skin and skin.animated and skin.deforms_points))
         self._rest: Optional[Vt.Vec3fArray] = None  # points that do not vary, read once
+        self._cage_parts: list[tuple] = []  # add_part's arguments for each cage part, to make them again as polygons
         self._miscounted = False
 
     @property
@@ -268,6 +269,7 @@ class MeshSource:
         A cage's part is the whole cage, with the faces of the other parts as holes."""
         t = self.topology
         if self.cage is not None:
+            self._cage_parts.append((name, triangles, material, st, st_values))
             return self._add_cage_part(name, triangles, material, st, st_values)
         corners = t.triangles[triangles]
         normal_per_point = self.normals is None or self.normals.point_ids is not None
@@ -305,6 +307,14 @@ class MeshSource:
             part.uvs = uv.astype(np.float32)
         self.parts.append(part)
         return part
+
+    def drop_cage(self, normals: Optional[Primvar]) -> None:
+        """Draws the cage as the polygons it is (a subdivision level of 0), with these normals: its parts made
+        again, in the same order."""
+        parts, self._cage_parts = self._cage_parts, []
+        self.cage, self.normals, self.parts = None, normals, []
+        for arguments in parts:
+            self.add_part(*arguments)
 
     def _add_cage_part(self, name: str, triangles: np.ndarray, material: int, st: Optional[Primvar],
                        st_values: Optional[np.ndarray]) -> Part:

@@ -30,6 +30,8 @@ from ._meshes import (MeshSource, Part, Pose, Topology, material_subsets, read_n
                       read_subdivision, read_topology)
 from ._mtlx import referenced_document
 from ._problems import Problems, StageError
+from ._screen import (DEFAULT_TRIANGLE_BUDGET, MAX_AUTO_LEVEL, REFINED_VERTEX_BUDGET, CageCounts, fit_budget,
+                      level_for, mean_edge, screen_of, world_box)
 from ._skinning import SkelFrame, Skin
 
 GEOMETRY_PURPOSES = ("render", "proxy")
@@ -46,7 +48,12 @@ class ReadOptions:
     load_textures: bool = True
     strict: bool = False  #: a broken stage (mesh without points, missing texture) raises StageError
     missing_textures_fail: bool = False  #: a missing texture file is an error, not a warning with its fallback
-    subdivision_level: int = 2  #: levels a subdivision surface's cage is refined by on the GPU; 0: draw cages
+    #: levels a subdivision surface's cage is refined by on the GPU (0: draw cages); None: each cage's own,
+    #: sized to the view (_screen.py), within the triangle budget
+    subdivision_level: Optional[int] = None
+    image_size: tuple[int, int] = (1920, 1080)  #: the picture levels are sized for
+    camera: Union[None, int, str] = None  #: the camera they are sized for (None: the first, or the framed view)
+    triangle_budget: int = DEFAULT_TRIANGLE_BUDGET  #: refined triangles before sized levels are lowered
 
 
 @dataclass
@@ -146,8 +153,65 @@ class StageContents:
         self._initial: dict[int, Pose] = {}
         self._instance_count = 0
         self._traverse()
+        self._size_subdivision()
         self.dynamic_sources = [s for s in self.sources if s.deforms]
         self.dynamic_placements = [p for p in self.placements if p.varying]
+
+    # ------------------------------------------------------------------ detail
+
+    def _size_subdivision(self) -> None:
+        """Each cage's level from its mean edge on screen (_screen.py), then lowered to the triangle budget with
+        one warning naming the meshes; a level given fixes them all."""
+        cages = [s for s in self.sources if s.cage is not None]
+        if not cages or self.options.subdivision_level is not None:
+            return
+        time = Usd.TimeCode(self.time)
+        boxes: dict[int, tuple[np.ndarray, np.ndarray, np.ndarray]] = {}
+        lo, hi = np.full(3, np.inf), np.full(3, -np.inf)
+        for placement in self.placements:
+            source = placement.source
+            points = np.asarray(source.points_attribute.Get(time) or [], np.float64).reshape(-1, 3)
+            box = world_box(points, placement.matrix)
+            if box is None:
+                continue
+            lo, hi = np.minimum(lo, box[0]), np.maximum(hi, box[1])
+            if source.cage is not None:
+                seen = boxes.get(id(source))
+                near = box if seen is None else (np.minimum(seen[0], box[0]), np.maximum(seen[1], box[1]))
+                boxes[id(source)] = (near[0], near[1], placement.matrix if seen is None else seen[2])
+        try:
+            camera = self._camera(self.options.camera, self.time) if self.cameras else None
+        except StageError:  # the drawing says what is wrong with the camera; the levels take the first
+            camera = self._camera(None, self.time)
+        screen = screen_of(camera, lo, hi, *self.options.image_size)
+        sizes: dict[str, tuple[CageCounts, int]] = {}
+        for source in cages:
+            if id(source) not in boxes:
+                continue
+            box_lo, box_hi, matrix = boxes[id(source)]
+            points = np.asarray(source.points_attribute.Get(time), np.float64).reshape(-1, 3)
+            world = points @ matrix[:3, :3].T
+            edge = mean_edge(world, source.topology.face_counts, source.topology.face_points)
+            counts = CageCounts.of(source.topology.face_counts, source.topology.face_points, source.cage.scheme)
+            sizes[source.path] = (counts, level_for(screen.pixels(edge, box_lo, box_hi)))
+        lowered = fit_budget(sizes, self.options.triangle_budget, REFINED_VERTEX_BUDGET)
+        for source in cages:
+            level = lowered.get(source.path, sizes[source.path][1] if source.path in sizes else MAX_AUTO_LEVEL)
+            if level == 0:
+                source.drop_cage(read_normals(source.mesh, source.topology, time, self.problems))
+                self._initial[id(source)] = source.pose(time, SkelFrame(time))
+                continue
+            source.cage.level = level
+            for part in source.parts:
+                if part.cage is not None:
+                    part.cage.level = level
+        if lowered:
+            named = ", ".join(f"{path} ({level})" for path, level in sorted(lowered.items()))
+            self.problems.warn("", f"{len(lowered)} subdivision surfaces refined fewer levels than the view asks "
+                                   f"(0: the cage drawn as polygons), to keep the scene within "
+                                   f"{self.options.triangle_budget:,} refined triangles (--subdiv-budget) and "
+                                   f"{REFINED_VERTEX_BUDGET:,} refined vertices (refine tables Vulkan binds on any "
+                                   f"device): {named}")
 
     # ------------------------------------------------------------------ traversal
 
@@ -373,7 +437,8 @@ class StageContents:
         prim = mesh.GetPrim()
         cage = None
         if prim.IsA(UsdGeom.Mesh):
-            cage = read_subdivision(mesh, topology, time, self.options.subdivision_level, self.problems)
+            level = self.options.subdivision_level
+            cage = read_subdivision(mesh, topology, time, MAX_AUTO_LEVEL if level is None else level, self.problems)
         normals = None if cage is not None else read_normals(mesh, topology, time, self.problems)
         source = MeshSource(mesh, topology, normals, skin, self.problems, cage)
         pose = source.pose(time, SkelFrame(time))

@@ -28,6 +28,7 @@ from ._cameras import CameraState
 from ._frames import UsageError, check_frame_pattern, frame_path, parse_frames
 from ._output import EXTENSIONS, OutputError, check_format, check_writable, write_image
 from ._reader import StageContents
+from ._screen import DEFAULT_TRIANGLE_BUDGET, refined_bytes, refined_size
 from ._stage import framed_view, scene_of, shot_frame, world_bounds
 
 EXIT_OK, EXIT_FAILURE, EXIT_USAGE = 0, 1, 2
@@ -90,6 +91,16 @@ def _size(text: str) -> tuple[int, int]:
     return width, height
 
 
+def _budget(text: str) -> int:
+    try:
+        budget = int(text.replace("_", "").replace(",", ""))
+    except ValueError:
+        budget = 0
+    if budget <= 0:
+        raise argparse.ArgumentTypeError(f"a triangle budget is a positive count, not '{text}'")
+    return budget
+
+
 def _level(text: str) -> int:
     try:
         level = int(text)
@@ -142,9 +153,14 @@ def _parser() -> argparse.ArgumentParser:
                          help="the geometry drawn beside 'default' ('guide' never is; default render)")
     reading.add_argument("--meters-per-unit", type=_positive, metavar="M",
                          help="the stage's unit in metres, instead of its metersPerUnit")
-    reading.add_argument("--subdiv-level", dest="subdivision_level", type=_level, default=2, metavar="N",
-                         help="levels a subdivision surface's cage is refined by, on the GPU (0 to 8; 0 draws the "
-                              "cages as they are; default 2)")
+    reading.add_argument("--subdiv-level", dest="subdivision_level", type=_level, default=None, metavar="N",
+                         help="levels every subdivision surface's cage is refined by, on the GPU (0 to 8; 0 draws "
+                              "the cages as they are; default: each cage's own, 1 to 3, its edges about a pixel "
+                              "at --size through --camera)")
+    reading.add_argument("--subdiv-budget", dest="triangle_budget", type=_budget, default=DEFAULT_TRIANGLE_BUDGET,
+                         metavar="TRIANGLES",
+                         help="refined triangles the sized levels may make before the largest meshes are refined "
+                              f"fewer levels, with a warning (default {DEFAULT_TRIANGLE_BUDGET:,})")
     reading.add_argument("--strict", action="store_true",
                          help="a texture file that is missing or cannot be decoded, or a stage with nothing to "
                               "draw, is an error (by default a warning, and the texture's fallback or the "
@@ -229,13 +245,37 @@ class _Console:
 def _info(args: argparse.Namespace, console: _Console) -> int:
     contents = read(args.stage, time=args.time, purpose=args.purpose, geometry_purpose=args.geometry_purpose,
                     meters_per_unit=args.meters_per_unit, load_textures=False, missing_textures_fail=args.strict,
-                    subdivision_level=args.subdivision_level)
+                    subdivision_level=args.subdivision_level, triangle_budget=args.triangle_budget)
     listing = _listing(contents)
     if args.json:
         print(json.dumps(listing, indent=2))
     elif not console.quiet:
         _print_listing(listing)
     return EXIT_FAILURE if contents.problems.errors else EXIT_OK
+
+
+def _refined(source) -> dict[str, Any]:
+    """A cage's scheme and level, and what its refinement holds (whole cage, every part together)."""
+    t, cage = source.topology, source.cage
+    vertices, triangles = refined_size(t.face_counts, t.face_points, cage.scheme, cage.level)
+    return {"scheme": cage.scheme, "level": cage.level, "vertices": vertices, "triangles": triangles,
+            "bytes": refined_bytes(vertices, triangles)}
+
+
+def _drawn(part, source) -> dict[str, Any]:
+    """What a part draws: its refined vertices and triangles where it is a cage's (its faces refined), else its
+    own; a cage's own counts beside them."""
+    if part.cage is None:
+        return {"vertices": len(part.vertex_point), "triangles": len(part.triangles)}
+    t = source.topology
+    faces = np.unique(t.triangle_face[part.triangles])
+    vertices, _ = refined_size(t.face_counts, t.face_points, part.cage.scheme, part.cage.level)
+    counts = t.face_counts[faces]
+    starts = (np.cumsum(t.face_counts) - t.face_counts)[faces]
+    points = np.concatenate([t.face_points[s:s + c] for s, c in zip(starts, counts)]) if len(faces) else []
+    _, triangles = refined_size(counts, points, part.cage.scheme, part.cage.level)
+    return {"vertices": vertices, "triangles": triangles, "cage_vertices": t.point_count,
+            "cage_triangles": len(part.triangles)}
 
 
 def _listing(contents: "StageContents") -> dict[str, Any]:
@@ -249,12 +289,11 @@ def _listing(contents: "StageContents") -> dict[str, Any]:
             "triangles": int(sum(len(p.triangles) for p in source.parts)),
             "normals": (source.normals.interpolation if source.normals is not None else
                         "snell's, of the refined surface" if source.cage is not None else "computed (smooth)"),
-            "subdivision": ({"scheme": source.cage.scheme, "level": source.cage.level}
-                            if source.cage is not None else None),
+            "subdivision": (_refined(source) if source.cage is not None else None),
             "skeleton": str(source.skin.skeleton_prim.GetPath()) if source.skin is not None else None,
             "deforms": source.deforms, "moves": any(p.varying for p in placements), "instances": len(placements),
-            "parts": [{"name": part.name, "vertices": len(part.vertex_point), "triangles": len(part.triangles),
-                       "material": materials[part.material].path or "(none)"} for part in source.parts],
+            "parts": [{"name": part.name, "material": materials[part.material].path or "(none)",
+                       **_drawn(part, source)} for part in source.parts],
         }
         meshes.append(entry)
     cameras = []
@@ -300,12 +339,17 @@ def _print_listing(i: dict[str, Any]) -> None:
         motion = [w for w, on in (("deforms", m["deforms"]), ("moves", m["moves"])) if on]
         skinned = f", skinned by {m['skeleton']}" if m["skeleton"] else ""
         shared = f", {m['instances']} instances" if m["instances"] > 1 else ""
-        refined = (f", a {m['subdivision']['scheme']} subdivision surface refined {m['subdivision']['level']} "
-                   "levels on the GPU" if m["subdivision"] else "")
+        sub = m["subdivision"]
+        refined = (f", a {sub['scheme']} subdivision surface refined {sub['level']} "
+                   f"level{'s' if sub['level'] != 1 else ''} on the GPU to "
+                   f"{sub['vertices']} vertices and {sub['triangles']} triangles (about "
+                   f"{sub['bytes'] / 2 ** 20:.1f} MiB)" if sub else "")
         print(f"  {m['prim']}: {m['points']} points, {m['faces']} faces ({m['triangles']} triangles){refined}, "
               f"normals {m['normals']}{skinned}{shared}{', ' + ' and '.join(motion) if motion else ', static'}")
         for part in m["parts"]:
-            print(f"    {part['name']}: {part['vertices']} vertices, {part['triangles']} triangles, "
+            cage = (f" (its cage {part['cage_vertices']} vertices, {part['cage_triangles']} triangles)"
+                    if "cage_vertices" in part else "")
+            print(f"    {part['name']}: {part['vertices']} vertices, {part['triangles']} triangles{cage}, "
                   f"material {part['material']}")
     print(f"materials (purpose {i['material_purpose']}): {len(i['materials'])}")
     for m in i["materials"]:
@@ -376,7 +420,8 @@ def _render(args: argparse.Namespace, console: _Console) -> int:
             return EXIT_OK
     contents = read(args.stage, time=frames[0] if frames else None, purpose=args.purpose,
                     geometry_purpose=args.geometry_purpose, meters_per_unit=args.meters_per_unit,
-                    missing_textures_fail=args.strict, subdivision_level=args.subdivision_level)
+                    missing_textures_fail=args.strict, subdivision_level=args.subdivision_level,
+                    image_size=args.size, camera=args.camera, triangle_budget=args.triangle_budget)
     if contents.problems.errors:  # a stage broken where snell needs it: nothing is drawn
         raise StageError(f"{contents.path}: {contents.problems.errors[0]}".replace(": error: ", ": ", 1))
     if frames is None:
