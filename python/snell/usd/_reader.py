@@ -10,13 +10,14 @@ and a static prim is never touched again.
 
 from __future__ import annotations
 
+import math
 import os
 import time as clock
 from dataclasses import dataclass
 from typing import Callable, Optional, Union
 
 import numpy as np
-from pxr import Sdf, Tf, Usd, UsdGeom, UsdLux, UsdSkel
+from pxr import Gf, Sdf, Tf, Usd, UsdGeom, UsdLux, UsdSkel
 
 from .. import Instance, Light, Material, Mesh
 from ._cameras import CameraState, camera_state
@@ -30,8 +31,8 @@ from ._meshes import (MeshSource, Part, Pose, Topology, material_subsets, read_n
                       read_subdivision, read_topology)
 from ._mtlx import referenced_document
 from ._problems import Problems, StageError
-from ._screen import (DEFAULT_TRIANGLE_BUDGET, MAX_AUTO_LEVEL, REFINED_VERTEX_BUDGET, CageCounts, fit_budget,
-                      level_for, mean_edge, screen_of, world_box)
+from ._screen import (DEFAULT_TRIANGLE_BUDGET, MAX_AUTO_LEVEL, REFINED_VERTEX_BUDGET, CageCounts, Screen,
+                      fit_budget, level_for, mean_edge, screen_of, world_box)
 from ._skinning import SkelFrame, Skin
 
 GEOMETRY_PURPOSES = ("render", "proxy")
@@ -148,6 +149,7 @@ class StageContents:
         self.skipped: dict[str, list[str]] = {}
         self._skel_cache = UsdSkel.Cache()
         self._xform_cache = UsdGeom.XformCache(Usd.TimeCode(self.time))
+        self._first_screen: Optional[Screen] = None
         self._topologies: dict[Sdf.Path, Optional[Topology]] = {}
         self._shared: dict[tuple, MeshSource] = {}
         self._initial: dict[int, Pose] = {}
@@ -212,6 +214,44 @@ class StageContents:
                                    f"{self.options.triangle_budget:,} refined triangles (--subdiv-budget) and "
                                    f"{REFINED_VERTEX_BUDGET:,} refined vertices (refine tables Vulkan binds on any "
                                    f"device): {named}")
+
+    def _pixels_of(self, prim: Usd.Prim) -> Callable[[float], float]:
+        """How many pixels a length in prim's own units spans where prim comes nearest the camera, in the view
+        found ahead of the traversal (_screen_ahead)."""
+        screen = self._screen_ahead()
+        box = _snell_box(self.to_snell, self._bounds().ComputeWorldBound(prim).ComputeAlignedRange())
+        world = self.to_snell @ np.array(self._xform_cache.GetLocalToWorldTransform(prim)).T
+        scale = float(np.mean(np.linalg.norm(world[:3, :3], axis=0)))
+        if box is None:
+            return lambda length: math.nan
+        return lambda length: screen.pixels(length * scale, *box)
+
+    def _bounds(self) -> UsdGeom.BBoxCache:
+        purposes = [UsdGeom.Tokens.default_, self.options.geometry_purpose]
+        return UsdGeom.BBoxCache(Usd.TimeCode(self.time), purposes, useExtentsHint=True)
+
+    def _screen_ahead(self) -> Screen:
+        """The view a gprim's detail is sized for while the stage is still being read: the camera asked for
+        (else the stage's first) or the framed view of USD's own bounds of the stage."""
+        if self._first_screen is None:
+            time = Usd.TimeCode(self.time)
+            predicate = Usd.TraverseInstanceProxies(Usd.PrimDefaultPredicate)
+            cameras = [p for p in Usd.PrimRange(self.stage.GetPseudoRoot(), predicate) if p.IsA(UsdGeom.Camera)]
+            which = self.options.camera
+            prim = None
+            if isinstance(which, str) and Sdf.Path.IsValidPathString(which):
+                prim = self.stage.GetPrimAtPath(which)
+            elif isinstance(which, int) and 0 <= which < len(cameras):
+                prim = cameras[which]
+            if not (prim and prim.IsA(UsdGeom.Camera)):
+                prim = cameras[0] if cameras else None
+            camera = (camera_state(prim, time, self.to_snell, self.meters_per_unit, self._xform_cache)
+                      if prim is not None else None)
+            box = _snell_box(self.to_snell, self._bounds().ComputeWorldBound(self.stage.GetPseudoRoot())
+                             .ComputeAlignedRange())
+            lo, hi = box if box is not None else (np.full(3, np.inf), np.full(3, -np.inf))
+            self._first_screen = screen_of(camera, lo, hi, *self.options.image_size)
+        return self._first_screen
 
     # ------------------------------------------------------------------ traversal
 
@@ -397,7 +437,7 @@ class StageContents:
             self.problems.fail(prim.GetPath(), f"cannot be read as a mesh ({str(e).strip().splitlines()[-1]})")
 
     def _read_mesh(self, prim: Usd.Prim, time: Usd.TimeCode, placed, varying_placement: bool) -> None:
-        mesh = UsdGeom.Mesh(prim) if prim.IsA(UsdGeom.Mesh) else GprimMesh(prim)
+        mesh = UsdGeom.Mesh(prim) if prim.IsA(UsdGeom.Mesh) else GprimMesh(prim, self._pixels_of(prim))
         skin = self._skin_of(prim) if prim.IsA(UsdGeom.Mesh) else None
         prototype = prim.GetPrimInPrototype() if prim.IsInstanceProxy() else prim
         key = prototype.GetPath()
@@ -657,3 +697,13 @@ def _open_stage(path: str) -> Usd.Stage:
     if stage is None:
         raise StageError(f"{path}: not a stage USD opens")
     return stage
+
+
+def _snell_box(to_snell: np.ndarray, box: Gf.Range3d) -> Optional[tuple[np.ndarray, np.ndarray]]:
+    """A USD world range in snell's space (metres, +Y up), None where it is empty."""
+    if box.IsEmpty():
+        return None
+    lo, hi = np.array(box.GetMin()), np.array(box.GetMax())
+    corners = np.array([[x, y, z] for x in (lo[0], hi[0]) for y in (lo[1], hi[1]) for z in (lo[2], hi[2])])
+    placed = corners @ to_snell[:3, :3].T + to_snell[:3, 3]
+    return placed.min(axis=0), placed.max(axis=0)

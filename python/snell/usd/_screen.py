@@ -1,4 +1,5 @@
-"""How big things are on screen, for detail sized to the view: each subdivision cage's level.
+"""How big things are on screen, for detail sized to the view: each subdivision cage's level, each round
+gprim's segments (_gprims.py).
 
 The view is the one snell draws a stage through first: the camera asked for (the
 stage's first, else snell render's framed view of the bounds) at the image size
