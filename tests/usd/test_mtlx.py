@@ -122,6 +122,12 @@ def test_an_open_pbr_glass_in_a_referenced_mtlx_refracts_as_the_same_usd_preview
     assert_same_glass(referencing_stage(tmp_path, "./looks.mtlx"), preview_glass(tmp_path), device)
 
 
+def test_materialxs_own_usd_preview_surface_node_in_a_referenced_mtlx_refracts_as_usds(tmp_path, device):
+    mtlx_document(tmp_path / "looks.mtlx", "UsdPreviewSurface", opacity=0.0, ior=1.45, roughness=0.25,
+                  diffuseColor=TINT)
+    assert_same_glass(referencing_stage(tmp_path, "./looks.mtlx"), preview_glass(tmp_path), device)
+
+
 def test_an_inline_standard_surface_in_the_mtlx_render_context_refracts_as_the_same_preview_glass(
         tmp_path, device):
     stage = inline_stage(tmp_path, "ND_standard_surface_surfaceshader", transmission=1.0, specular_IOR=1.45,

@@ -315,6 +315,8 @@ class MaterialTable:
         record.fields.update(roughness=float(surface.value("roughness")), ior=float(surface.value("ior")),
                              emissive=emissive, base_color=(*colour, 1.0))
         transmission = float(surface.value("transmission"))
+        if surface.kind == "UsdPreviewSurface" and opacity < 1.0:  # as UsdShade's UsdPreviewSurface: glass
+            transmission, opacity = 1.0 - max(opacity, 0.0), 1.0
         image = surface.image("colour")
         if image is not None and transmission <= 0.0:
             if image.resolved:
@@ -703,8 +705,10 @@ def _mtlx_dispersion(surface: Surface) -> float:
     if surface.kind == "open_pbr_surface":
         scale = float(surface.constant("transmission_dispersion_scale"))
         abbe = float(surface.constant("transmission_dispersion_abbe_number"))
-    else:  # standard_surface's transmission_dispersion is an Abbe number, 0 for none
+    elif surface.kind == "standard_surface":  # its transmission_dispersion is an Abbe number, 0 for none
         scale, abbe = 1.0, float(surface.constant("transmission_dispersion"))
+    else:
+        return 0.0
     return scale * 20.0 / abbe if scale > 0.0 and abbe > 0.0 else 0.0
 
 

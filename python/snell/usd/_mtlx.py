@@ -48,7 +48,14 @@ OPEN_PBR_SURFACE: dict[str, Any] = {
     "thin_film_weight": 0.0, "emission_luminance": 0.0, "emission_color": (1.0, 1.0, 1.0), "geometry_opacity": 1.0,
     "geometry_thin_walled": False,
 }
-# Each surface's inputs by what they mean to snell.
+# MaterialX's own UsdPreviewSurface node (libraries/bxdf/usd_preview_surface.mtlx), as UsdShade's.
+PREVIEW_SURFACE: dict[str, Any] = {
+    "diffuseColor": (0.18, 0.18, 0.18), "emissiveColor": (0.0, 0.0, 0.0), "useSpecularWorkflow": 0,
+    "specularColor": (0.0, 0.0, 0.0), "metallic": 0.0, "roughness": 0.5, "clearcoat": 0.0,
+    "clearcoatRoughness": 0.01, "opacity": 1.0, "opacityThreshold": 0.0, "ior": 1.5, "displacement": 0.0,
+    "occlusion": 1.0,
+}
+# Each surface's inputs by what they mean to snell (None: not an input of that surface; its neutral value).
 _MEANINGS = {
     "standard_surface": dict(weight="base", colour="base_color", roughness="specular_roughness", ior="specular_IOR",
                              transmission="transmission", tint="transmission_color", depth="transmission_depth",
@@ -58,9 +65,15 @@ _MEANINGS = {
                              ior="specular_ior", transmission="transmission_weight", tint="transmission_color",
                              depth="transmission_depth", thin="geometry_thin_walled", opacity="geometry_opacity",
                              emission="emission_luminance", emission_colour="emission_color"),
+    # Glass by snell's UsdPreviewSurface rule (docs/usd.md): opacity below 1 transmits, diffuseColor tints.
+    "UsdPreviewSurface": dict(weight=None, colour="diffuseColor", roughness="roughness", ior="ior",
+                              transmission=None, tint="diffuseColor", depth=None, thin=None, opacity="opacity",
+                              emission=None, emission_colour="emissiveColor"),
 }
+_NEUTRAL = {"weight": 1.0, "transmission": 0.0, "depth": 0.0, "thin": False, "emission": 1.0}
 SURFACES = {"standard_surface": ("MaterialX standard_surface", STANDARD_SURFACE),
-            "open_pbr_surface": ("OpenPBR", OPEN_PBR_SURFACE)}
+            "open_pbr_surface": ("OpenPBR", OPEN_PBR_SURFACE),
+            "UsdPreviewSurface": ("MaterialX UsdPreviewSurface", PREVIEW_SURFACE)}
 _SHADER_IDS = {f"ND_{name}_surfaceshader": name for name in SURFACES}
 _IMAGE_CATEGORIES = ("image", "tiledimage")
 _SRGB_SPACES = ("srgb_texture", "srgb_displayp3")
@@ -104,7 +117,8 @@ class Surface:
 
     def value(self, meaning: str) -> Any:
         """The constant of the input that means `meaning` to snell (its default where unauthored or connected)."""
-        return self.constant(_MEANINGS[self.kind][meaning])
+        name = _MEANINGS[self.kind][meaning]
+        return _NEUTRAL[meaning] if name is None else self.constant(name)
 
     def constant(self, name: str) -> Any:
         """An input's constant, its default where unauthored or connected."""
@@ -112,13 +126,13 @@ class Surface:
         return SURFACES[self.kind][1][name] if given is None or given.value is None else given.value
 
     def image(self, meaning: str) -> Optional[Image]:
-        given = self.inputs.get(_MEANINGS[self.kind][meaning])
+        given = self.inputs.get(_MEANINGS[self.kind][meaning] or "")
         return given.image if given is not None else None
 
     def unmapped(self) -> list[str]:
         """What snell leaves out: each authored input it does not map that differs from its default, and each
         connection it cannot evaluate (images are mapped on the base colour alone)."""
-        mapped = set(_MEANINGS[self.kind].values())
+        mapped = set(_MEANINGS[self.kind].values()) - {None}
         dispersion = {"transmission_dispersion", "transmission_dispersion_scale", "transmission_dispersion_abbe_number"}
         defaults = SURFACES[self.kind][1]
         said = []
