@@ -1,8 +1,10 @@
 // Image files for hosts without an image library of their own (a pip
 // install's snell-usd): decoded by stb_image, as the glTF loader decodes
-// textures, and written as PNG by snell's own encoder (scene/png.h).
+// textures, and written as PNG by snell's own encoder (scene/png.h), whole
+// or not at all (io/file_write.h).
 #include "snell/snell.h"
 
+#include "io/file_write.h"
 #include "scene/png.h"
 
 #include <stb/stb_image.h>
@@ -14,7 +16,6 @@
 #include <fstream>
 #include <iterator>
 #include <memory>
-#include <unistd.h>
 
 namespace snell {
 
@@ -27,12 +28,6 @@ std::vector<unsigned char> fileBytes(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   if (!in) throw Error(path + ": cannot open the file");
   return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-}
-
-uint8_t srgbByte(float linear) {
-  float c = std::clamp(std::isnan(linear) ? 0.0f : linear, 0.0f, 1.0f);
-  float s = c <= 0.0031308f ? 12.92f * c : 1.055f * std::pow(c, 1.0f / 2.4f) - 0.055f;
-  return static_cast<uint8_t>(std::lround(s * 255.0f));
 }
 
 }  // namespace
@@ -70,34 +65,17 @@ ImageFile readImageFile(const std::string& path) {
 void writePng(const std::string& path, uint32_t width, uint32_t height, const float* rgba, bool alpha) {
   if (width == 0 || height == 0 || !rgba) throw Error(path + ": an image of " + std::to_string(width) + "x" +
                                                       std::to_string(height) + " pixels has nothing to write");
-  fs::path target(path);
-  fs::path folder = target.has_parent_path() ? target.parent_path() : fs::path(".");
-  if (!fs::is_directory(folder)) throw Error(path + ": the folder " + folder.string() + " does not exist");
   std::vector<uint8_t> bytes(size_t(width) * height * 4);
   for (size_t i = 0; i < size_t(width) * height; ++i) {
-    for (size_t c = 0; c < 3; ++c) bytes[4 * i + c] = srgbByte(rgba[4 * i + c]);
+    for (size_t c = 0; c < 3; ++c) bytes[4 * i + c] = io::linearToSrgb8(rgba[4 * i + c]);
     float a = std::clamp(std::isnan(rgba[4 * i + 3]) ? 0.0f : rgba[4 * i + 3], 0.0f, 1.0f);
     bytes[4 * i + 3] = alpha ? static_cast<uint8_t>(std::lround(a * 255.0f)) : 255;
   }
   std::vector<uint8_t> png = scene::encodePng(width, height, bytes);
-  // The rename makes the write all-or-nothing: a file appears only once complete.
-  fs::path temp = folder / ("." + target.stem().string() + ".partial-" + std::to_string(::getpid()) + ".png");
-  {
-    std::ofstream out(temp, std::ios::binary);
-    out.write(reinterpret_cast<const char*>(png.data()), std::streamsize(png.size()));
-    out.close();
-    if (!out) {
-      std::error_code ignored;
-      fs::remove(temp, ignored);
-      throw Error(path + ": could not write the file");
-    }
-  }
-  std::error_code renamed;
-  fs::rename(temp, target, renamed);
-  if (renamed) {
-    std::error_code ignored;
-    fs::remove(temp, ignored);
-    throw Error(path + ": could not write the file (" + renamed.message() + ")");
+  try {
+    io::writeAtomically(path, [&](const std::string& temp) { io::writeBytes(path, temp, png); });
+  } catch (const std::runtime_error& e) {
+    throw Error(e.what());
   }
 }
 

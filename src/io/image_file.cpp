@@ -4,6 +4,7 @@
 // machine that has only the Vulkan loader (the GPU benchmarks do that).
 #include "io/image_file.h"
 
+#include "io/file_write.h"
 #include "io/version.h"
 #include "scene/png.h"
 #include "scene/scene.h"
@@ -30,12 +31,6 @@ namespace snell::io {
 
 namespace fs = std::filesystem;
 
-uint8_t linearToSrgb8(float linear) {
-  float c = std::clamp(std::isnan(linear) ? 0.0f : linear, 0.0f, 1.0f);
-  float s = c <= 0.0031308f ? 12.92f * c : 1.055f * std::pow(c, 1.0f / 2.4f) - 0.055f;
-  return static_cast<uint8_t>(std::lround(s * 255.0f));
-}
-
 float LinearImage::channel(size_t i, int c) const {
   return rgba.empty() ? glm::unpackHalf1x16(rgbaHalf[4 * i + size_t(c)]) : rgba[i][c];
 }
@@ -61,37 +56,6 @@ Rgb8Image toSrgb8(const LinearImage& image) {
 }
 
 namespace {
-
-// The folder `path` goes in; throws naming the path when it does not exist.
-fs::path existingFolder(const std::string& path) {
-  fs::path target(path);
-  fs::path dir = target.has_parent_path() ? target.parent_path() : fs::path(".");
-  if (!fs::is_directory(dir)) throw std::runtime_error(path + ": the folder " + dir.string() + " does not exist");
-  return dir;
-}
-
-// Writes through a temporary file in the same folder, so the rename is atomic.
-template <typename WriteFn>
-void writeAtomically(const std::string& path, WriteFn write) {
-  fs::path target(path);
-  fs::path dir = existingFolder(path);
-  fs::path temp = dir / ("." + target.stem().string() + ".partial-" + std::to_string(::getpid()) + target.extension().string());
-  try {
-    write(temp.string());
-    fs::rename(temp, target);
-  } catch (...) {
-    std::error_code ignored;
-    fs::remove(temp, ignored);
-    throw;
-  }
-}
-
-void writeBytes(const std::string& finalPath, const std::string& path, const std::vector<uint8_t>& bytes) {
-  std::ofstream out(path, std::ios::binary);
-  out.write(reinterpret_cast<const char*>(bytes.data()), std::streamsize(bytes.size()));
-  out.close();
-  if (!out) throw std::runtime_error(finalPath + ": could not write the file");
-}
 
 std::vector<uint8_t> pngBytes(uint32_t width, uint32_t height, const std::vector<uint8_t>& rgb) {
   std::vector<uint8_t> rgba(size_t(width) * height * 4, 255);

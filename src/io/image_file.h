@@ -3,6 +3,8 @@
 // a failed or interrupted write leaves nothing behind.
 #pragma once
 
+#include "io/file_write.h"  // linearToSrgb8, which callers of toSrgb8 use too
+
 #include "scene/optics.h"
 
 #include <glm/glm.hpp>
@@ -47,9 +49,6 @@ struct ImageExtras {
   bool hasWorldToCamera = false;
   glm::mat4 worldToCamera{1.0f};
 };
-
-/// Encodes linear [0, 1] to 8-bit sRGB, rounding to nearest.
-uint8_t linearToSrgb8(float linear);
 
 /// Writes `image` to `path` (format from the extension: .png or .exr): into a
 /// temporary file beside it, renamed into place once complete. Throws
