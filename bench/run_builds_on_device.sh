@@ -12,7 +12,7 @@
 #                                          # and the 1M sphere as ten instanced wedges (the footprint ablation)
 #   bench/run_builds_on_device.sh build    # bench scale at 1M: build (with its steps) and refit beside the driver's
 #   bench/run_builds_on_device.sh viewport # the viewport's refraction work: crowd 2, eye 64, eye 256, crowd 100 at 4K
-# A build name may carry a leaf size, for bench/experiments/wide-bvh8.patch:
+# A build name may carry a leaf size, for the 8-wide tree's patch (git show 31fafc1:bench/experiments/wide-bvh8.patch):
 # wide@1 runs .carry/snell-wide with SNELL_BVH_LEAF_MAX=1.
 set -uo pipefail
 source "$(dirname "$0")/device_env.sh"
