@@ -82,6 +82,54 @@ class Frame : public GpuTest {
   scene::Pose pose = scene::evaluate(s, 0.0);
 };
 
+// A request no renderer can draw is refused before any GPU work, saying why.
+class FrameRequestCheck : public GpuTest {
+ protected:
+  scene::Scene eye = scene::makeEye();
+  scene::Pose pose = scene::evaluate(eye, 0.0);
+  FrameRequest request;
+  void SetUp() override {
+    GpuTest::SetUp();
+    request.pose = &pose;
+    request.views.emplace_back();
+    request.views[0].settings.width = request.views[0].settings.height = 4;
+  }
+  std::string refusal() {
+    try {
+      request.check(context(), pose.items.size());
+    } catch (const std::invalid_argument& e) {
+      return e.what();
+    }
+    return "";
+  }
+};
+
+TEST_F(FrameRequestCheck, AFrameOfTheScenesPoseAndItsViewsPasses) { EXPECT_EQ(refusal(), ""); }
+
+TEST_F(FrameRequestCheck, AFrameWithoutAPoseIsRefused) {
+  request.pose = nullptr;
+  EXPECT_EQ(refusal(), "renderer: a frame needs a pose");
+}
+
+TEST_F(FrameRequestCheck, APoseOfAnotherSceneIsRefusedWithBothCounts) {
+  scene::Pose other = pose;
+  other.items.pop_back();
+  request.pose = &other;
+  EXPECT_NE(refusal().find("the pose has " + std::to_string(other.items.size()) + " draw items; it was built for " +
+                           std::to_string(pose.items.size())),
+            std::string::npos);
+}
+
+TEST_F(FrameRequestCheck, ARayListThatDoesNotFillItsViewIsRefused) {
+  request.views[0].settings.rays.resize(3);
+  EXPECT_EQ(refusal(), "renderer: 3 rays for 16 pixels");
+}
+
+TEST_F(FrameRequestCheck, AReadbackOfAViewNotAskedForIsRefused) {
+  request.readbacks.push_back({.view = 1});
+  EXPECT_EQ(refusal(), "renderer: a readback of view 1 of 1");
+}
+
 TEST_F(Frame, AStaticScenesSecondFrameRunsNoDeformRefitOrTopLevelWork) {
   scene::Scene s = smallEye();
   scene::Pose pose = scene::evaluate(s, 0.5);

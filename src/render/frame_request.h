@@ -103,6 +103,12 @@ struct FrameRequest {
   VkSemaphore waitSemaphore = VK_NULL_HANDLE;
   VkPipelineStageFlags waitStage = 0;
   VkSemaphore signalSemaphore = VK_NULL_HANDLE;
+
+  /// Throws std::invalid_argument (or the size check's error) for a request
+  /// no renderer of `drawItems` draw items on `context` can draw: no pose or
+  /// one of another scene, an image too large, a ray list that does not fill
+  /// its view or that asks for a raster, a readback of a view not asked for.
+  void check(const vk::Context& context, size_t drawItems) const;
 };
 
 }  // namespace snell::render

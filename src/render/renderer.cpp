@@ -139,28 +139,8 @@ Renderer::~Renderer() {
 // ---------------------------------------------------------------- the frame
 
 uint64_t Renderer::submit(const FrameRequest& request) {
-  if (!request.pose) throw std::invalid_argument("renderer: a frame needs a pose");
+  request.check(context_, scene_.itemGeometry.size());
   const scene::Pose& pose = *request.pose;
-  if (pose.items.size() != scene_.itemGeometry.size()) {
-    throw std::invalid_argument("renderer: the pose has " + std::to_string(pose.items.size()) +
-                                " draw items; it was built for " + std::to_string(scene_.itemGeometry.size()));
-  }
-  for (const ViewRequest& v : request.views) {
-    checkImageSize(context_, v.settings.width, v.settings.height);
-    if (!v.settings.rays.empty() && v.settings.rays.size() != size_t(v.settings.width) * v.settings.height) {
-      throw std::invalid_argument("renderer: " + std::to_string(v.settings.rays.size()) + " rays for " +
-                                  std::to_string(size_t(v.settings.width) * v.settings.height) + " pixels");
-    }
-    if (!v.settings.rays.empty() && v.output != ViewOutput::Trace) {
-      throw std::invalid_argument("renderer: ray lists have no raster image");
-    }
-  }
-  for (const ReadbackRequest& r : request.readbacks) {
-    if (r.view >= request.views.size()) {
-      throw std::invalid_argument("renderer: a readback of view " + std::to_string(r.view) + " of " +
-                                  std::to_string(request.views.size()));
-    }
-  }
 
   // Where every item is (bounding spheres), then what each view does: both
   // decide which views trace, and the pipelines those need start compiling
