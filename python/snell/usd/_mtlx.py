@@ -221,7 +221,7 @@ def surface_of_document(document_path: str, shown: str, material_name: str) -> S
                         f"(its surface: {found})")
     shader = shaders[0]
     folder = os.path.dirname(document_path)
-    surface = Surface(shader.getCategory(), f"{shown}: {shader.getName()}")
+    surface = Surface(shader.getCategory(), f"{shown}: material {material_name}, shader {shader.getName()}")
     for given in shader.getInputs():
         node = given.getConnectedNode()
         if node is None and not given.getNodeName() and not given.getNodeGraphString() and not given.getOutputString():
