@@ -86,14 +86,46 @@ scene::Shape toShape(const Mesh& m, int index, size_t materials, const std::stri
   return shape;
 }
 
+// The API's subdivision tags as the scene layer's. Switches, not casts of one
+// enum's value to the other's: a tag the API gains and this misses fails the
+// build (-Wswitch), where a cast would silently read another tag.
+scene::SubdivisionScheme schemeOf(Subdivision::Scheme scheme) {
+  switch (scheme) {
+    case Subdivision::Scheme::Loop: return scene::SubdivisionScheme::Loop;
+    case Subdivision::Scheme::Bilinear: return scene::SubdivisionScheme::Bilinear;
+    case Subdivision::Scheme::CatmullClark:
+    case Subdivision::Scheme::None: break;  // None is no cage; toCage is only asked for cages
+  }
+  return scene::SubdivisionScheme::CatmullClark;
+}
+
+scene::BoundaryInterpolation boundaryOf(Subdivision::Boundary boundary) {
+  switch (boundary) {
+    case Subdivision::Boundary::None: return scene::BoundaryInterpolation::None;
+    case Subdivision::Boundary::EdgeOnly: return scene::BoundaryInterpolation::EdgeOnly;
+    case Subdivision::Boundary::EdgeAndCorner: break;
+  }
+  return scene::BoundaryInterpolation::EdgeAndCorner;
+}
+
+scene::FaceVaryingInterpolation faceVaryingOf(Subdivision::FaceVarying rule) {
+  switch (rule) {
+    case Subdivision::FaceVarying::None: return scene::FaceVaryingInterpolation::None;
+    case Subdivision::FaceVarying::CornersOnly: return scene::FaceVaryingInterpolation::CornersOnly;
+    case Subdivision::FaceVarying::CornersPlus1: return scene::FaceVaryingInterpolation::CornersPlus1;
+    case Subdivision::FaceVarying::CornersPlus2: return scene::FaceVaryingInterpolation::CornersPlus2;
+    case Subdivision::FaceVarying::Boundaries: return scene::FaceVaryingInterpolation::Boundaries;
+    case Subdivision::FaceVarying::All: break;
+  }
+  return scene::FaceVaryingInterpolation::All;
+}
+
 // A subdivision surface's cage, at rest at `positions` (3 floats a vertex;
 // null for a mesh in the host's buffers, which snell never sees at rest).
 scene::SubdivisionCage toCage(const Mesh& m, const float* positions) {
   const Subdivision& d = m.subdivision;
   scene::SubdivisionCage cage;
-  cage.scheme = d.scheme == Subdivision::Scheme::Loop       ? scene::SubdivisionScheme::Loop
-                : d.scheme == Subdivision::Scheme::Bilinear ? scene::SubdivisionScheme::Bilinear
-                                                            : scene::SubdivisionScheme::CatmullClark;
+  cage.scheme = schemeOf(d.scheme);
   cage.level = d.level;
   cage.limitSurface = d.limitSurface;
   cage.normals = d.normals == Subdivision::Normals::Limit && positions ? scene::SubdivisionNormals::Limit
@@ -109,8 +141,8 @@ scene::SubdivisionCage toCage(const Mesh& m, const float* positions) {
   cage.creaseSharpnesses = d.creaseSharpnesses;
   cage.cornerIndices = d.cornerIndices;
   cage.cornerSharpnesses = d.cornerSharpnesses;
-  cage.boundary = scene::BoundaryInterpolation(int(d.interpolateBoundary));
-  cage.faceVarying = scene::FaceVaryingInterpolation(int(d.faceVarying));
+  cage.boundary = boundaryOf(d.interpolateBoundary);
+  cage.faceVarying = faceVaryingOf(d.faceVarying);
   cage.smoothTriangles = d.smoothTriangles;
   for (size_t i = 0; i + 1 < m.texcoords.size(); i += 2) cage.uvs.emplace_back(m.texcoords[i], m.texcoords[i + 1]);
   cage.uvIndices = d.uvIndices;
