@@ -185,14 +185,15 @@ _SHAPES: dict[tuple[str, int], _Shape] = {}
 class GprimMesh:
     """A gprim read as a UsdGeomMesh: the mesh reader's calls, on faces and points tessellated from it."""
 
-    def __init__(self, prim: Usd.Prim, radius_pixels: Callable[[float], float] = lambda radius: math.nan) -> None:
+    def __init__(self, prim: Usd.Prim, radius_pixels: Callable[[float], float] = lambda radius: math.nan,
+                 time: Usd.TimeCode = Usd.TimeCode.EarliestTime()) -> None:
         """radius_pixels: how many pixels a length (the gprim's own units) spans where the gprim comes nearest
-        the camera (_screen.py); round gprims take their segments from it."""
+        the camera (_screen.py); round gprims take their segments from it, for their radius at `time`."""
         self.prim = prim
         self.kind = prim.GetTypeName()
         self._attributes = [prim.GetAttribute(n) for n in ("size", "radius", "height", "width", "length", "axis")]
         round_kinds = ("Sphere", "Cylinder", "Cone", "Capsule")
-        radius = self._dimensions(Usd.TimeCode.EarliestTime())[0].get("radius", 0.0)
+        radius = self._dimensions(time)[0].get("radius", 0.0)
         self.segments = segments_for(radius_pixels(radius)) if self.kind in round_kinds else SEGMENTS
         key = (self.kind, self.segments)
         if key not in _SHAPES:

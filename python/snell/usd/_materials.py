@@ -335,7 +335,7 @@ class MaterialTable:
                                      attenuation_distance=depth)
             else:
                 record.fields["base_color"] = (*tint, 1.0)
-            record.fields["dispersion"] = _mtlx_dispersion(surface)
+            record.fields["dispersion"] = surface.dispersion()
             volume = f", absorbing to {_fmt(tint)} at {depth:g}" if "thickness" in record.fields else ""
             kind = (f"glass (transmission {transmission:g}, ior {record.fields['ior']:g}) transmitting "
                     f"{_fmt(tint)}{volume}{', thin-walled' if thin else ''}")
@@ -698,18 +698,6 @@ def _channel_colour(values: np.ndarray, output: str) -> tuple[float, float, floa
     if output in ("r", "g", "b", "a"):
         return (float(values["rgba".index(output)]),) * 3
     return tuple(float(c) for c in values[:3])
-
-
-def _mtlx_dispersion(surface: Surface) -> float:
-    """snell's dispersion (KHR_materials_dispersion: 20 / Abbe number) of a MaterialX glass."""
-    if surface.kind == "open_pbr_surface":
-        scale = float(surface.constant("transmission_dispersion_scale"))
-        abbe = float(surface.constant("transmission_dispersion_abbe_number"))
-    elif surface.kind == "standard_surface":  # its transmission_dispersion is an Abbe number, 0 for none
-        scale, abbe = 1.0, float(surface.constant("transmission_dispersion"))
-    else:
-        return 0.0
-    return scale * 20.0 / abbe if scale > 0.0 and abbe > 0.0 else 0.0
 
 
 def _surface_fields(values: dict[str, Any]) -> dict[str, Any]:

@@ -125,6 +125,17 @@ class Surface:
         given = self.inputs.get(name)
         return SURFACES[self.kind][1][name] if given is None or given.value is None else given.value
 
+    def dispersion(self) -> float:
+        """snell's dispersion (KHR_materials_dispersion: 20 / Abbe number) of the surface's glass."""
+        if self.kind == "open_pbr_surface":
+            scale = float(self.constant("transmission_dispersion_scale"))
+            abbe = float(self.constant("transmission_dispersion_abbe_number"))
+        elif self.kind == "standard_surface":  # its transmission_dispersion is an Abbe number, 0 for none
+            scale, abbe = 1.0, float(self.constant("transmission_dispersion"))
+        else:
+            return 0.0
+        return scale * 20.0 / abbe if scale > 0.0 and abbe > 0.0 else 0.0
+
     def image(self, meaning: str) -> Optional[Image]:
         given = self.inputs.get(_MEANINGS[self.kind][meaning] or "")
         return given.image if given is not None else None

@@ -150,6 +150,9 @@ class StageContents:
         self._skel_cache = UsdSkel.Cache()
         self._xform_cache = UsdGeom.XformCache(Usd.TimeCode(self.time))
         self._first_screen: Optional[Screen] = None
+        self._bbox_cache = UsdGeom.BBoxCache(Usd.TimeCode(self.time), [UsdGeom.Tokens.default_,
+                                                                        self.options.geometry_purpose],
+                                             useExtentsHint=True)
         self._topologies: dict[Sdf.Path, Optional[Topology]] = {}
         self._shared: dict[tuple, MeshSource] = {}
         self._initial: dict[int, Pose] = {}
@@ -168,37 +171,28 @@ class StageContents:
         if not cages or self.options.subdivision_level is not None:
             return
         time = Usd.TimeCode(self.time)
-        boxes: dict[int, tuple[np.ndarray, np.ndarray, np.ndarray]] = {}
-        lo, hi = np.full(3, np.inf), np.full(3, -np.inf)
+        screen = self._screen_ahead()  # the view the gprims were sized for: one view for all detail
+        points = {id(s): np.asarray(s.points_attribute.Get(time) or [], np.float64).reshape(-1, 3) for s in cages}
+        near: dict[int, tuple[np.ndarray, np.ndarray, np.ndarray]] = {}  # each cage's box over its placements
         for placement in self.placements:
             source = placement.source
-            points = np.asarray(source.points_attribute.Get(time) or [], np.float64).reshape(-1, 3)
-            box = world_box(points, placement.matrix)
-            if box is None:
-                continue
-            lo, hi = np.minimum(lo, box[0]), np.maximum(hi, box[1])
-            if source.cage is not None:
-                seen = boxes.get(id(source))
-                near = box if seen is None else (np.minimum(seen[0], box[0]), np.maximum(seen[1], box[1]))
-                boxes[id(source)] = (near[0], near[1], placement.matrix if seen is None else seen[2])
-        try:
-            camera = self._camera(self.options.camera, self.time) if self.cameras else None
-        except StageError:  # the drawing says what is wrong with the camera; the levels take the first
-            camera = self._camera(None, self.time)
-        screen = screen_of(camera, lo, hi, *self.options.image_size)
-        sizes: dict[str, tuple[CageCounts, int]] = {}
+            box = world_box(points[id(source)], placement.matrix) if source.cage is not None else None
+            if box is not None:
+                seen = near.get(id(source))
+                near[id(source)] = box + (placement.matrix,) if seen is None else (
+                    np.minimum(seen[0], box[0]), np.maximum(seen[1], box[1]), seen[2])
+        sizes: dict[int, tuple[CageCounts, int]] = {}
         for source in cages:
-            if id(source) not in boxes:
+            if id(source) not in near:
                 continue
-            box_lo, box_hi, matrix = boxes[id(source)]
-            points = np.asarray(source.points_attribute.Get(time), np.float64).reshape(-1, 3)
-            world = points @ matrix[:3, :3].T
-            edge = mean_edge(world, source.topology.face_counts, source.topology.face_points)
+            box_lo, box_hi, matrix = near[id(source)]
+            edge = mean_edge(points[id(source)] @ matrix[:3, :3].T, source.topology.face_counts,
+                             source.topology.face_points)
             counts = CageCounts.of(source.topology.face_counts, source.topology.face_points, source.cage.scheme)
-            sizes[source.path] = (counts, level_for(screen.pixels(edge, box_lo, box_hi)))
+            sizes[id(source)] = (counts, level_for(screen.pixels(edge, box_lo, box_hi)))
         lowered = fit_budget(sizes, self.options.triangle_budget, REFINED_VERTEX_BUDGET)
         for source in cages:
-            level = lowered.get(source.path, sizes[source.path][1] if source.path in sizes else MAX_AUTO_LEVEL)
+            level = lowered.get(id(source), sizes[id(source)][1] if id(source) in sizes else MAX_AUTO_LEVEL)
             if level == 0:
                 source.drop_cage(read_normals(source.mesh, source.topology, time, self.problems))
                 self._initial[id(source)] = source.pose(time, SkelFrame(time))
@@ -208,7 +202,8 @@ class StageContents:
                 if part.cage is not None:
                     part.cage.level = level
         if lowered:
-            named = ", ".join(f"{path} ({level})" for path, level in sorted(lowered.items()))
+            paths = {id(source): source.path for source in cages}
+            named = ", ".join(sorted(f"{paths[key]} ({level})" for key, level in lowered.items()))
             self.problems.warn("", f"{len(lowered)} subdivision surfaces refined fewer levels than the view asks "
                                    f"(0: the cage drawn as polygons), to keep the scene within "
                                    f"{self.options.triangle_budget:,} refined triangles (--subdiv-budget) and "
@@ -219,16 +214,12 @@ class StageContents:
         """How many pixels a length in prim's own units spans where prim comes nearest the camera, in the view
         found ahead of the traversal (_screen_ahead)."""
         screen = self._screen_ahead()
-        box = _snell_box(self.to_snell, self._bounds().ComputeWorldBound(prim).ComputeAlignedRange())
+        box = _snell_box(self.to_snell, self._bbox_cache.ComputeWorldBound(prim).ComputeAlignedRange())
         world = self.to_snell @ np.array(self._xform_cache.GetLocalToWorldTransform(prim)).T
         scale = float(np.mean(np.linalg.norm(world[:3, :3], axis=0)))
         if box is None:
             return lambda length: math.nan
         return lambda length: screen.pixels(length * scale, *box)
-
-    def _bounds(self) -> UsdGeom.BBoxCache:
-        purposes = [UsdGeom.Tokens.default_, self.options.geometry_purpose]
-        return UsdGeom.BBoxCache(Usd.TimeCode(self.time), purposes, useExtentsHint=True)
 
     def _screen_ahead(self) -> Screen:
         """The view a gprim's detail is sized for while the stage is still being read: the camera asked for
@@ -247,7 +238,7 @@ class StageContents:
                 prim = cameras[0] if cameras else None
             camera = (camera_state(prim, time, self.to_snell, self.meters_per_unit, self._xform_cache)
                       if prim is not None else None)
-            box = _snell_box(self.to_snell, self._bounds().ComputeWorldBound(self.stage.GetPseudoRoot())
+            box = _snell_box(self.to_snell, self._bbox_cache.ComputeWorldBound(self.stage.GetPseudoRoot())
                              .ComputeAlignedRange())
             lo, hi = box if box is not None else (np.full(3, np.inf), np.full(3, -np.inf))
             self._first_screen = screen_of(camera, lo, hi, *self.options.image_size)
@@ -437,7 +428,7 @@ class StageContents:
             self.problems.fail(prim.GetPath(), f"cannot be read as a mesh ({str(e).strip().splitlines()[-1]})")
 
     def _read_mesh(self, prim: Usd.Prim, time: Usd.TimeCode, placed, varying_placement: bool) -> None:
-        mesh = UsdGeom.Mesh(prim) if prim.IsA(UsdGeom.Mesh) else GprimMesh(prim, self._pixels_of(prim))
+        mesh = UsdGeom.Mesh(prim) if prim.IsA(UsdGeom.Mesh) else GprimMesh(prim, self._pixels_of(prim), time)
         skin = self._skin_of(prim) if prim.IsA(UsdGeom.Mesh) else None
         prototype = prim.GetPrimInPrototype() if prim.IsInstanceProxy() else prim
         key = prototype.GetPath()

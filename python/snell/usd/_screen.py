@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Optional
+from typing import Hashable, Optional
 
 import numpy as np
 
@@ -83,17 +83,21 @@ def mean_edge(points: np.ndarray, face_counts: np.ndarray, face_points: np.ndarr
     """The mean length of a cage's face edges (each face's corners in turn), in the points' units."""
     if len(face_points) == 0 or len(points) == 0:
         return 0.0
-    ends = np.cumsum(face_counts)
-    starts = ends - face_counts
-    corner = np.arange(len(face_points))
-    following = corner + 1
-    last = ends - 1
-    following[last] = starts
     p = points[face_points]
-    return float(np.mean(np.linalg.norm(p[following] - p, axis=1)))
+    return float(np.mean(np.linalg.norm(p[_following(face_counts)] - p, axis=1)))
 
 
-def fit_budget(meshes: dict[str, tuple["CageCounts", int]], triangles: int, vertices: int) -> dict[str, int]:
+def _following(face_counts: np.ndarray) -> np.ndarray:
+    """For each face corner (faces' corners in turn), the corner after it in its face: its edge's other end."""
+    counts = np.asarray(face_counts, np.int64)
+    ends = np.cumsum(counts)
+    following = np.arange(int(counts.sum())) + 1
+    following[ends - 1] = ends - counts
+    return following
+
+
+def fit_budget(meshes: dict[Hashable, tuple["CageCounts", int]], triangles: int,
+               vertices: int) -> dict[Hashable, int]:
     """Levels lowered until the refined triangles and vertices fit: {mesh: (its cage's counts, level)} in,
     {mesh: level} out for the meshes lowered, the mesh of most refined triangles first; 0 (the cage drawn as
     polygons) is the last resort, and a scene still over then is left to the device's own check."""
@@ -135,10 +139,7 @@ class CageCounts:
     def of(face_counts: np.ndarray, face_points: np.ndarray, scheme: str) -> "CageCounts":
         counts = np.asarray(face_counts, np.int64)
         points = np.asarray(face_points, np.int64)
-        ends = np.cumsum(counts)
-        following = np.arange(len(points)) + 1
-        following[ends - 1] = ends - counts
-        pairs = np.sort(np.stack([points, points[following]], axis=1), axis=1)
+        pairs = np.sort(np.stack([points, points[_following(counts)]], axis=1), axis=1)
         return CageCounts(len(np.unique(points)), len(np.unique(pairs, axis=0)), len(counts), int(counts.sum()),
                           scheme)
 
