@@ -11,6 +11,7 @@
 #extension GL_KHR_shader_subgroup_arithmetic : require
 #extension GL_KHR_shader_subgroup_ballot : require
 #extension GL_KHR_memory_scope_semantics : require
+#include "dispatch.glsl"
 
 shared uint sSubgroupSums[MAX_SUBGROUPS];
 shared uint sWorkgroupTotal;
@@ -18,12 +19,6 @@ shared uint sWorkgroupTotal;
 // Dense invocation number in scan order, 0 .. workgroup size - 1.
 uint scanOrderIndex() {
   return gl_SubgroupID * gl_SubgroupSize + gl_SubgroupInvocationID;
-}
-
-// Large dispatches are split over y because x is limited to 65535 groups on
-// many devices; this flattens them back into one block number.
-uint blockIndex() {
-  return gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x;
 }
 
 // Execution barrier for the subgroup that orders its shared-memory accesses

@@ -19,18 +19,12 @@ layout(std430, binding = kDeformBindingPositions) writeonly buffer Positions { f
 layout(std430, binding = kDeformBindingNormals) writeonly buffer Normals { float normals[]; };
 layout(std430, binding = kDeformBindingJobs) readonly buffer Jobs { DeformJob jobs[]; };
 
-uint jobOf(uint t) {
-  uint lo = 0u, hi = pc.jobCount;
-  while (hi - lo > 1u) {
-    uint mid = (lo + hi) / 2u;
-    if (jobs[mid].threadBase <= t) lo = mid;
-    else hi = mid;
-  }
-  return lo;
-}
+#define JOB_FIRST(i) jobs[i].threadBase
+#define JOB_COUNT pc.jobCount
+#include "../common/dispatch.glsl"
 
 void main() {
-  uint t = (gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x) * gl_WorkGroupSize.x + gl_LocalInvocationID.x;
+  uint t = invocationIndex();
   if (t >= pc.count) return;
   DeformJob job = jobs[jobOf(t)];
   uint v = t - job.threadBase;

@@ -17,17 +17,11 @@ layout(std430, binding = kRefineBindingPositions) writeonly buffer Positions { f
 layout(std430, binding = kRefineBindingNormals) writeonly buffer Normals { float normals[]; };
 layout(std430, binding = kRefineBindingJobs) readonly buffer Jobs { RefineJob jobs[]; };
 
-// The job whose invocations hold t: the last one starting at or before it.
-uint jobOf(uint t) {
-  uint lo = 0u, hi = pc.jobCount;
-  while (hi - lo > 1u) {
-    uint mid = (lo + hi) / 2u;
-    uint base = kStage == kRefineStageRefine ? jobs[mid].refineBase : jobs[mid].limitBase;
-    if (base <= t) lo = mid;
-    else hi = mid;
-  }
-  return lo;
-}
+// Each stage numbers its own invocations: a job's first is its refineBase in
+// the refine stage and its limitBase in the limit stage.
+#define JOB_FIRST(i) (kStage == kRefineStageRefine ? jobs[i].refineBase : jobs[i].limitBase)
+#define JOB_COUNT pc.jobCount
+#include "../common/dispatch.glsl"
 
 vec3 cageAt(uint v) { return vec3(cage[3u * v], cage[3u * v + 1u], cage[3u * v + 2u]); }
 vec3 refinedAt(uint v) { return vec3(refined[3u * v], refined[3u * v + 1u], refined[3u * v + 2u]); }
@@ -90,7 +84,7 @@ void limitVertex(RefineJob job, uint v) {
 }
 
 void main() {
-  uint t = (gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x) * gl_WorkGroupSize.x + gl_LocalInvocationID.x;
+  uint t = invocationIndex();
   if (t >= pc.count) return;
   RefineJob job = jobs[jobOf(t)];
   if (kStage == kRefineStageRefine) {

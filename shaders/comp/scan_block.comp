@@ -19,7 +19,7 @@ shared uint sTile[kTile + kTile / 32];
 uint padded(uint i) { return i + (i >> 5); }
 
 void main() {
-  uint block = blockIndex();
+  uint block = workgroupIndex();
   if (block >= pc.blockCount) return;  // uniform per workgroup
   uint base = block * kTile;
   uint r = scanOrderIndex();

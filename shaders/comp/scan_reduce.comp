@@ -13,7 +13,7 @@ layout(std430, binding = kScanBindingData) readonly buffer Data { uint data[]; }
 layout(std430, binding = kScanBindingPartials) writeonly buffer Partials { uint partials[]; };
 
 void main() {
-  uint block = blockIndex();
+  uint block = workgroupIndex();
   if (block >= pc.blockCount) return;  // uniform per workgroup, so no barrier is skipped by part of it
   uint tile = gl_WorkGroupSize.x * ITEMS_PER_THREAD;
   uint base = block * tile;

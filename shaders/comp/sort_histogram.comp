@@ -19,7 +19,7 @@ layout(std430, binding = kSortBindingHistogram) writeonly buffer Histogram { uin
 shared uint sCount[kSortRadix];
 
 void main() {
-  uint block = blockIndex();
+  uint block = workgroupIndex();
   if (block >= pc.blockCount) return;  // uniform per workgroup
   uint r = scanOrderIndex();
   for (uint d = r; d < kSortRadix; d += gl_WorkGroupSize.x) sCount[d] = 0;

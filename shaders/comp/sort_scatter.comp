@@ -54,7 +54,7 @@ uvec2 loadKey(uint index) {
 }
 
 void main() {
-  uint block = blockIndex();
+  uint block = workgroupIndex();
   if (block >= pc.blockCount) return;  // uniform per workgroup
   uint r = scanOrderIndex();
   // A constant 0 for 32-bit keys lets the compiler drop every high-word path.

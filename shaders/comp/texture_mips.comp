@@ -13,6 +13,7 @@
 #include "../shared/trace.h"
 
 layout(local_size_x = 64) in;
+#include "../common/dispatch.glsl"
 layout(push_constant) uniform Push { TextureMipPush pc; };
 layout(std430, binding = 0) readonly buffer SrgbDecode { float srgbDecode[]; };
 layout(std430, binding = 1) buffer Page { uint texels[]; };
@@ -22,8 +23,7 @@ float encodeSrgb(float c) {
 }
 
 void main() {
-  // Workgroups beyond the device's x limit continue along y (ComputeProgram).
-  uint id = (gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x) * gl_WorkGroupSize.x + gl_LocalInvocationID.x;
+  uint id = invocationIndex();
   if (id >= pc.targetWidth * pc.targetHeight) return;
   uvec2 p = uvec2(id % pc.targetWidth, id / pc.targetWidth);
   uvec2 last = uvec2(pc.sourceWidth, pc.sourceHeight) - 1u;

@@ -14,6 +14,7 @@
 #include "bvh/bvh_node.glsl"
 
 layout(local_size_x = 64) in;  // one kTraceTile x kTraceTile tile of pixels
+#include "../common/dispatch.glsl"
 layout(push_constant) uniform Push { TracePush pc; };
 layout(constant_id = kTraceSpecLanes) const uint kLanes = 1u;
 
@@ -476,7 +477,7 @@ Hit traceClosest(vec3 origin, vec3 dir, uint skipInstance, uint skipPrim, float 
 uint firstTriangleOf(uint instance) { return blasGroups[instances[instance].geometry].first; }
 
 void main() {
-  uint group = gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x;
+  uint group = workgroupIndex();
   uvec2 pixel;
   if (traceFlag(kTraceFlagPixelList)) {
     // The masked trace: one listed pixel per invocation (listed tile by tile,

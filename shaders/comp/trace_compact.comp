@@ -10,6 +10,7 @@
 #include "../shared/trace.h"
 
 layout(local_size_x = 64) in;  // one kTraceTile x kTraceTile tile
+#include "../common/dispatch.glsl"
 layout(push_constant) uniform Push { TraceCompactPush pc; };
 layout(binding = kTraceBindingMask, r32ui) uniform readonly uimage2D mask;
 layout(std430, binding = kTraceBindingPixels) coherent buffer Pixels {
@@ -18,7 +19,7 @@ layout(std430, binding = kTraceBindingPixels) coherent buffer Pixels {
 };
 
 void main() {
-  uint group = gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x;
+  uint group = workgroupIndex();
   uint tiles = pc.tilesX * ((pc.height + kTraceTile - 1u) / kTraceTile);
   for (uint k = 0u; k < kTraceCompactTiles; ++k) {
     uint tile = group * kTraceCompactTiles + k;

@@ -22,9 +22,9 @@ layout(std430, binding = kBvhBindingDropped) buffer Dropped { uint dropped; };
 #include "bvh_entry_of.glsl"
 
 void main() {
-  uint t = threadIndex();
+  uint t = invocationIndex();
   if (t >= pc.count) return;
-  uint e = entryOf(t);
+  uint e = jobOf(t);
   uint prim = entries[e].first + (t - entries[e].base);
   vec3 lo, hi;
   primitiveBox(prim, lo, hi);

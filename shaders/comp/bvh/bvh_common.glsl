@@ -5,14 +5,11 @@
 #include "../../shared/bvh.h"
 
 layout(local_size_x_id = kBvhSpecWorkgroupSize) in;
+#include "../../common/dispatch.glsl"
 layout(push_constant) uniform Push { BvhPush pc; };
 
 const float kInf = 1.0 / 0.0;  // folded to +infinity at compile time
 
-uint threadIndex() {
-  // Large dispatches are split over y (ComputeProgram::dispatchThreads).
-  return (gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x) * gl_WorkGroupSize.x + gl_LocalInvocationID.x;
-}
 
 uint orderedKey(float f) {
   uint u = floatBitsToUint(f);

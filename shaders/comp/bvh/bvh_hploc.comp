@@ -275,12 +275,12 @@ void main() {
   lane = gl_SubgroupInvocationID;
   width = gl_SubgroupSize;
   w0 = team * kBvhWindow;
-  uint s = (gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x) * gl_WorkGroupSize.x + team * width + lane;
+  uint s = workgroupIndex() * gl_WorkGroupSize.x + team * width + lane;
   bool climbing = s < pc.count;
   uint e = 0u, L = s, R = s, lowest = 0u, highest = 0u, split = 0u;
   bool needMerge = false, final = false;
   if (climbing) {
-    e = entryOf(s);
+    e = jobOf(s);
     BvhBuildEntry entry = entries[e];
     lowest = entry.base;
     highest = entry.base + entry.count - 1u;

@@ -23,9 +23,9 @@ uint spreadBits(uint v) {
 #include "bvh_entry_of.glsl"
 
 void main() {
-  uint t = threadIndex();
+  uint t = invocationIndex();
   if (t >= pc.count) return;
-  uint e = entryOf(t);
+  uint e = jobOf(t);
   vec3 lo = vec3(primBoxes[6u * t], primBoxes[6u * t + 1u], primBoxes[6u * t + 2u]);
   vec3 hi = vec3(primBoxes[6u * t + 3u], primBoxes[6u * t + 4u], primBoxes[6u * t + 5u]);
   uint morton = (1u << kBvhMortonBits) - 1u;

@@ -21,9 +21,9 @@ layout(std430, binding = kBvhBindingNodes) buffer Nodes { BvhNode nodes[]; };
 #include "bvh_child_box.glsl"
 
 void main() {
-  uint t = threadIndex();
+  uint t = invocationIndex();
   if (t >= pc.count) return;
-  BvhBuildEntry entry = entries[entryOf(t)];
+  BvhBuildEntry entry = entries[jobOf(t)];
   uint local = t - entry.base;
   if (local + 1u >= entry.count) return;  // a group of n leaves has n - 1 nodes
   uint node = entry.first + local;

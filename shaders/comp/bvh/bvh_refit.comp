@@ -40,7 +40,7 @@ layout(std430, binding = kBvhBindingStats) buffer Stats { uvec4 stats[]; };
 layout(std430, binding = kBvhBindingDropped) buffer Dropped { uint dropped; };
 #include "bvh_leaves.glsl"
 
-#define BVH_ENTRY_FIRST(i) entries[i].threadBase
+#define JOB_FIRST(i) entries[i].threadBase
 #include "bvh_entry_of.glsl"
 
 // A 64-bit add from two 32-bit atomics: the low word's carry is seen by the
@@ -83,9 +83,9 @@ bool arrive(uint node) {
 }
 
 void main() {
-  uint t = threadIndex();
+  uint t = invocationIndex();
   if (t >= pc.count) return;
-  BvhRefitEntry entry = entries[entryOf(t)];
+  BvhRefitEntry entry = entries[jobOf(t)];
   uint g = entry.group;
   float unitScale = float(kBvhSahScale) / max(groups[g].buildArea, 1e-30);
   uint sah = 0u;

@@ -202,9 +202,9 @@ bool arrive(uint node) {
 // One invocation per node slot of the build; the walk starts at the nodes
 // that hold a leaf, as the refit's does.
 void main() {
-  uint t = threadIndex();
+  uint t = invocationIndex();
   if (t >= pc.count) return;
-  entry = entries[entryOf(t)];
+  entry = entries[jobOf(t)];
   uint local = t - entry.base;
   if (local + 1u >= entry.count) return;  // a group of n leaves has n - 1 nodes
   uint node = entry.first + local;
