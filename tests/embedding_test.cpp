@@ -257,29 +257,46 @@ snell::HostScene cageAndFloor(const float* cage, const float* floor) {
   return host;
 }
 
-TEST(Embedding, ASubdivisionCageInTheHostsBuffersDrawsAsTheSameCageKeptBySnell) {
-  snell::Device device = snell::Device::create({.validation = true, .synchronizationValidation = true});
+// cageAndFloor's vertices, at rest, in buffers of the host's.
+struct CageAndFloorBuffers {
   float cage[24], floor[12] = {-2, -0.8f, -2, 2, -0.8f, -2, 2, -0.8f, 2, -2, -0.8f, 2};
-  for (int i = 0; i < 8; ++i) {
-    for (int c = 0; c < 3; ++c) cage[3 * i + c] = (i >> c & 1) ? 0.5f : -0.5f;
+  HostBuffer positions, normals;
+  snell::HostScene scene = cageAndFloor(nullptr, nullptr);
+
+  explicit CageAndFloorBuffers(const snell::Device& device) : positions(device, 12 * 3), normals(device, 12 * 3) {
+    for (int i = 0; i < 8; ++i) {
+      for (int c = 0; c < 3; ++c) cage[3 * i + c] = (i >> c & 1) ? 0.5f : -0.5f;
+    }
+    std::memcpy(positions.mapped, floor, sizeof floor);
+    std::memcpy(positions.mapped + 12, cage, sizeof cage);
+    for (int v = 0; v < 12; ++v) {
+      normals.mapped[3 * v] = 0, normals.mapped[3 * v + 1] = v < 4 ? 1.0f : 0.0f, normals.mapped[3 * v + 2] = 0;
+    }
+    scene.positions = positions.buffer;
+    scene.normals = normals.buffer;
+    scene.vertexCapacity = 12;
   }
-  HostBuffer positions(device, 12 * 3), normals(device, 12 * 3);
-  std::memcpy(positions.mapped, floor, sizeof floor);
-  std::memcpy(positions.mapped + 12, cage, sizeof cage);
-  for (int v = 0; v < 12; ++v) normals.mapped[3 * v] = 0, normals.mapped[3 * v + 1] = v < 4 ? 1.0f : 0.0f, normals.mapped[3 * v + 2] = 0;
-  snell::HostScene inBuffers = cageAndFloor(nullptr, nullptr);
-  inBuffers.positions = positions.buffer;
-  inBuffers.normals = normals.buffer;
-  inBuffers.vertexCapacity = 12;
-  snell::Scene hostScene = snell::Scene::fromHost(inBuffers), keptScene = snell::Scene::fromHost(cageAndFloor(cage, floor));
-  EXPECT_EQ(hostScene.vertexCount(1), 8u);
-  EXPECT_EQ(hostScene.drawnVertexCount(1), 98u);
-  snell::Renderer hostRenderer(device, hostScene), keptRenderer(device, keptScene);
+};
+
+snell::View cageView() {
   snell::View view;
   view.width = 80;
   view.height = 60;
   view.output = snell::View::Output::Trace;
   view.camera.eye = {1.2f, 1.0f, 2.4f};
+  return view;
+}
+
+TEST(Embedding, ASubdivisionCageInTheHostsBuffersDrawsAsTheSameCageKeptBySnell) {
+  snell::Device device = snell::Device::create({.validation = true, .synchronizationValidation = true});
+  CageAndFloorBuffers buffers(device);
+  HostBuffer& positions = buffers.positions;
+  snell::Scene hostScene = snell::Scene::fromHost(buffers.scene);
+  snell::Scene keptScene = snell::Scene::fromHost(cageAndFloor(buffers.cage, buffers.floor));
+  EXPECT_EQ(hostScene.vertexCount(1), 8u);
+  EXPECT_EQ(hostScene.drawnVertexCount(1), 98u);
+  snell::Renderer hostRenderer(device, hostScene), keptRenderer(device, keptScene);
+  const snell::View view = cageView();
   std::vector<float> before;
   for (int frame = 0; frame < 2; ++frame) {
     if (frame == 1) {  // the host squashes its cage; snell refines it again
@@ -299,6 +316,31 @@ TEST(Embedding, ASubdivisionCageInTheHostsBuffersDrawsAsTheSameCageKeptBySnell) 
       EXPECT_GT(compare(view, before, fromHost).over1, 100u) << "the squashed cage drew as before";
     }
   }
+  EXPECT_EQ(device.validationMessages(), 0u);
+}
+
+// snell.h: the refined cage's vertices are snell's, so the floor beside it is
+// copied out of the host's buffers, at the first frame and at markDirty.
+TEST(Embedding, AHostSceneWithASubdivisionCageCopiesItsOtherMeshesWhenMarkedDirty) {
+  snell::Device device = snell::Device::create({.validation = true, .synchronizationValidation = true});
+  CageAndFloorBuffers buffers(device);
+  buffers.scene.materials[1].emissive = {0.8f, 0.8f, 0.8f};  // a floor seen without lights, from above
+  buffers.scene.materials[1].doubleSided = true;
+  snell::Scene scene = snell::Scene::fromHost(buffers.scene);
+  snell::Renderer renderer(device, scene);
+  const snell::View view = cageView();
+  const std::vector<float> atRest = renderer.read(view);
+  EXPECT_EQ(renderer.lastFrame().meshesUploaded, 2u);  // the first frame takes every mesh
+  for (int v = 0; v < 4; ++v) {  // the floor shrinks to a quarter of its width
+    buffers.positions.mapped[3 * v] *= 0.25f;
+    buffers.positions.mapped[3 * v + 2] *= 0.25f;
+  }
+  EXPECT_EQ(compare(view, atRest, renderer.read(view)).over1, 0u) << "the host's floor was read in place";
+  EXPECT_EQ(renderer.lastFrame().meshesUploaded, 0u);
+  renderer.markDirty(0);
+  EXPECT_GT(compare(view, atRest, renderer.read(view)).over1, 100u) << "the marked floor was not copied";
+  EXPECT_EQ(renderer.lastFrame().meshesUploaded, 1u);
+  EXPECT_EQ(renderer.lastFrame().meshesRefined, 0u) << "the cage did not move";
   EXPECT_EQ(device.validationMessages(), 0u);
 }
 

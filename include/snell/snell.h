@@ -250,7 +250,13 @@ struct MeshVertices {
 ///   triples (12 bytes a vertex) in two VkBuffers made with
 ///   VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, each mesh at its firstVertex: one
 ///   buffer for all meshes, as an engine's skinning output usually is. snell
-///   reads them in place, never copies them, and never frees them.
+///   reads them in place and never frees them. A scene with a subdivision
+///   surface is the one exception: its refined vertices are snell's, and the
+///   trace reads one vertex buffer, so snell copies every other mesh's vertices
+///   from the host's buffers into its own, all of them at the first frame and
+///   then each mesh when the host marks it dirty (Renderer::markDirty). The
+///   cages are read in place. In such a scene, a mesh rewritten without
+///   markDirty keeps drawing its old vertices.
 /// - snell's own buffers (`positions` and `normals` null): `vertices` gives
 ///   each mesh's vertices (Mesh::vertexCount of them; firstVertex is
 ///   ignored). Each Renderer keeps a copy on the GPU and a mapped one the host
@@ -435,7 +441,7 @@ struct FrameInfo {
   uint64_t pixelsTraced = 0;
   bool skipped = false;  ///< nothing changed since the view was last drawn: the image was reused
   uint32_t itemsDeformed = 0;   ///< glTF items whose morphs or skin snell deformed
-  uint32_t meshesUploaded = 0;  ///< kept meshes (Renderer::vertices) copied to the GPU
+  uint32_t meshesUploaded = 0;  ///< meshes whose vertices were copied to the GPU: kept ones, or a host's beside a subdivision surface
   uint32_t meshesRefined = 0;   ///< subdivision surfaces whose moved cage the GPU refined
   uint32_t verticesRefined = 0; ///< the vertices those became
   bool topLevelBuilt = false, topLevelRefit = false;

@@ -4,7 +4,6 @@
 // frame's items go in one dispatch, whatever their number; static shapes skip it.
 #pragma once
 
-#include "render/scene_gpu.h"
 #include "scene/evaluate.h"
 #include "scene/scene.h"
 #include "vk/buffer.h"
@@ -13,6 +12,7 @@
 #include "vk/context.h"
 #include "vk/upload_arena.h"
 
+#include <cstdint>
 #include <functional>
 #include <memory>
 #include <span>
@@ -27,6 +27,12 @@ struct DeformSlot {
   const vk::Buffer* positions = nullptr;
   const vk::Buffer* normals = nullptr;
   uint32_t firstVertex = 0;
+};
+
+/// Vertices copied from one place of a pair of vertex buffers to another
+/// (DeformPass::recordCopies): `count` vertices from vertex `from` to `to`.
+struct VertexCopy {
+  uint32_t from = 0, to = 0, count = 0;
 };
 
 /// One deforming draw item and where its deformed geometry goes.

@@ -95,21 +95,16 @@ Renderer::Renderer(vk::Context& context, const scene::Scene& scene, const scene:
     throw std::invalid_argument("renderer: traceLanes must be 0 (chosen per frame), 1, 2, 4 or 8, not " +
                                 std::to_string(options_.traceLanes));
   }
-  if (options_.keepVertices && options_.host.positions) {
-    throw std::invalid_argument("renderer: kept vertices are for scenes without host buffers");
-  }
   deform_ = std::make_unique<DeformPass>(context, scene, pose, [&](int item) {
     for (const GeometryRange& g : scene_.geometries) {
       if (g.item == item) return DeformSlot{&scene_.positions, &scene_.normals, g.firstVertex};
     }
     throw std::logic_error("deforming item without a geometry");
   });
-  refine_ = std::make_unique<RefinePass>(context, scene, scene_);
-  // A copied host scene's vertices are the host's to give: the first frame takes them all.
-  if (scene_.copiesHost()) hostDirty_.assign(scene.shapes.size(), 1);
   raster_ = std::make_unique<RasterPass>(context);
   trace_ = std::make_unique<TracePass>(context, scene, scene_);
   std::string name = scene.source.empty() ? std::string("scene") : scene.source;
+  feed_ = std::make_unique<VertexFeed>(context, scene, scene_, options_.keepVertices, name);
   size_t lightNodes = 0;
   for (const scene::Node& node : scene.nodes) lightNodes += node.light >= 0 ? 1 : 0;
   instances_ = vk::Buffer(context, {std::max<size_t>(pose.items.size(), 1) * sizeof(gpu::GpuInstance),
@@ -124,7 +119,6 @@ Renderer::Renderer(vk::Context& context, const scene::Scene& scene, const scene:
   for (size_t o = 0; o < deform_->outputs().size(); ++o) {
     itemDeformOutput_[size_t(deform_->outputs()[o].item)] = static_cast<uint32_t>(o);
   }
-  if (options_.keepVertices) kept_ = std::make_unique<KeptVertexCopy>(context, scene, name);
   for (uint32_t i = 0; i < options_.framesInFlight; ++i) slots_.push_back(std::make_unique<Slot>(context, i));
 }
 
@@ -171,10 +165,10 @@ uint64_t Renderer::submit(const FrameRequest& request) {
   // Frames in flight share the scene's GPU data: what this frame rewrites,
   // the one before may still be reading.
   commands.fullBarrier();
-  if (kept_) stats.shapesCopied = kept_->recordCopies(commands, scene_, *refine_);
-  recordHostCopies(commands, slot);
-  if (stats.shapesCopied) commands.fullBarrier();
-  recordRefine(commands, slot);
+  const FeedCounts fed = feed_->record(commands, slot.arena, *deform_);
+  stats.shapesCopied = fed.shapesCopied;
+  stats.shapesRefined = fed.shapesRefined;
+  stats.verticesRefined = fed.verticesRefined;
   for (const vk::Image* image : targets_.takeNewImages()) {
     commands.imageLayout(*image, VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_GENERAL);
   }
@@ -245,28 +239,6 @@ void Renderer::planDeform(const scene::Pose& pose, Update& u, FrameStats& stats)
       if (scene_.geometries[g].item == int(i)) noteMoved(g);
     }
   }
-}
-
-void Renderer::recordHostCopies(vk::Commands& commands, Slot& slot) {
-  std::vector<VertexCopy> copies;
-  for (size_t shape = 0; shape < hostDirty_.size(); ++shape) {
-    if (!std::exchange(hostDirty_[shape], 0)) continue;
-    ++slot.result.stats.shapesCopied;
-    refine_->markDirty(int(shape));  // a subdivision surface's cage is read in place by the refine pass
-    for (const VertexCopy& c : scene_.hostCopies(sceneModel_, int(shape))) copies.push_back(c);
-  }
-  deform_->recordCopies(commands, slot.arena, scene_.hostPositions, scene_.hostNormals, scene_.positions,
-                        scene_.normals, copies);
-}
-
-void Renderer::recordRefine(vk::Commands& commands, Slot& slot) {
-  if (!refine_->pending()) return;
-  commands.beginPass(pass::kRefine);
-  for (int shape : refine_->record(commands, scene_, slot.arena)) {
-    ++slot.result.stats.shapesRefined;
-    slot.result.stats.verticesRefined += static_cast<uint32_t>(sceneModel_.shapes[size_t(shape)].vertexCount());
-  }
-  commands.endPass();
 }
 
 void Renderer::recordUpdate(vk::Commands& commands, Slot& slot, const scene::Pose& pose, const Update& u) {
@@ -436,13 +408,9 @@ void Renderer::finish() {
 // ---------------------------------------------------------------- between frames
 
 KeptVertices Renderer::keptVertices(int shape) {
-  if (!kept_) throw std::invalid_argument("renderer: made without kept vertices");
-  if (shape < 0 || size_t(shape) >= sceneModel_.shapes.size()) {
-    throw std::invalid_argument("renderer: no shape " + std::to_string(shape) + " of " +
-                                std::to_string(sceneModel_.shapes.size()));
-  }
+  if (!feed_->keeps()) throw std::invalid_argument("renderer: made without kept vertices");
   finish();
-  return kept_->shape(shape);
+  return feed_->kept(shape);
 }
 
 void Renderer::markDirty(int shape) {
@@ -452,8 +420,7 @@ void Renderer::markDirty(int shape) {
   for (uint32_t g = 0; g < scene_.geometries.size(); ++g) {
     if (scene_.geometries[g].shape == shape) noteMoved(g);
   }
-  if (kept_) kept_->markDirty(shape);
-  if (!hostDirty_.empty()) hostDirty_[size_t(shape)] = 1;
+  feed_->markDirty(shape);
   // A host's promised box still holds; any other is unknown until a refit measures it.
   if (!sceneModel_.shapes[size_t(shape)].host) {
     bounds_.setShapeBox(shape, glm::dvec3(INFINITY), glm::dvec3(-INFINITY));
@@ -494,7 +461,7 @@ void Renderer::noteMoved(uint32_t geometry) {
 }
 
 uint64_t Renderer::memoryBytes() const {
-  return scene_.bytes + deform_->bytes() + refine_->bytes() + instances_.size() + lights_.size() + (kept_ ? kept_->bytes() : 0) +
+  return scene_.bytes + deform_->bytes() + feed_->bytes() + instances_.size() + lights_.size() +
          trees_.bytes() + trace_->bytes();
 }
 

@@ -19,14 +19,13 @@
 #include "render/deform_pass.h"
 #include "render/frame_request.h"
 #include "render/frame_settings.h"
-#include "render/kept_vertices.h"
 #include "render/raster_pass.h"
-#include "render/refine_pass.h"
 #include "render/refraction_map.h"
 #include "render/scene_gpu.h"
 #include "render/scene_state.h"
 #include "render/scene_trees.h"
 #include "render/trace_pass.h"
+#include "render/vertex_feed.h"
 #include "render/view_targets.h"
 #include "scene/evaluate.h"
 #include "scene/scene.h"
@@ -150,10 +149,6 @@ class Renderer {
   Update planUpdate(const scene::Pose& pose, const FrameRequest& request, const std::vector<ViewPlan>& plans,
                     Slot& slot);
   void planDeform(const scene::Pose& pose, Update& update, FrameStats& stats);
-  /// A copied host scene's shapes marked dirty: their vertices copied from the host's buffers, or their cages refined.
-  void recordHostCopies(vk::Commands& commands, Slot& slot);
-  /// The refine pass over the subdivision surfaces whose cage moved.
-  void recordRefine(vk::Commands& commands, Slot& slot);
   void recordUpdate(vk::Commands& commands, Slot& slot, const scene::Pose& pose, const Update& update);
   void recordView(vk::Commands& commands, Slot& slot, size_t index, const ViewRequest& request, const ViewPlan& plan);
   /// The view's trace, by snell's own traversal or (plan.driver) the driver's.
@@ -170,7 +165,7 @@ class Renderer {
   RendererOptions options_;
   SceneGpu scene_;
   std::unique_ptr<DeformPass> deform_;
-  std::unique_ptr<RefinePass> refine_;
+  std::unique_ptr<VertexFeed> feed_;  ///< kept vertices, host copies and the refine
   std::unique_ptr<RasterPass> raster_;
   std::unique_ptr<TracePass> trace_;
   SceneTrees trees_;
@@ -194,11 +189,6 @@ class Renderer {
   uint64_t sceneVersion_ = 0;  ///< bumps whenever what a view shows may have changed
   SceneBounds bounds_;
   FrameOrigin origin_;
-
-  std::unique_ptr<KeptVertexCopy> kept_;  ///< RendererOptions::keepVertices
-  /// Per shape of a scene that copies a host's vertices (SceneGpu::copiesHost):
-  /// marked dirty since the last frame, so copied or refined by the next.
-  std::vector<char> hostDirty_;
 
   std::vector<std::unique_ptr<Slot>> slots_;
   uint64_t submitted_ = 0;

@@ -407,16 +407,6 @@ std::vector<gpu::GpuLight> SceneGpu::packLights(const scene::Scene& scene, const
   return lights;
 }
 
-std::vector<VertexCopy> SceneGpu::hostCopies(const scene::Scene& scene, int shape) const {
-  std::vector<VertexCopy> copies;
-  const scene::Shape& s = scene.shapes.at(size_t(shape));
-  if (!copiesHost() || !s.host || s.subdivided()) return copies;
-  for (const GeometryRange& range : geometries) {
-    if (range.shape == shape) copies.push_back({s.host->first, range.firstVertex, range.vertexCount});
-  }
-  return copies;
-}
-
 void SceneGpu::appendBindings(std::vector<vk::BufferBinding>& out, const vk::Buffer& instances,
                               const vk::Buffer& lights) const {
   out.insert(out.end(), {{gpu::kSceneBindingInstances, &instances},

@@ -22,12 +22,6 @@
 
 namespace snell::render {
 
-/// Vertices copied from one place of a pair of vertex buffers to another
-/// (DeformPass::recordCopies): `count` vertices from vertex `from` to `to`.
-struct VertexCopy {
-  uint32_t from = 0, to = 0, count = 0;
-};
-
 /// One bottom-level group: a static shape (shared by all its instances) or
 /// one deforming draw item's own copy of its shape.
 struct GeometryRange {
@@ -55,7 +49,7 @@ struct SceneGpu {
   /// A host scene with subdivision surfaces: the host's own buffers, which
   /// hold their cages; `positions` and `normals` are then snell's, holding
   /// the refined vertices past the host's and a copy of every other mesh's,
-  /// taken when the host marks it dirty (hostCopies).
+  /// taken when the host marks it dirty (vertex_feed.h).
   vk::Buffer hostPositions, hostNormals;
   vk::Buffer texcoords;           ///< vec4 per vertex: uv0, uv1
   vk::Buffer indices;             ///< uint[3 * triangleCount], absolute
@@ -81,10 +75,6 @@ struct SceneGpu {
 
   /// Whether the scene's vertices are copies of a host's (hostPositions set).
   bool copiesHost() const { return hostPositions.handle() != VK_NULL_HANDLE; }
-  /// Where a host shape's vertices go from the host's buffers, for each
-  /// geometry of its, in a copiesHost scene (none for a subdivision surface,
-  /// which the refine pass reads in place).
-  std::vector<VertexCopy> hostCopies(const scene::Scene& scene, int shape) const;
 };
 
 /// Level 0 of the textures goes to the GPU through one staging ring of at most this many bytes.
