@@ -216,22 +216,26 @@ void bindGeometry(py::module_& m) {
 
   py::class_<PyMesh>(m, "Mesh", "A triangle mesh from numpy arrays, for Scene.from_arrays.")
       .def(py::init([](py::object positions, py::object normals, py::object indices, py::object uvs, int material,
-                       const std::string& name, std::optional<snell::Subdivision> subdivision) {
+                       const std::string& name, std::optional<snell::Subdivision> subdivision, py::object faceMaterials) {
              return PyMesh{std::move(positions), std::move(normals), std::move(indices), std::move(uvs), material, name,
-                           std::move(subdivision)};
+                           std::move(subdivision), std::move(faceMaterials)};
            }),
            "positions"_a, "normals"_a, "indices"_a, "uvs"_a = py::none(), "material"_a = -1, "name"_a = "",
-           "subdivision"_a = py::none(),
+           "subdivision"_a = py::none(), "face_materials"_a = py::none(),
            "positions and normals: (n, 3) float32; indices: (m, 3) uint32, counted from 0;\n"
            "uvs: (n, 2) float32 or None; material: an index into the scene's materials (-1: grey).\n"
            "subdivision: a Subdivision, making the mesh a cage: indices are then its faces' corners (1-D\n"
            "uint32, subdivision.face_vertex_counts says how many each face has), normals may be None,\n"
-           "and uvs are per vertex or, with subdivision.uv_indices, face-varying values.")
+           "and uvs are per vertex or, with subdivision.uv_indices, face-varying values.\n"
+           "face_materials: a material per face (a cage's faces, else its triangles; -1: grey), or None:\n"
+           "`material` for every face. Each material's faces draw from the mesh's one set of vertices, and\n"
+           "a cage is refined once for all of them.")
       .def_readonly("subdivision", &PyMesh::subdivision)
       .def_readonly("positions", &PyMesh::positions)
       .def_readonly("normals", &PyMesh::normals)
       .def_readonly("indices", &PyMesh::indices)
       .def_readonly("uvs", &PyMesh::uvs)
+      .def_readonly("face_materials", &PyMesh::faceMaterials)
       .def_readwrite("material", &PyMesh::material)
       .def_readwrite("name", &PyMesh::name);
 

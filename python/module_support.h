@@ -154,6 +154,7 @@ struct PyMesh {
   int material = -1;
   std::string name;
   std::optional<snell::Subdivision> subdivision;  ///< a subdivision cage's scheme and tags
+  py::object faceMaterials;  ///< None, or a material per face (snell::Mesh::faceMaterials)
 };
 
 // The names Python gives an enum (UsdGeomMesh's tokens for Subdivision's), both ways: every enum
@@ -281,6 +282,13 @@ inline snell::Scene sceneFromArrays(const std::vector<PyMesh>& meshes, const std
     mesh.material = m.material;
     mesh.indices = flat(indices);
     if (m.subdivision) mesh.subdivision = *m.subdivision;
+    if (!m.faceMaterials.is_none()) {
+      auto faceMaterials = py::array_t<int32_t, py::array::c_style | py::array::forcecast>::ensure(m.faceMaterials);
+      if (!faceMaterials || faceMaterials.ndim() != 1) {
+        throw snell::Error(what + " face_materials must be a 1-D sequence of material indices");
+      }
+      mesh.faceMaterials.assign(faceMaterials.data(), faceMaterials.data() + faceMaterials.size());
+    }
     for (size_t k = 0; k < mesh.indices.size(); ++k) {
       if (mesh.indices[k] >= n) {
         throw snell::Error(what + " indices: " + (cage ? "corner " + std::to_string(k) : "triangle " + std::to_string(k / 3)) +

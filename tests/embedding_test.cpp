@@ -349,6 +349,55 @@ TEST(Embedding, TheApisDefaultBackgroundIsTheRenderersDefault) {
   for (int c = 0; c < 3; ++c) EXPECT_EQ(api[size_t(c)], float(snell::scene::kDefaultBackground[c])) << "channel " << c;
 }
 
+// A quad of two triangles facing the camera, its left triangle one
+// material and its right another (Mesh::faceMaterials), its vertices kept.
+snell::HostScene twoColourQuad(std::vector<int> faceMaterials) {
+  snell::HostScene host;
+  host.name = "two-colour quad";
+  snell::Material red, green;
+  red.emissive = {1, 0, 0}, green.emissive = {0, 1, 0};
+  red.baseColor = green.baseColor = {0, 0, 0, 1};  // their own light only
+  host.materials = {red, green};
+  snell::Mesh quad;
+  quad.name = "quad";
+  quad.vertexCount = 4;
+  quad.indices = {0, 1, 3, 1, 2, 3};  // lower left to upper left; then the right triangle
+  quad.material = 0;
+  quad.faceMaterials = std::move(faceMaterials);
+  host.meshes = {quad};
+  host.instances = {{0, snell::kIdentity}};
+  host.vertices = {{{-1, -1, 0, 1, -1, 0, 1, 1, 0, -1, 1, 0}, {0, 0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1}}};
+  return host;
+}
+
+TEST(Embedding, AMeshDrawsEachFaceWithItsOwnMaterial) {
+  snell::Device device = snell::Device::create({.validation = true});
+  snell::Scene scene = snell::Scene::fromHost(twoColourQuad({0, 1}));
+  EXPECT_EQ(scene.meshCount(), 1u);
+  EXPECT_EQ(scene.drawnTriangleCount(0), 2u);
+  snell::Renderer renderer(device, scene);
+  snell::View view;
+  view.width = view.height = 32;
+  view.output = snell::View::Output::Trace;
+  const std::vector<float> rgba = renderer.read(view);
+  auto pixel = [&](uint32_t x, uint32_t y) { return &rgba[4 * (size_t(y) * view.width + x)]; };
+  // Below the diagonal from lower left to upper right lies the left triangle (0, 1, 3).
+  EXPECT_GT(pixel(8, 20)[0], 0.9f) << "left triangle";
+  EXPECT_LT(pixel(8, 20)[1], 0.1f) << "left triangle";
+  EXPECT_GT(pixel(24, 12)[1], 0.9f) << "right triangle";
+  EXPECT_LT(pixel(24, 12)[0], 0.1f) << "right triangle";
+  EXPECT_EQ(device.validationMessages(), 0u);
+}
+
+TEST(Embedding, FaceMaterialsOfTheWrongCountAreRefusedNamingTheMesh) {
+  try {
+    snell::Scene::fromHost(twoColourQuad({0, 1, 1}));
+    FAIL() << "three face materials for two triangles were accepted";
+  } catch (const snell::Error& e) {
+    EXPECT_NE(std::string(e.what()).find("two-colour quad: mesh 0: 3 face materials for 2 triangles"), std::string::npos) << e.what();
+  }
+}
+
 TEST(Embedding, HostSceneRefusesAMeshPastItsBuffers) {
   snell::Device device = snell::Device::create({.validation = true});
   HostBuffer buffer(device, 9);

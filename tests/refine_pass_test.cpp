@@ -127,6 +127,72 @@ TEST_F(RefinePass, AMovedCageIsRefinedAsTheCpuTwinRefinesIt) {
   }
 }
 
+// A cage whose faces carry two materials (USD subsets, Blender's
+// material_index) is one refinement and one refine job, whose vertices both
+// materials' triangles read; with two materials alike it draws as the
+// one-material cage, moved or not.
+TEST_F(RefinePass, ACageWithTwoMaterialsIsRefinedOnceForBoth) {
+  scene::SubdivisionCage cage = boxCage(2);
+  CageScene one = cageScene(cage), two;
+  two.scene.source = "a cage of two materials";
+  scene::Shape shape;
+  std::vector<std::string> warnings;
+  std::vector<uint32_t> triangleFaces;
+  scene::subdivide(cage, shape, "box", warnings, scene::kMaxRefinedVertices, &triangleFaces);
+  ASSERT_EQ(triangleFaces.size(), shape.triangleCount());
+  // Opaque: glass faces of two materials would be two media, entered through one and left through the other.
+  scene::Material glow;
+  glow.emissiveFactor = {0.9f, 0.5f, 0.2f};
+  for (scene::Scene* s : {&one.scene, &two.scene}) s->materials = {glow, glow};
+  one.scene.shapes[0].material = 0;
+  scene::addRootShape(two.scene, std::move(shape));
+  std::vector<int> triangleMaterials;
+  for (uint32_t face : triangleFaces) triangleMaterials.push_back(face < 3 ? 0 : 1);  // the first three cage faces, then the rest
+  ASSERT_EQ(scene::splitByMaterial(two.scene, 0, triangleMaterials), std::vector<int>{1});
+  two.pose = scene::evaluate(two.scene, 0.0);
+  ASSERT_EQ(two.scene.shapes.size(), 2u);
+  EXPECT_EQ(two.scene.shapes[1].vertexSource, 0);
+  EXPECT_EQ(two.scene.shapes[1].refinement.get(), two.scene.shapes[0].refinement.get()) << "refined twice";
+  EXPECT_EQ(two.scene.shapes[0].triangleCount() + two.scene.shapes[1].triangleCount(),
+            one.scene.shapes[0].triangleCount());
+
+  render::RendererOptions options;
+  options.keepVertices = true;
+  render::Renderer oneRenderer(context(), one.scene, one.pose, options), twoRenderer(context(), two.scene, two.pose, options);
+  EXPECT_EQ(twoRenderer.sceneGpu().vertexCount, oneRenderer.sceneGpu().vertexCount) << "the part's vertices uploaded again";
+  scene::ViewRequest request;
+  request.lookAt = scene::LookAt{{0.3, 0.5, 3.0}, {0.0, 0.0, 0.0}, {0.0, 1.0, 0.0}};
+  auto image = [&](render::Renderer& r, const CageScene& s) {
+    render::FrameSettings settings{48, 48, scene::resolveView(s.scene, s.pose, request), glm::vec3(0.2f), 8};
+    return render::renderFrame(r, s.pose, settings);
+  };
+  for (int frame = 0; frame < 2; ++frame) {
+    if (frame == 1) {  // the host twists the cage: one copy, one refine job for both materials
+      std::vector<glm::dvec3> moved = twisted(cage.positions);
+      for (render::Renderer* r : {&oneRenderer, &twoRenderer}) {
+        render::KeptVertices kept = r->keptVertices(0);
+        for (size_t v = 0; v < moved.size(); ++v) {
+          for (int k = 0; k < 3; ++k) kept.positions[3 * v + size_t(k)] = float(moved[v][k]);
+        }
+        r->markDirty(0);
+      }
+    }
+    render::RenderedFrame oneImage = image(oneRenderer, one), twoImage = image(twoRenderer, two);
+    if (frame == 1) {
+      EXPECT_EQ(twoImage.stats.shapesCopied, 1u);
+      EXPECT_EQ(twoImage.stats.shapesRefined, 1u);
+      EXPECT_EQ(twoImage.stats.verticesRefined, oneImage.stats.verticesRefined);
+    }
+    ASSERT_EQ(twoImage.rgba.size(), oneImage.rgba.size());
+    float worst = 0.0f;  // a ray through an edge between the materials may meet the other triangle of it
+    for (size_t i = 0; i < oneImage.rgba.size(); ++i) {
+      const glm::vec4 d = glm::abs(twoImage.rgba[i] - oneImage.rgba[i]);
+      worst = std::max(worst, std::max(std::max(d.r, d.g), d.b));
+    }
+    EXPECT_LT(worst, 1.0f / 255.0f) << "frame " << frame << ": two materials alike drew otherwise";
+  }
+}
+
 TEST_F(RefinePass, TheRestCageRefinesToOpenSubdivsRestPose) {
   CageScene s = cageScene(boxCage(2));
   render::RendererOptions options;

@@ -169,7 +169,7 @@ class Cage:
 
 
 def read_cage(mesh, gpu: GpuModifier, uv_layer) -> Cage:
-    """The cage mesh's faces and the modifier's settings as a snell.Subdivision (holes filled in per part)."""
+    """The cage mesh's faces and the modifier's settings as a snell.Subdivision."""
     import snell
 
     modifier = gpu.modifier
@@ -219,17 +219,3 @@ def read_cage(mesh, gpu: GpuModifier, uv_layer) -> Cage:
     return Cage(counts, face_points.astype(np.uint32), material, uvs, uv_indices, subdivision)
 
 
-def part_subdivision(cage: Cage, slot: int):
-    """The cage's Subdivision for the part of material slot `slot`: the other slots' faces are its holes."""
-    import snell
-
-    s = cage.subdivision
-    part = snell.Subdivision(s.scheme, s.level, face_vertex_counts=cage.face_counts,
-                             interpolate_boundary=s.interpolate_boundary,
-                             face_varying_linear_interpolation=s.face_varying_linear_interpolation,
-                             limit_surface=s.limit_surface, normals=s.normals)
-    for tag in ("crease_indices", "crease_lengths", "crease_sharpnesses", "corner_indices", "corner_sharpnesses",
-                "uv_indices"):
-        setattr(part, tag, getattr(s, tag))
-    part.hole_indices = np.nonzero(cage.face_material != slot)[0]
-    return part

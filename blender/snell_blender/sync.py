@@ -188,8 +188,8 @@ class SceneSync:
         return material_index[key], key
 
     def _cage_topology(self, obj, mesh, gpu, meshes, materials, material_index, textures) -> ObjectGeometry:
-        """An object's subdivision cage: each material slot's part carries the whole cage, the other slots'
-        faces as holes, so that every part refines the one surface."""
+        """An object's subdivision cage: one snell mesh whose faces carry their slots' materials, refined once
+        for all of them, as Blender's own GPU subdivision refines once and draws a range per material."""
         import snell
 
         uv_layer = _render_uv_layer(mesh)
@@ -197,13 +197,18 @@ class SceneSync:
         geometry = ObjectGeometry(obj.original.name, len(mesh.vertices), len(mesh.loops), cage=True)
         co, _ = self._read_vertices(mesh, geometry)
         geometry.sent = (co.copy(), None)
-        for slot in np.unique(cage.face_material):
-            index, key = self._material_index(obj, int(slot), material_index, materials, textures, uv_layer)
-            part = MeshPart(len(meshes), np.zeros(0, np.int32), np.arange(geometry.vertex_count, dtype=np.int32))
-            meshes.append(snell.Mesh(np.ascontiguousarray(co), None, cage.face_points, cage.uvs, material=index,
-                                     name=f"{obj.original.name}/{key}",
-                                     subdivision=subdivision.part_subdivision(cage, int(slot))))
-            geometry.parts.append(part)
+        slots = np.unique(cage.face_material)
+        snell_material = np.empty(len(slots), np.int32)
+        for k, slot in enumerate(slots):
+            snell_material[k], _ = self._material_index(obj, int(slot), material_index, materials, textures,
+                                                        uv_layer)
+        face_materials = snell_material[np.searchsorted(slots, cage.face_material)]
+        part = MeshPart(len(meshes), np.zeros(0, np.int32), np.arange(geometry.vertex_count, dtype=np.int32))
+        meshes.append(snell.Mesh(np.ascontiguousarray(co), None, cage.face_points, cage.uvs,
+                                 material=int(face_materials[0]) if len(face_materials) else -1,
+                                 name=obj.original.name, subdivision=cage.subdivision,
+                                 face_materials=face_materials))
+        geometry.parts.append(part)
         return geometry
 
     def _triangle_topology(self, obj, meshes, materials, material_index, textures) -> Optional[ObjectGeometry]:

@@ -206,6 +206,12 @@ struct Mesh {
   std::vector<uint32_t> indices;  ///< 3 per triangle, counted from firstVertex (a subdivision surface's: its faces')
   std::vector<float> texcoords;   ///< 2 per vertex (u, v), or empty
   int material = -1;              ///< index into HostScene::materials; -1: a grey default
+  /// A material per face (a subdivision surface's cage faces, else its
+  /// triangles): an index into HostScene::materials, -1 the grey default;
+  /// empty: `material` for every face. The faces of each material are drawn
+  /// with it from the mesh's one set of vertices, and a subdivision surface
+  /// is refined once for all of them (USD's GeomSubsets, Blender's material_index).
+  std::vector<int> faceMaterials;
   /// A box, in the mesh's space, the host promises its vertices stay in; the
   /// default (empty) promises nothing, and the mesh is then never culled.
   Vec3 boundsLo{INFINITY, INFINITY, INFINITY}, boundsHi{-INFINITY, -INFINITY, -INFINITY};
@@ -295,7 +301,7 @@ class Scene {
   /// Mesh `mesh`'s vertex count (Scene::meshCount meshes): the cage's, of a subdivision surface.
   uint32_t vertexCount(int mesh) const;
   /// The vertices and triangles mesh `mesh` is drawn with: a subdivision
-  /// surface's refined ones, else its own.
+  /// surface's refined ones, else its own (all its materials' together).
   uint32_t drawnVertexCount(int mesh) const;
   uint32_t drawnTriangleCount(int mesh) const;
   /// What loading repaired or left out, and what a subdivision cage could not

@@ -12,6 +12,8 @@
 #include <glm/glm.hpp>
 #include <glm/gtc/type_ptr.hpp>
 
+#include <algorithm>
+#include <cstddef>
 #include <exception>
 #include <memory>
 #include <mutex>
@@ -49,6 +51,14 @@ auto guarded(Body&& body) -> decltype(body()) {
 
 inline glm::dmat4 toMatrix(const Mat4& m) { return glm::dmat4(glm::make_mat4(m.data())); }
 inline glm::vec3 toVec(const Vec3& v) { return {v[0], v[1], v[2]}; }
+
+/// The public API's meshes: a mesh with several materials is one shape and
+/// its parts (scene::splitByMaterial), which follow every mesh's shape, so
+/// meshes are the shapes before the first part.
+inline size_t meshCount(const scene::Scene& s) {
+  return size_t(std::find_if(s.shapes.begin(), s.shapes.end(), [](const scene::Shape& shape) { return shape.part(); }) -
+                s.shapes.begin());
+}
 
 
 }  // namespace api

@@ -4,6 +4,7 @@
 #include "snell/snell.h"
 
 #include "api/api_internal.h"
+#include "scene/scene_builder.h"
 #include "scene/subdivision.h"
 
 #include <cstring>
@@ -75,6 +76,16 @@ scene::Shape toShape(const Mesh& m, int index, size_t materials, const std::stri
   }
   if (m.material >= int(materials)) {
     throw Error(where + ": material " + std::to_string(m.material) + " of " + std::to_string(materials));
+  }
+  const size_t faces = cage ? m.subdivision.faceVertexCounts.size() : m.indices.size() / 3;
+  if (!m.faceMaterials.empty() && m.faceMaterials.size() != faces) {
+    throw Error(where + ": " + std::to_string(m.faceMaterials.size()) + " face materials for " + std::to_string(faces) +
+                (cage ? " cage faces" : " triangles"));
+  }
+  for (int material : m.faceMaterials) {
+    if (material < -1 || material >= int(materials)) {
+      throw Error(where + ": face material " + std::to_string(material) + " of " + std::to_string(materials));
+    }
   }
   scene::Shape shape;
   shape.name = m.name;
@@ -149,11 +160,13 @@ scene::SubdivisionCage toCage(const Mesh& m, const float* positions) {
   return cage;
 }
 
-// Refines mesh `m`'s cage into `shape` (its warnings into the scene's); SceneError becomes Error.
-void refineCage(const Mesh& m, const float* positions, scene::Shape& shape, scene::Scene& s, const std::string& where) {
+// Refines mesh `m`'s cage into `shape` (its warnings into the scene's), and
+// says each refined triangle's cage face in `triangleFaces`; SceneError becomes Error.
+void refineCage(const Mesh& m, const float* positions, scene::Shape& shape, scene::Scene& s, const std::string& where,
+                std::vector<uint32_t>& triangleFaces) {
   try {
     std::optional<scene::HostVertices> host = shape.host;
-    scene::subdivide(toCage(m, positions), shape, where, s.warnings);
+    scene::subdivide(toCage(m, positions), shape, where, s.warnings, scene::kMaxRefinedVertices, &triangleFaces);
     if (host) {  // its vertices are the host's: only the refined triangles and texcoords are snell's
       shape.host = host;
       shape.positions.clear();
@@ -165,8 +178,9 @@ void refineCage(const Mesh& m, const float* positions, scene::Shape& shape, scen
 }
 
 // Gives each mesh its vertices from HostScene::vertices: the scene's shapes
-// are then snell's own, with a rest pose each Renderer keeps a copy of.
-void keepVertices(const HostScene& host, Scene::Impl& impl) {
+// are then snell's own, with a rest pose each Renderer keeps a copy of. A
+// cage's triangles' cage faces go to `triangleFaces` (per mesh).
+void keepVertices(const HostScene& host, Scene::Impl& impl, std::vector<std::vector<uint32_t>>& triangleFaces) {
   if (host.vertices.size() != host.meshes.size()) {
     throw Error(host.name + ": " + std::to_string(host.vertices.size()) + " vertex lists for " +
                 std::to_string(host.meshes.size()) + " meshes (without host buffers, each mesh needs its vertices)");
@@ -188,7 +202,7 @@ void keepVertices(const HostScene& host, Scene::Impl& impl) {
     scene::Shape& shape = impl.scene.shapes[i];
     shape.host.reset();
     if (m.subdivision.scheme != Subdivision::Scheme::None) {
-      refineCage(m, v.positions.data(), shape, impl.scene, where);
+      refineCage(m, v.positions.data(), shape, impl.scene, where, triangleFaces[i]);
       continue;
     }
     shape.positions.resize(m.vertexCount);
@@ -295,14 +309,25 @@ Scene Scene::fromHost(const HostScene& host) {
       s.roots.push_back(int(s.nodes.size()));
       s.nodes.push_back(node);
     }
+    std::vector<std::vector<uint32_t>> triangleFaces(host.meshes.size());  // a cage's: each refined triangle's face
     if (keep) {
-      keepVertices(host, *impl);
+      keepVertices(host, *impl, triangleFaces);
     } else {
       impl->host = {host.positions, host.normals, host.vertexCapacity};
       for (size_t i = 0; i < host.meshes.size(); ++i) {
         if (host.meshes[i].subdivision.scheme == Subdivision::Scheme::None) continue;
-        refineCage(host.meshes[i], nullptr, s.shapes[i], s, host.name + ": mesh " + std::to_string(i));
+        refineCage(host.meshes[i], nullptr, s.shapes[i], s, host.name + ": mesh " + std::to_string(i), triangleFaces[i]);
       }
+    }
+    // Each material of a mesh's faces after its first draws as a part that
+    // shares the mesh's vertices and its one refinement; parts follow every mesh.
+    for (size_t i = 0; i < host.meshes.size(); ++i) {
+      const std::vector<int>& faceMaterials = host.meshes[i].faceMaterials;
+      if (faceMaterials.empty()) continue;
+      const std::vector<uint32_t>& faces = triangleFaces[i];
+      std::vector<int> triangleMaterials(s.shapes[i].triangleCount());
+      for (size_t t = 0; t < triangleMaterials.size(); ++t) triangleMaterials[t] = faceMaterials[faces.empty() ? t : faces[t]];
+      scene::splitByMaterial(s, int(i), triangleMaterials);
     }
     return Scene(std::move(impl));
   });

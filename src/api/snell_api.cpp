@@ -142,11 +142,11 @@ Scene Scene::load(const std::string& path) {
 }
 
 std::string Scene::name() const { return impl_->scene.source; }
-size_t Scene::meshCount() const { return impl_->scene.shapes.size(); }
+size_t Scene::meshCount() const { return api::meshCount(impl_->scene); }
 size_t Scene::cameraCount() const { return impl_->scene.cameras.size(); }
 uint32_t Scene::vertexCount(int mesh) const {
-  if (mesh < 0 || size_t(mesh) >= impl_->scene.shapes.size()) {
-    throw Error("vertexCount: no mesh " + std::to_string(mesh) + " of " + std::to_string(impl_->scene.shapes.size()));
+  if (mesh < 0 || size_t(mesh) >= meshCount()) {
+    throw Error("vertexCount: no mesh " + std::to_string(mesh) + " of " + std::to_string(meshCount()));
   }
   return uint32_t(impl_->scene.shapes[size_t(mesh)].writtenVertexCount());
 }
@@ -156,7 +156,11 @@ uint32_t Scene::drawnVertexCount(int mesh) const {
 }
 uint32_t Scene::drawnTriangleCount(int mesh) const {
   vertexCount(mesh);
-  return uint32_t(impl_->scene.shapes[size_t(mesh)].triangleCount());
+  size_t triangles = 0;
+  for (const scene::Shape& s : impl_->scene.shapes) {
+    if (&s - impl_->scene.shapes.data() == mesh || s.vertexSource == mesh) triangles += s.triangleCount();
+  }
+  return uint32_t(triangles);
 }
 std::vector<std::string> Scene::warnings() const { return impl_->scene.warnings; }
 bool Scene::keepsVertices() const { return impl_->keep; }
@@ -328,8 +332,9 @@ void Renderer::setTransform(size_t instance, const Mat4& transform) {
 void Renderer::markDirty(int mesh) {
   guarded([&] {
     std::lock_guard lock(impl_->mutex);
-    if (mesh < 0 || size_t(mesh) >= impl_->scene.scene.shapes.size()) {
-      throw Error("markDirty: no mesh " + std::to_string(mesh) + " of " + std::to_string(impl_->scene.scene.shapes.size()));
+    const size_t meshes = api::meshCount(impl_->scene.scene);
+    if (mesh < 0 || size_t(mesh) >= meshes) {
+      throw Error("markDirty: no mesh " + std::to_string(mesh) + " of " + std::to_string(meshes));
     }
     impl_->renderer->markDirty(mesh);
   });
@@ -339,8 +344,9 @@ Vertices Renderer::vertices(int mesh) {
   return guarded([&] {
     std::lock_guard lock(impl_->mutex);
     if (!impl_->scene.keep) throw Error("vertices: the scene's vertices are the host's own (only a HostScene without buffers has kept ones)");
-    if (mesh < 0 || size_t(mesh) >= impl_->scene.scene.shapes.size()) {
-      throw Error("vertices: no mesh " + std::to_string(mesh) + " of " + std::to_string(impl_->scene.scene.shapes.size()));
+    const size_t meshes = api::meshCount(impl_->scene.scene);
+    if (mesh < 0 || size_t(mesh) >= meshes) {
+      throw Error("vertices: no mesh " + std::to_string(mesh) + " of " + std::to_string(meshes));
     }
     render::KeptVertices kept = impl_->renderer->keptVertices(mesh);  // waits for the frames that read them
     return Vertices{kept.positions, kept.normals, kept.count};

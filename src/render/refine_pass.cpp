@@ -33,7 +33,8 @@ RefinePass::RefinePass(vk::Context& context, const scene::Scene& scene, const Sc
   uint32_t refined = 0, cageVertices = 0;
   for (const GeometryRange& range : gpu.geometries) {
     const scene::Shape& shape = scene.shapes[size_t(range.shape)];
-    if (!shape.refinement || tablesOf_[size_t(range.shape)] >= 0) continue;
+    // A part (Shape::vertexSource) is drawn from its source's refined vertices.
+    if (!shape.refinement || shape.part() || tablesOf_[size_t(range.shape)] >= 0) continue;
     const scene::Refinement& r = *shape.refinement;
     ShapeTables tables;
     tables.shape = range.shape;

@@ -417,14 +417,18 @@ void Renderer::markDirty(int shape) {
   if (shape < 0 || size_t(shape) >= sceneModel_.shapes.size()) {
     throw std::invalid_argument("renderer: no shape " + std::to_string(shape) + " to mark dirty");
   }
-  for (uint32_t g = 0; g < scene_.geometries.size(); ++g) {
-    if (scene_.geometries[g].shape == shape) noteMoved(g);
-  }
   feed_->markDirty(shape);
-  // A host's promised box still holds; any other is unknown until a refit measures it.
-  if (!sceneModel_.shapes[size_t(shape)].host) {
-    bounds_.setShapeBox(shape, glm::dvec3(INFINITY), glm::dvec3(-INFINITY));
-    trees_.measure(shape);
+  // The shape's vertices are also those of its parts (Shape::vertexSource).
+  for (size_t s = 0; s < sceneModel_.shapes.size(); ++s) {
+    if (int(s) != shape && sceneModel_.shapes[s].vertexSource != shape) continue;
+    for (uint32_t g = 0; g < scene_.geometries.size(); ++g) {
+      if (scene_.geometries[g].shape == int(s)) noteMoved(g);
+    }
+    // A host's promised box still holds; any other is unknown until a refit measures it.
+    if (!sceneModel_.shapes[s].host) {
+      bounds_.setShapeBox(int(s), glm::dvec3(INFINITY), glm::dvec3(-INFINITY));
+      trees_.measure(int(s));
+    }
   }
   ++sceneVersion_;
 }

@@ -261,9 +261,15 @@ SceneGpu uploadScene(vk::Context& context, const scene::Scene& scene, const scen
       const bool inPlace = host && !shape.subdivided();
       range.firstVertex = inPlace ? shape.host->first : static_cast<uint32_t>(vertices);
       range.vertexCount = static_cast<uint32_t>(shape.vertexCount());
+      if (shape.part()) {  // its triangles index its source's vertices, uploaded with the source
+        const int source = shapeGeometry[size_t(shape.vertexSource)];
+        if (item.deforms() || source < 0) throw std::logic_error(scene.source + ": a part drawn without its source");
+        range.firstVertex = gpu.geometries[size_t(source)].firstVertex;
+        range.vertexCount = 0;
+      }
       range.firstTriangle = static_cast<uint32_t>(triangles);
       range.triangleCount = static_cast<uint32_t>(shape.triangleCount());
-      if (!inPlace) vertices += shape.vertexCount();
+      if (!inPlace) vertices += range.vertexCount;
       triangles += shape.triangleCount();
       if (vertices >= (1ull << 31) || triangles >= (1ull << 31)) {
         throw std::runtime_error(scene.source + ": more than 2^31 vertices or triangles in view");
@@ -299,12 +305,12 @@ SceneGpu uploadScene(vk::Context& context, const scene::Scene& scene, const scen
   if (hostCopies) positions.assign(vertices * 3, 0.0f), normals.assign(vertices * 3, 0.0f);
   for (const GeometryRange& range : gpu.geometries) {
     const scene::Shape& shape = scene.shapes[size_t(range.shape)];
-    for (size_t v = 0; host && v < shape.vertexCount(); ++v) {
+    for (size_t v = 0; host && v < range.vertexCount; ++v) {
       glm::vec2 uv0 = v < shape.texcoords0.size() ? shape.texcoords0[v] : glm::vec2(0.0f);
       glm::vec2 uv1 = v < shape.texcoords1.size() ? shape.texcoords1[v] : glm::vec2(0.0f);
       texcoords[range.firstVertex + v] = glm::vec4(uv0, uv1);
     }
-    for (size_t v = 0; !host && v < shape.vertexCount(); ++v) {
+    for (size_t v = 0; !host && v < range.vertexCount; ++v) {
       const glm::vec3& p = shape.positions[v];
       glm::vec3 n = v < shape.normals.size() ? shape.normals[v] : glm::vec3(0.0f);
       positions.insert(positions.end(), {p.x, p.y, p.z});

@@ -30,12 +30,13 @@ VertexFeed::VertexFeed(vk::Context& context, const scene::Scene& scene, const Sc
                                   "' has morph targets or a skin)");
     }
     keptFirst_[i] = keptCount_;
-    keptCount_ += static_cast<uint32_t>(shape.writtenVertexCount());
+    if (!shape.part()) keptCount_ += static_cast<uint32_t>(shape.writtenVertexCount());  // a part's are its source's
   }
   kept_ = vk::Buffer(context, {std::max<VkDeviceSize>(VkDeviceSize(keptCount_) * 24, 16),
                                VK_BUFFER_USAGE_TRANSFER_SRC_BIT, vk::MemoryDomain::Readback, name + " kept vertices"});
   for (size_t i = 0; i < scene.shapes.size(); ++i) {
     const scene::Shape& shape = scene.shapes[i];
+    if (shape.part()) continue;
     KeptVertices k = kept(int(i));
     if (shape.refinement) {  // the cage at rest; its normals are the refine pass's to make
       const std::vector<glm::vec3>& cage = shape.refinement->cageRest;
@@ -57,10 +58,11 @@ KeptVertices VertexFeed::kept(int shape) {
     throw std::invalid_argument("renderer: no shape " + std::to_string(shape) + " of " +
                                 std::to_string(scene_.shapes.size()));
   }
+  const scene::Shape& s = scene_.shapes[size_t(shape)];
+  if (s.part()) return kept(s.vertexSource);  // its vertices are its source's
   auto* floats = reinterpret_cast<float*>(kept_.mapped().data());
   const size_t first = keptFirst_[size_t(shape)];
-  return {floats + 3 * first, floats + 3 * (size_t(keptCount_) + first),
-          static_cast<uint32_t>(scene_.shapes[size_t(shape)].writtenVertexCount())};
+  return {floats + 3 * first, floats + 3 * (size_t(keptCount_) + first), static_cast<uint32_t>(s.writtenVertexCount())};
 }
 
 void VertexFeed::markDirty(int shape) {
@@ -71,7 +73,8 @@ FeedCounts VertexFeed::record(vk::Commands& commands, vk::UploadArena& arena, De
   FeedCounts counts;
   std::vector<VertexCopy> copies;
   for (size_t shape = 0; shape < dirty_.size(); ++shape) {
-    if (!std::exchange(dirty_[shape], 0)) continue;
+    // A part's vertices are its source's, which the source's copy brings.
+    if (!std::exchange(dirty_[shape], 0) || scene_.shapes[shape].part()) continue;
     ++counts.shapesCopied;
     if (keeps()) {
       recordKeptCopy(commands, int(shape));

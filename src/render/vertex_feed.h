@@ -53,7 +53,8 @@ class VertexFeed {
              const std::string& name);
 
   bool keeps() const { return kept_.size() > 0; }
-  /// Shape `shape`'s kept vertices; the caller makes sure no frame in flight reads them.
+  /// Shape `shape`'s kept vertices (a part's: its source's); the caller makes
+  /// sure no frame in flight reads them.
   KeptVertices kept(int shape);
   /// Shape `shape`'s vertices (kept, or in the host's buffers) changed: the
   /// next record copies or refines them.

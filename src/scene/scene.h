@@ -154,12 +154,19 @@ struct Shape {
   /// a cage of `cageVertices`, which is what a host writes (host->count).
   std::shared_ptr<const Refinement> refinement;
   uint32_t cageVertices = 0, refinedVertexCount = 0;
+  /// Set for a part of shape `vertexSource` drawn with another material (a
+  /// mesh with a material per face, splitByMaterial): its triangles index
+  /// that shape's vertices, which it carries too (its host range, its
+  /// refinement, a copy of its positions) for what reads a shape alone, but
+  /// the GPU's vertices are the source's, uploaded, copied, kept and refined once.
+  int vertexSource = -1;
 
   /// The vertices its triangles index.
   size_t vertexCount() const { return refinement ? refinedVertexCount : host ? host->count : positions.size(); }
   /// The vertices a host writes: the cage's of a subdivision surface.
   size_t writtenVertexCount() const { return refinement ? cageVertices : vertexCount(); }
   bool subdivided() const { return refinement != nullptr; }
+  bool part() const { return vertexSource >= 0; }
   size_t triangleCount() const { return indices.size() / 3; }
   bool morphed() const { return !targets.empty(); }
   bool skinned() const { return !joints.empty(); }

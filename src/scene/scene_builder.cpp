@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
 #include <string>
 #include <utility>
 
@@ -110,6 +111,40 @@ Shape uvSphere(uint32_t segments, float radius) {
     }
   }
   return shape;
+}
+
+std::vector<int> splitByMaterial(Scene& scene, int shape, const std::vector<int>& triangleMaterials) {
+  Shape& source = scene.shapes.at(size_t(shape));
+  if (triangleMaterials.size() != source.triangleCount()) {
+    throw std::invalid_argument("splitByMaterial: " + std::to_string(triangleMaterials.size()) + " materials for " +
+                                std::to_string(source.triangleCount()) + " triangles");
+  }
+  std::vector<int> order;  // materials in the order met
+  std::vector<std::vector<uint32_t>> indices;
+  for (size_t t = 0; t < triangleMaterials.size(); ++t) {
+    const int m = triangleMaterials[t];
+    size_t k = size_t(std::find(order.begin(), order.end(), m) - order.begin());
+    if (k == order.size()) order.push_back(m), indices.emplace_back();
+    indices[k].insert(indices[k].end(), source.indices.begin() + 3 * long(t), source.indices.begin() + 3 * long(t) + 3);
+  }
+  std::vector<int> parts;
+  if (order.empty()) return parts;
+  source.material = order[0];
+  for (size_t k = 1; k < order.size(); ++k) {
+    Shape part = scene.shapes[size_t(shape)];  // scene.shapes grows below: no reference held across it
+    part.material = order[k];
+    part.indices = std::move(indices[k]);
+    part.vertexSource = shape;
+    parts.push_back(int(scene.shapes.size()));
+    scene.shapes.push_back(std::move(part));
+  }
+  scene.shapes[size_t(shape)].indices = std::move(indices[0]);
+  for (Mesh& mesh : scene.meshes) {
+    if (std::find(mesh.shapes.begin(), mesh.shapes.end(), shape) != mesh.shapes.end()) {
+      mesh.shapes.insert(mesh.shapes.end(), parts.begin(), parts.end());
+    }
+  }
+  return parts;
 }
 
 }  // namespace snell::scene

@@ -29,6 +29,11 @@ Shape flatShape(const std::vector<glm::vec3>& positions, const std::vector<uint3
 void addQuad(Shape& shape, glm::vec3 a, glm::vec3 b, glm::vec3 c, glm::vec3 d);
 /// Appends the box [lo, hi]'s 12 triangles, counter-clockwise seen from outside.
 void addBox(glm::vec3 lo, glm::vec3 hi, std::vector<glm::vec3>& positions, std::vector<uint32_t>& indices);
+/// Splits shape `shape` by its triangles' materials (one per triangle of its
+/// indices, -1 the default): it keeps the triangles of the first material met,
+/// and each other material's go to a part (Shape::vertexSource) appended to
+/// the scene's shapes and to every mesh that holds the shape. Returns the parts.
+std::vector<int> splitByMaterial(Scene& scene, int shape, const std::vector<int>& triangleMaterials);
 /// A UV sphere about the origin: `segments` around, half as many rings, one vertex at each pole.
 Shape uvSphere(uint32_t segments, float radius);
 

@@ -42,7 +42,10 @@ SceneSummary summarize(const Scene& scene, uint32_t width, uint32_t height) {
   SceneSummary s;
   s.shapes = scene.shapes.size();
   for (const Shape& shape : scene.shapes) {
-    s.geometryBytes += shape.vertexCount() * kRestBytesPerVertex + shape.triangleCount() * kIndexBytesPerTriangle;
+    // A part (Shape::vertexSource) brings triangles only: its vertices, refinement and deformation are its source's.
+    s.geometryBytes += (shape.part() ? 0 : shape.vertexCount() * kRestBytesPerVertex) +
+                       shape.triangleCount() * kIndexBytesPerTriangle;
+    if (shape.part()) continue;
     s.deformBytes += shape.vertexCount() * shape.targets.size() * kMorphBytesPerVertexTarget;
     if (shape.skinned()) s.deformBytes += shape.vertexCount() * kSkinBytesPerVertex;
     s.morphedShapes += shape.morphed();
@@ -60,7 +63,7 @@ SceneSummary summarize(const Scene& scene, uint32_t width, uint32_t height) {
       const Shape& shape = scene.shapes[size_t(index)];
       s.instances += copies;
       s.triangles += shape.triangleCount() * copies;
-      s.vertices += shape.vertexCount() * copies;
+      s.vertices += shape.part() ? 0 : shape.vertexCount() * copies;
       // One BVH per shape; deformed shapes get their own deformed copy and tree per instance.
       bool deforms = shape.morphed() || (shape.skinned() && node.skin >= 0);
       s.bvhBytes += shape.triangleCount() * kBvhBytesPerTriangle * (deforms ? copies : 1);
@@ -99,7 +102,7 @@ std::string describe(const Scene& scene, uint32_t width, uint32_t height) {
   if (s.subdividedShapes) {
     out << "  subdivision surfaces " << s.subdividedShapes << " (refined on the GPU when their cage moves)\n";
     for (const Shape& shape : scene.shapes) {
-      if (!shape.refinement) continue;
+      if (!shape.refinement || shape.part()) continue;
       const Refinement& r = *shape.refinement;
       out << "    " << (shape.name.empty() ? "(unnamed)" : "'" + shape.name + "'") << ": " << schemeName(r.scheme)
           << " level " << r.level << ", cage " << r.cageVertices << " vertices and " << r.cageFaces << " faces -> "

@@ -265,6 +265,7 @@ struct Triangles {
   std::vector<uint32_t> corners;
   std::vector<uint32_t> vertexOf;  ///< per shape vertex: its vertex of the level
   std::vector<int> uvOf;           ///< per shape vertex: its face-varying value (or -1)
+  std::vector<uint32_t> faces;     ///< per triangle of `indices`: the level's face it is part of
 };
 
 // Fans of `faces` faces, each read by face(f, vertices, uvs), which says
@@ -300,6 +301,7 @@ Triangles triangulate(int faces, size_t vertices, bool faceVarying, bool flip, F
     for (size_t k = 1; k + 1 < verts.size(); ++k) {
       size_t b = flip ? k + 1 : k, c = flip ? k : k + 1;
       out.indices.insert(out.indices.end(), {shapeVerts[0], shapeVerts[b], shapeVerts[c]});
+      out.faces.push_back(uint32_t(f));
     }
   }
   return out;
@@ -392,7 +394,8 @@ void limitStencils(const osd::PrimvarRefiner& refiner, const std::vector<glm::dv
 
 // What subdivide() draws at `level`; level 0 is the cage itself, whose
 // "stencils" copy each cage vertex.
-void refineAt(const SubdivisionCage& cage, uint32_t level, const osd::TopologyRefiner* topology, Shape& shape) {
+void refineAt(const SubdivisionCage& cage, uint32_t level, const osd::TopologyRefiner* topology, Shape& shape,
+              std::vector<uint32_t>* triangleFaces) {
   auto refinement = std::make_shared<Refinement>();
   Refinement& r = *refinement;
   r.scheme = cage.scheme;
@@ -511,6 +514,12 @@ void refineAt(const SubdivisionCage& cage, uint32_t level, const osd::TopologyRe
     if (vertexUvs) shape.texcoords0.push_back(glm::vec2(uvValues[v]));
   }
   shape.indices = std::move(triangles.indices);
+  if (triangleFaces) {  // each refined face's cage face, down the levels
+    *triangleFaces = std::move(triangles.faces);
+    for (uint32_t& f : *triangleFaces) {
+      for (uint32_t l = level; l > 0; --l) f = uint32_t(topology->GetLevel(int(l)).GetFaceParentFace(int(f)));
+    }
+  }
   shape.cageVertices = r.cageVertices;
   shape.refinedVertexCount = uint32_t(r.vertexOf.size());
   shape.refinement = std::move(refinement);
@@ -532,7 +541,7 @@ const char* schemeName(SubdivisionScheme scheme) {
 }
 
 void subdivide(const SubdivisionCage& cage, Shape& shape, const std::string& where, std::vector<std::string>& warnings,
-               uint64_t vertexBudget) {
+               uint64_t vertexBudget, std::vector<uint32_t>* triangleFaces) {
   checkCage(cage, where);
   uint32_t level = cage.level;
   if (level > kMaxSubdivisionLevel) {
@@ -548,11 +557,11 @@ void subdivide(const SubdivisionCage& cage, Shape& shape, const std::string& whe
                        std::to_string(vertexBudget) + " snell refines a mesh to; level " + std::to_string(level) +
                        (level ? " is drawn" : " (the cage) is drawn"));
   }
-  if (level == 0) return refineAt(cage, 0, nullptr, shape);
+  if (level == 0) return refineAt(cage, 0, nullptr, shape, triangleFaces);
   std::string problem = tagProblem(cage);
   if (!problem.empty()) {
     warnings.push_back(where + ": " + problem + "; the cage is drawn unrefined");
-    return refineAt(cage, 0, nullptr, shape);
+    return refineAt(cage, 0, nullptr, shape, triangleFaces);
   }
   Descriptor descriptor(cage);
   FarMessages messages;
@@ -562,13 +571,13 @@ void subdivide(const SubdivisionCage& cage, Shape& shape, const std::string& whe
   if (!topology) {
     std::string why = messages.messages.empty() ? std::string("OpenSubdiv refused its topology") : messages.messages.front();
     warnings.push_back(where + ": " + why + "; the cage is drawn unrefined");
-    return refineAt(cage, 0, nullptr, shape);
+    return refineAt(cage, 0, nullptr, shape, triangleFaces);
   }
   osd::TopologyRefiner::UniformOptions uniform{int(level)};
   uniform.fullTopologyInLastLevel = true;
   topology->RefineUniform(uniform);
   for (const std::string& m : messages.messages) warnings.push_back(where + ": OpenSubdiv: " + m);
-  refineAt(cage, level, topology.get(), shape);
+  refineAt(cage, level, topology.get(), shape, triangleFaces);
 }
 
 }  // namespace snell::scene

@@ -108,9 +108,10 @@ struct Refinement {
 /// naming `where` to `warnings`. Throws SceneError naming `where` for a cage
 /// that is not a mesh at all (counts that disagree, indices out of range,
 /// faces of fewer than three vertices). `vertexBudget` is the most refined
-/// vertices the shape may have.
+/// vertices the shape may have. With `triangleFaces`, each of the shape's
+/// triangles' cage face (a material per face splits the shape by them).
 void subdivide(const SubdivisionCage& cage, Shape& shape, const std::string& where, std::vector<std::string>& warnings,
-               uint64_t vertexBudget = kMaxRefinedVertices);
+               uint64_t vertexBudget = kMaxRefinedVertices, std::vector<uint32_t>* triangleFaces = nullptr);
 
 /// The scheme's name as USD spells it: "catmullClark", "loop", "bilinear".
 const char* schemeName(SubdivisionScheme scheme);

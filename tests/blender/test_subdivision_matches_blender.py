@@ -155,3 +155,25 @@ cube.modifiers["Subdivision"].render_levels = 0
 cage = srgb(render_f12(SCRATCH / "cage.exr"))
 apart = float((np.abs(cage - cpu).max(axis=2) > 2.0 / 255.0).mean())
 check(apart > 0.05, f"the unrefined cage differs from the subdivided surface on {apart:.1%} of pixels")
+
+# A cage of two material slots (the card's two emissions on alternate faces) goes to snell as one mesh whose
+# faces carry their materials, refined once for both, as Blender's own GPU subdivision refines once.
+cube.modifiers["Subdivision"].render_levels = 2
+cube.snell.gpu_subdivision = True
+cube.data.materials.append(bpy.data.materials["light"])
+for polygon in cube.data.polygons:
+    polygon.material_index = polygon.index % 2
+depsgraph = bpy.context.evaluated_depsgraph_get()
+sync = SceneSync(runtime.device(), depsgraph)
+geometry = sync.geometry[cube.name]
+parts = sum(len(g.parts) for g in sync.geometry.values())
+check(len(geometry.parts) == 1 and sync.scene.mesh_count == parts,
+      f"a cage of two slots is one snell mesh ({len(geometry.parts)} parts; {sync.scene.mesh_count} meshes "
+      f"for {parts} parts in all)")
+sync.renderer.render(view)
+cube.data.shape_keys.key_blocks["Bulge"].value = 0.5
+sent = sync.send_changed(bpy.context.evaluated_depsgraph_get())
+sync.renderer.render(view)
+check(sent["meshes_sent"] == [cube.name] and sync.renderer.last_frame()["meshes_refined"] == 1,
+      f"a moved two-slot cage is refined once for both slots ({sync.renderer.last_frame()})")
+sync.close()

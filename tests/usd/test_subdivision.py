@@ -80,7 +80,7 @@ def test_a_sharp_crease_changes_the_picture(tmp_path, device):
     assert (np.abs(smooth - creased).max(axis=2) > 0.05).mean() > 0.01
 
 
-def test_each_material_subset_refines_the_whole_cage_and_draws_its_own_faces(tmp_path):
+def test_a_cage_with_a_material_subset_is_one_mesh_refined_once_with_a_material_per_face(tmp_path, device):
     points, counts, indices, _ = sphere_arrays(rings=6, segments=8)
     top = list(range(16))  # the cap: the pole's triangles and the first ring of quads
 
@@ -94,14 +94,24 @@ def test_each_material_subset_refines_the_whole_cage_and_draws_its_own_faces(tmp
             bind(subset.GetPrim(), preview_material(stage, "/World/Glass", opacity=0.0, ior=1.376))
         stage.GetRootLayer().Save()
         contents = snell.usd.read(path)
-        return contents.snell_meshes(), snell.usd._stage.scene_of(contents)[0]
+        return path, contents.snell_meshes(), snell.usd._stage.scene_of(contents)[0]
 
-    meshes, scene = read("subsets.usda", True)
-    assert len(meshes) == 2 and all(len(x.positions) == len(points) for x in meshes)
-    assert sorted(map(len, (x.subdivision.hole_indices for x in meshes))) == [len(top), len(counts) - len(top)]
-    _, whole = read("whole.usda", False)
-    assert scene.drawn_triangle_count(0) + scene.drawn_triangle_count(1) == whole.drawn_triangle_count(0)
-    assert 0 < scene.drawn_triangle_count(1) < whole.drawn_triangle_count(0)
+    path, meshes, scene = read("subsets.usda", True)
+    [mesh] = meshes
+    assert len(mesh.positions) == len(points) and len(mesh.subdivision.hole_indices) == 0
+    faces = np.asarray(mesh.face_materials)
+    assert len(faces) == len(counts) and len(set(faces[top])) == 1 and faces[top][0] != faces[len(top)]
+    assert set(faces[len(top):]) == {mesh.material}, "the faces outside the subset keep the mesh's material"
+    _, _, whole = read("whole.usda", False)
+    assert scene.drawn_triangle_count(0) == whole.drawn_triangle_count(0)
+    assert scene.drawn_vertex_count(0) == whole.drawn_vertex_count(0)
+    with snell.usd.open(path, device=device) as opened:
+        opened.render(32, 32)
+        frame = opened.renderer.last_frame()
+        assert frame["meshes_refined"] == 0
+        opened.renderer.mark_dirty(0)
+        opened.render(32, 32)
+        assert opened.renderer.last_frame()["meshes_refined"] == 1, "one refine job for both materials"
 
 
 def test_animated_points_are_sent_as_the_cage_each_frame(tmp_path, device):

@@ -77,6 +77,7 @@ class Part:
     identity: bool = False  #: vertex i is point i: positions copy without a gather
     mesh: int = -1  #: snell's mesh index
     cage: Optional[Subdivision] = None  #: a subdivision surface's scheme and tags: indices are then its faces
+    face_materials: Optional[np.ndarray] = None  #: a cage's: each face's material (snell.Mesh's face_materials)
 
 
 @dataclass
@@ -256,6 +257,8 @@ class MeshSource:
                         or bool(skin and skin.animated and skin.deforms_points))
         self._rest: Optional[Vt.Vec3fArray] = None  # points that do not vary, read once
         self._cage_parts: list[tuple] = []  # add_part's arguments for each cage part, to make them again as polygons
+        self._cage_st: Optional[Usd.Attribute] = None  # the texture coordinates the cage's first material reads
+        self._authored_holes = np.zeros(0, np.int64)  # the cage's own hole_indices, before unclaimed faces join them
         self._miscounted = False
 
     @property
@@ -266,7 +269,7 @@ class MeshSource:
                  st_values: Optional[np.ndarray], corner_uvs: Optional[np.ndarray] = None) -> Part:
         """A part of these triangles, with its vertices split where its normals or st differ; with corner_uvs
         ((T * 3, 2): a colour atlas's, _colours.py) every triangle has its own three vertices, with those UVs.
-        A cage's part is the whole cage, with the faces of the other parts as holes."""
+        A cage has one part, the whole cage, whose faces each carry their material: snell refines it once."""
         t = self.topology
         if self.cage is not None:
             self._cage_parts.append((name, triangles, material, st, st_values))
@@ -319,19 +322,26 @@ class MeshSource:
     def _add_cage_part(self, name: str, triangles: np.ndarray, material: int, st: Optional[Primvar],
                        st_values: Optional[np.ndarray]) -> Part:
         t = self.topology
-        cage = Subdivision(self.cage.scheme, self.cage.level, t.face_counts, self.cage.interpolate_boundary,
-                           self.cage.face_varying_linear_interpolation)
-        for tag in ("smooth_triangles", "left_handed", "crease_indices", "crease_lengths", "crease_sharpnesses",
-                    "corner_indices", "corner_sharpnesses"):
-            setattr(cage, tag, getattr(self.cage, tag))
-        drawn = np.zeros(t.face_count, bool)
-        drawn[t.triangle_face[triangles]] = True
-        holes = np.union1d(np.nonzero(~drawn)[0], np.asarray(self.cage.hole_indices, np.int64))
-        cage.hole_indices = holes[(holes >= 0) & (holes < t.face_count)]
-        part = Part(name, triangles, material, cage=cage, identity=True)
+        faces = np.unique(t.triangle_face[triangles])
+        if self.parts:  # another material's faces of the cage: the one part takes them
+            part = self.parts[0]
+            part.triangles = np.concatenate([part.triangles, triangles])
+            part.face_materials[faces] = material
+            part.cage.hole_indices = self._cage_holes(part.face_materials)
+            if (st is None) != (part.uvs is None) or (st is not None and st.attribute != self._cage_st):
+                self.problems.warn(name, "its material reads other texture coordinates than the cage's first "
+                                         "material; the cage carries one set, the first material's")
+            return part
+        cage = self.cage  # the one part's: its holes grow with the faces no material claims
+        self._authored_holes = np.asarray(cage.hole_indices, np.int64)
+        part = Part(self.path, triangles, material, cage=cage, identity=True)
+        part.face_materials = np.full(t.face_count, -2, np.int32)  # -2: no material's face, a hole
+        part.face_materials[faces] = material
+        cage.hole_indices = self._cage_holes(part.face_materials)
         part.vertex_point = np.arange(t.point_count)
         part.vertex_normal = part.vertex_point
         part.indices = np.ascontiguousarray(t.face_points, np.uint32)
+        self._cage_st = None if st is None else st.attribute
         if st is not None:
             per_point = st.point_ids is not None
             uv = st_values[st.point_ids].astype(np.float64) if per_point else st_values.astype(np.float64)
@@ -341,6 +351,11 @@ class MeshSource:
                 cage.uv_indices = st.corner_ids
         self.parts.append(part)
         return part
+
+    def _cage_holes(self, face_materials: np.ndarray) -> np.ndarray:
+        """The cage's holes: its authored ones and the faces no material claims."""
+        holes = np.union1d(np.nonzero(face_materials == -2)[0], self._authored_holes)
+        return holes[(holes >= 0) & (holes < self.topology.face_count)]
 
     def _points(self, time: Usd.TimeCode) -> Vt.Vec3fArray:
         if self._rest is not None:

@@ -577,8 +577,12 @@ class StageContents:
                 normals = np.empty_like(positions)
                 source.write(part, pose, positions, normals)
                 part.mesh = len(meshes)
+                face_materials = None
+                if part.face_materials is not None:  # a hole's entry is never drawn; any material will do
+                    face_materials = np.where(part.face_materials == -2, part.material, part.face_materials)
                 meshes.append(Mesh(positions, None if part.cage is not None else normals, part.indices, part.uvs,
-                                   material=part.material, name=part.name, subdivision=part.cage))
+                                   material=part.material, name=part.name, subdivision=part.cage,
+                                   face_materials=face_materials))
         return meshes
 
     def snell_instances(self) -> list[Instance]:
