@@ -102,6 +102,17 @@ void bindView(py::module_& m) {
             v.sceneCamera = -1;
           },
           "view_matrix"_a, "projection"_a, "Points the view by the host's matrices (a DCC viewport's).");
+  m.def(
+      "framing",
+      [](const std::vector<float>& lo, const std::vector<float>& hi, float yfov) {
+        const snell::Camera c = snell::Camera::framing(toVec3(lo, "lo"), toVec3(hi, "hi"), yfov);
+        auto tuple = [](const snell::Vec3& v) { return py::make_tuple(v[0], v[1], v[2]); };
+        return py::dict("eye"_a = tuple(c.eye), "target"_a = tuple(c.target), "up"_a = tuple(c.up), "yfov"_a = c.yfov);
+      },
+      "lo"_a, "hi"_a, "yfov"_a = float(snell::kDefaultYfov),
+      "The look-at snell render frames a scene without a camera with, for View(width, height, **framing(lo, hi)):\n"
+      "looking down -Z at the centre of the world box [lo, hi], far enough back to see its whole bounding\n"
+      "sphere (an empty box, lo > hi: the origin). Returns eye, target, up and yfov.");
 }
 
 void bindRenderer(py::module_& m) {

@@ -324,6 +324,11 @@ class Scene {
 struct Camera {
   Vec3 eye{0, 0, 3}, target{0, 0, 0}, up{0, 1, 0};
   float yfov = float(kDefaultYfov);  ///< radians
+
+  /// The camera `snell render` frames a scene without one with: looking down
+  /// -Z at the centre of the world box [lo, hi], far enough back to see its
+  /// whole bounding sphere. An empty box (lo > hi) frames the origin.
+  static Camera framing(const Vec3& lo, const Vec3& hi, float yfov = float(kDefaultYfov));
 };
 
 /// A camera given as the host's own matrices (a DCC viewport's), OpenGL's conventions.

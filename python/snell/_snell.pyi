@@ -373,6 +373,11 @@ class ShotFrame:
     @property
     def seconds(self) -> float: ...
 
+def framing(lo: Sequence[float], hi: Sequence[float], yfov: float = ...) -> dict[str, Any]:
+    """The look-at snell render frames a scene without a camera with, for View(width, height, **framing(lo, hi)):
+    looking down -Z at the centre of the world box [lo, hi], far enough back to see its whole bounding sphere (an
+    empty box, lo > hi: the origin). Returns eye, target, up and yfov."""
+
 def render_frames(
     scene: Scene,
     view: View,

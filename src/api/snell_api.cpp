@@ -195,6 +195,16 @@ uint32_t Environment::width() const { return impl_->width; }
 uint32_t Environment::height() const { return impl_->height; }
 std::string Environment::name() const { return impl_->source; }
 
+Camera Camera::framing(const Vec3& lo, const Vec3& hi, float yfov) {
+  const scene::LookAt at = scene::framedLookAt(glm::dvec3(toVec(lo)), glm::dvec3(toVec(hi)), double(yfov));
+  Camera camera;
+  camera.eye = {float(at.eye.x), float(at.eye.y), float(at.eye.z)};
+  camera.target = {float(at.target.x), float(at.target.y), float(at.target.z)};
+  camera.up = {float(at.up.x), float(at.up.y), float(at.up.z)};
+  camera.yfov = yfov;
+  return camera;
+}
+
 // ---------------------------------------------------------------- Renderer
 
 namespace {

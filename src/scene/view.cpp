@@ -117,15 +117,18 @@ View resolveView(const Scene& scene, const Pose& pose, const ViewRequest& reques
   // No camera: look down -Z at the bounds' centre from far enough to see them all.
   glm::dvec3 lo, hi;
   sceneBounds(scene, pose, lo, hi);
+  return lookAtView(framedLookAt(lo, hi, request.yfov), request.yfov, "framed view of the scene");
+}
+
+LookAt framedLookAt(const glm::dvec3& lo, const glm::dvec3& hi, double yfov) {
   glm::dvec3 centre(0.0);
   double radius = 1.0;
   if (lo.x <= hi.x) {
     centre = 0.5 * (lo + hi);
     radius = std::max(0.5 * glm::length(hi - lo), 1e-6);
   }
-  double distance = radius / std::sin(request.yfov / 2.0);
-  return lookAtView({centre + glm::dvec3(0.0, 0.0, distance), centre, {0.0, 1.0, 0.0}}, request.yfov,
-                    "framed view of the scene");
+  const double distance = radius / std::sin(yfov / 2.0);
+  return {centre + glm::dvec3(0.0, 0.0, distance), centre, {0.0, 1.0, 0.0}};
 }
 
 // A camera frame from a host's view and projection matrices (OpenGL's

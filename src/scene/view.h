@@ -59,6 +59,12 @@ View resolveView(const Scene& scene, const Pose& pose, const ViewRequest& reques
 /// a projection, of the image's aspect (snell's pixels are square).
 View viewFromMatrices(const glm::dmat4& view, const glm::dmat4& projection, uint32_t width, uint32_t height);
 
+/// Looks down -Z at the centre of [lo, hi] from far enough that a camera of
+/// vertical field `yfov` sees the box's whole bounding sphere: the view of a
+/// scene without a camera. An empty box (lo.x > hi.x) frames the unit sphere
+/// about the origin.
+LookAt framedLookAt(const glm::dvec3& lo, const glm::dvec3& hi, double yfov);
+
 /// World-space bounds of everything drawn at the pose (deformation included);
 /// an empty scene gives min > max.
 void sceneBounds(const Scene& scene, const Pose& pose, glm::dvec3& lo, glm::dvec3& hi);

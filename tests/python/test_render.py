@@ -132,3 +132,12 @@ def test_scene_from_arrays_renders_like_its_gltf(device, lens_gltf):
     view = snell.View(WIDTH, HEIGHT, camera=0)
     a, b = srgb8(loaded.render(view)).astype(int), srgb8(arrays.render(view)).astype(int)
     assert np.abs(a - b).max() <= 1
+
+
+def test_framing_looks_down_z_at_the_box_from_far_enough_to_see_its_bounding_sphere():
+    framed = snell.framing((-1.0, 0.0, -3.0), (3.0, 4.0, 1.0))
+    distance = float(np.sqrt(12.0)) / np.sin(snell.DEFAULT_YFOV / 2)  # the box's half diagonal over sin(yfov / 2)
+    assert np.allclose(framed["eye"], (1.0, 2.0, -1.0 + distance), rtol=1e-6)
+    assert np.allclose(framed["target"], (1.0, 2.0, -1.0)) and framed["up"] == (0.0, 1.0, 0.0)
+    empty = snell.framing((np.inf,) * 3, (-np.inf,) * 3)  # nothing drawn: the unit sphere about the origin
+    assert np.allclose(empty["eye"], (0.0, 0.0, 1.0 / np.sin(snell.DEFAULT_YFOV / 2)), rtol=1e-6)

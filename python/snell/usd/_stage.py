@@ -10,7 +10,6 @@ Static prims cost nothing per frame.
 
 from __future__ import annotations
 
-import math
 import time as clock
 from dataclasses import dataclass
 from types import TracebackType
@@ -18,7 +17,7 @@ from typing import Any, Callable, Optional, Union
 
 import numpy as np
 
-from .. import DEFAULT_YFOV, Device, Environment, Mesh, Renderer, Scene, ShotFrame, View
+from .. import Device, Environment, Mesh, Renderer, Scene, ShotFrame, View, framing
 from ._cameras import CameraState
 from ._problems import StageError, StageWarning
 from ._reader import Frame, StageContents
@@ -132,7 +131,7 @@ class Stage:
         if state is not None:
             view_matrix, projection = state.matrices(width, height, conform)
             return View(width, height, view_matrix=view_matrix, projection=projection, **options)
-        return framed_view(*self.bounds(), width, height, **options)
+        return View(width, height, **framing(*self.bounds()), **options)
 
     def render(self, width: int, height: int, camera: Union[None, int, str] = None, **options: Any) -> np.ndarray:
         """The picture at the current time code: (height, width, 4) float32, scene-linear, row 0 at the top."""
@@ -196,16 +195,6 @@ def world_bounds(contents: StageContents, positions: Callable[[int], np.ndarray]
             if len(world):
                 lo, hi = np.minimum(lo, world.min(axis=0)), np.maximum(hi, world.max(axis=0))
     return lo, hi
-
-
-def framed_view(lo: np.ndarray, hi: np.ndarray, width: int, height: int, **options: Any) -> View:
-    """snell render's framed view of bounds, for a stage without a camera: the whole of them, looking down -Z."""
-    centre, radius = np.zeros(3), 1.0
-    if np.all(lo <= hi):
-        centre, radius = 0.5 * (lo + hi), max(0.5 * float(np.linalg.norm(hi - lo)), 1e-6)
-    distance = radius / math.sin(DEFAULT_YFOV / 2)
-    return View(width, height, eye=tuple(centre + (0.0, 0.0, distance)), target=tuple(centre), up=(0, 1, 0),
-                yfov=DEFAULT_YFOV, **options)
 
 
 def shot_frame(contents: StageContents, time_code: float, camera: Optional[CameraState], width: int, height: int,

@@ -22,14 +22,14 @@ from typing import Any, Optional, Sequence
 
 import numpy as np
 
-from .. import Device, Error, View, methods, render_frames, version
-from . import Stage, StageError, read
+from .. import Error, View, framing, methods, render_frames, version
+from . import StageError, read
 from ._cameras import CameraState
 from ._frames import UsageError, check_frame_pattern, frame_path, parse_frames
 from ._output import EXTENSIONS, OutputError, check_format, check_writable, write_image
 from ._reader import StageContents
 from ._screen import DEFAULT_TRIANGLE_BUDGET, refined_bytes, refined_size
-from ._stage import framed_view, scene_of, shot_frame, world_bounds
+from ._stage import scene_of, shot_frame, world_bounds
 
 EXIT_OK, EXIT_FAILURE, EXIT_USAGE = 0, 1, 2
 
@@ -446,8 +446,6 @@ def _render(args: argparse.Namespace, console: _Console) -> int:
     except OutputError as e:
         raise StageError(str(e)) from None
     console.warnings(contents.problems.items)
-    if args.devices is not None:
-        return _draw_on_devices(contents, frames, args, console)
     return _draw(contents, frames, args, console)
 
 
@@ -498,62 +496,28 @@ class _Writer:
         return EXIT_OK
 
 
-def _draw(contents: "StageContents", frames: list[int], args: argparse.Namespace, console: _Console) -> int:
-    """Renders and writes the frames; a signal drops the frame under way and exits 128 + N."""
-    global _stop_signal
-    said = len(contents.problems.items)
-    validation = os.environ.get("SNELL_VALIDATION") == "1"
-    device = Device(device=args.device, validation=validation)
-    device_name = device.name
-    width, height = args.size
-    writer = _Writer(contents, frames, args, console)
-    _stop_signal = 0
-    previous = {s: signal.signal(s, _on_stop) for s in (signal.SIGINT, signal.SIGTERM)}
-    try:
-        with Stage(contents, device=device) as stage:
-            for frame in frames:
-                if _stop_signal:
-                    break
-                frame_started = clock.perf_counter()
-                stage.set_time(frame)
-                rgba = stage.renderer.render(stage.view(width, height, args.camera, conform=args.conform,
-                                                        method=args.method))
-                if _stop_signal:
-                    break  # the frame under way is dropped: only whole frames are ever written
-                writer.write(frame, rgba, device_name, stage.camera(args.camera),
-                             clock.perf_counter() - frame_started)
-            console.warnings(stage.warnings[said:])  # what the frames found (a UsdSkel failure, ...)
-    finally:
-        for s, handler in previous.items():
-            signal.signal(s, handler)
-        messages = device.validation_messages if validation else 0
-        device.close()
-    return writer.finish(device_name, messages)
-
-
 class _Stopped(Exception):
     """A signal came during a shot on several devices: render_frames stops and raises this."""
 
 
-def _draw_on_devices(contents: "StageContents", frames: list[int], args: argparse.Namespace,
-                     console: _Console) -> int:
-    """Renders the frames with snell.render_frames, a worker per device of --devices (as snell render
-    --devices): each frame's posed meshes, moved instances and camera go with it, and its picture comes back
-    here, on this thread, to be written. A signal drops the frames under way and exits 128 + N."""
+def _draw(contents: "StageContents", frames: list[int], args: argparse.Namespace, console: _Console) -> int:
+    """Renders the frames as one shot with snell.render_frames: on the device --device names, or a worker per
+    device of --devices (as snell render --devices). Each frame's posed meshes, moved instances and camera go
+    with it, and its picture comes back here, on this thread, to be written. A signal drops the frames under way
+    and exits 128 + N."""
     global _stop_signal
     said = len(contents.problems.items)
     validation = os.environ.get("SNELL_VALIDATION") == "1"
     width, height = args.size
     scene, meshes = scene_of(contents)
-    environment = contents.snell_environment()
+    options = {"method": args.method, "environment": contents.snell_environment()}
     first = contents.camera(args.camera, frames[0])
     if first is not None:
         view_matrix, projection = first.matrices(width, height, args.conform)
-        view = View(width, height, view_matrix=view_matrix, projection=projection, method=args.method,
-                    environment=environment)
+        view = View(width, height, view_matrix=view_matrix, projection=projection, **options)
     else:  # no camera: the whole shot is framed on the first frame's bounds (the stage is read at that frame)
-        view = framed_view(*world_bounds(contents, lambda mesh: meshes[mesh].positions), width, height,
-                           method=args.method, environment=environment)
+        view = View(width, height, **framing(*world_bounds(contents, lambda mesh: meshes[mesh].positions)),
+                    **options)
     writer = _Writer(contents, frames, args, console)
     cameras: dict[int, Optional[CameraState]] = {}
     started: dict[int, float] = {}
@@ -575,9 +539,9 @@ def _draw_on_devices(contents: "StageContents", frames: list[int], args: argpars
 
     _stop_signal = 0
     previous = {s: signal.signal(s, _on_stop) for s in (signal.SIGINT, signal.SIGTERM)}
-    messages, where = 0, args.devices
+    messages, where = 0, args.devices or args.device or "the first device"
     try:
-        summary = render_frames(scene, view, poses(), keep, devices=args.devices, device=args.device,
+        summary = render_frames(scene, view, poses(), keep, devices=args.devices or "", device=args.device,
                                 validation=validation)
         messages = sum(int(w["validation_messages"]) for w in summary["workers"])
         where = ", ".join(f"{w['device']} ({w['frames']})" for w in summary["workers"])
