@@ -27,6 +27,20 @@ sys.path.insert(0, str(SOURCE / "blender"))
 import demo_eye_rig  # noqa: E402  (from the checkout's blender/ folder, put on the path above)
 
 
+def surface_material(name: str, node_type: str, **inputs):
+    """A material whose Surface is one node of `node_type` (the Principled BSDF taken out), with `inputs` (by
+    socket name) set; returns the material and the node."""
+    material = bpy.data.materials.new(name)
+    material.use_nodes = True
+    nodes = material.node_tree.nodes
+    nodes.remove(nodes["Principled BSDF"])
+    node = nodes.new(node_type)
+    for socket, value in inputs.items():
+        node.inputs[socket].default_value = value
+    material.node_tree.links.new(node.outputs[0], nodes["Material Output"].inputs["Surface"])
+    return material, node
+
+
 def module_folder() -> str:
     """The snell module's folder: the build's, or where the build's is not for this Python, the wheel of this
     Python from the extension zip, unpacked into the scratch folder."""

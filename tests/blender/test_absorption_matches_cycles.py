@@ -20,7 +20,8 @@ import bpy
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).parent))  # Blender runs the script without its folder on the path
-from blender_support import SCRATCH, check, cycles_comparison, enable_addon, render_f12  # noqa: E402
+from blender_support import (  # noqa: E402
+    SCRATCH, check, cycles_comparison, enable_addon, render_f12, surface_material)
 
 WIDTH, HEIGHT = 64, 48
 COLOUR, DENSITY, THICKNESS, IOR = (0.25, 0.5, 0.85), 1.6, 0.5, 1.45
@@ -33,29 +34,16 @@ def build(tilt_degrees: float):
     bpy.ops.wm.read_factory_settings(use_empty=True)
     enable_addon()
     scene = bpy.context.scene
-    card = bpy.data.materials.new("card")
-    card.use_nodes = True
-    nodes = card.node_tree.nodes
-    nodes.remove(nodes["Principled BSDF"])
-    emission = nodes.new("ShaderNodeEmission")
-    emission.inputs["Color"].default_value = (1, 1, 1, 1)
-    card.node_tree.links.new(emission.outputs[0], nodes["Material Output"].inputs["Surface"])
+    card, _ = surface_material("card", "ShaderNodeEmission", Color=(1, 1, 1, 1))
     bpy.ops.mesh.primitive_plane_add(size=6.0, location=(0, 2.0, 0), rotation=(math.radians(90), 0, 0))
     bpy.context.object.data.materials.append(card)
 
-    glass = bpy.data.materials.new("absorbing glass")
-    glass.use_nodes = True
+    glass, _ = surface_material("absorbing glass", "ShaderNodeBsdfGlass", Roughness=0.0, IOR=IOR)
     nodes = glass.node_tree.nodes
-    nodes.remove(nodes["Principled BSDF"])
-    bsdf = nodes.new("ShaderNodeBsdfGlass")
-    bsdf.inputs["Roughness"].default_value = 0.0
-    bsdf.inputs["IOR"].default_value = IOR
     absorption = nodes.new("ShaderNodeVolumeAbsorption")
     absorption.inputs["Color"].default_value = (*COLOUR, 1.0)
     absorption.inputs["Density"].default_value = DENSITY
-    output = nodes["Material Output"]
-    glass.node_tree.links.new(bsdf.outputs[0], output.inputs["Surface"])
-    glass.node_tree.links.new(absorption.outputs[0], output.inputs["Volume"])
+    glass.node_tree.links.new(absorption.outputs[0], nodes["Material Output"].inputs["Volume"])
     bpy.ops.mesh.primitive_cube_add(size=1.0)
     slab = bpy.context.object
     slab.scale = (2.0, THICKNESS, 1.6)

@@ -21,7 +21,8 @@ import bpy
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).parent))  # Blender runs the script without its folder on the path
-from blender_support import SCRATCH, check, cycles_comparison, enable_addon, render_f12  # noqa: E402
+from blender_support import (  # noqa: E402
+    SCRATCH, check, cycles_comparison, enable_addon, render_f12, surface_material)
 from snell_blender import compat  # noqa: E402
 
 WIDTH, HEIGHT = 160, 120
@@ -171,11 +172,7 @@ def glass(kind: str, ior: float, normal_map: bool = False):
 
 
 def red_backdrop():
-    m, nodes, links, output = material("red backdrop")
-    emit = nodes.new("ShaderNodeEmission")
-    emit.inputs["Color"].default_value = (0.8, 0.05, 0.05, 1)
-    links.new(emit.outputs[0], output.inputs["Surface"])
-    return m
+    return surface_material("red backdrop", "ShaderNodeEmission", Color=(0.8, 0.05, 0.05, 1))[0]
 
 
 def build(card, glass_material, pane: bool = False, lit: bool = False, backdrop: bool = False):

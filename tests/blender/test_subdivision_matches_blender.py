@@ -23,21 +23,15 @@ import bpy
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).parent))  # Blender runs the script without its folder on the path
-from blender_support import SCRATCH, check, cycles_comparison, enable_addon, render_f12, srgb  # noqa: E402
+from blender_support import (  # noqa: E402
+    SCRATCH, check, cycles_comparison, enable_addon, render_f12, srgb, surface_material)
 
 WIDTH, HEIGHT = 128, 96
 SCRATCH.mkdir(parents=True, exist_ok=True)
 
 
 def emission(name: str, strength: float):
-    material = bpy.data.materials.new(name)
-    material.use_nodes = True
-    nodes = material.node_tree.nodes
-    nodes.remove(nodes["Principled BSDF"])
-    node = nodes.new("ShaderNodeEmission")
-    node.inputs["Color"].default_value = (strength, strength, strength, 1)
-    material.node_tree.links.new(node.outputs[0], nodes["Material Output"].inputs["Surface"])
-    return material
+    return surface_material(name, "ShaderNodeEmission", Color=(strength, strength, strength, 1))[0]
 
 
 def build():
@@ -62,14 +56,7 @@ def build():
     card = bpy.data.objects.new("card", card_mesh)
     scene.collection.objects.link(card)
 
-    glass = bpy.data.materials.new("glass")
-    glass.use_nodes = True
-    nodes = glass.node_tree.nodes
-    nodes.remove(nodes["Principled BSDF"])
-    bsdf = nodes.new("ShaderNodeBsdfGlass")
-    bsdf.inputs["Roughness"].default_value = 0.0
-    bsdf.inputs["IOR"].default_value = 1.45
-    glass.node_tree.links.new(bsdf.outputs[0], nodes["Material Output"].inputs["Surface"])
+    glass, _ = surface_material("glass", "ShaderNodeBsdfGlass", Roughness=0.0, IOR=1.45)
     bpy.ops.mesh.primitive_cube_add(size=1.6)
     cube = bpy.context.object
     cube.data.materials.append(glass)

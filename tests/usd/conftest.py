@@ -49,6 +49,13 @@ def snell_usd(*args: object, timeout: float = 120) -> subprocess.CompletedProces
                           timeout=timeout)
 
 
+def snell_usd_ok(*args: object, timeout: float = 120) -> subprocess.CompletedProcess:
+    """snell_usd that must succeed: exit code 0, else the assertion shows its standard error."""
+    done = snell_usd(*args, timeout=timeout)
+    assert done.returncode == 0, done.stderr
+    return done
+
+
 def read_image(path: Path) -> np.ndarray:
     """An image file as float32 (height, width, channels), through OpenImageIO."""
     import OpenImageIO as oiio

@@ -12,15 +12,14 @@ import numpy as np
 import pytest
 from pxr import UsdGeom
 
-from conftest import read_image, snell_usd
+from conftest import read_image, snell_usd, snell_usd_ok
 from stages import bind, new_stage, preview_material, quad, texture
 
 SIZE = "64x48"
 
 
 def test_info_lists_prims_materials_cameras_lights_and_the_time_range(eyes):
-    done = snell_usd("info", eyes.usd)
-    assert done.returncode == 0, done.stderr
+    done = snell_usd_ok("info", eyes.usd)
     out = done.stdout
     assert "time codes 1-48 at 24 per second" in out and "metres per unit 1 (authored)" in out
     assert "/World/Rig/EyeballL (cornea): 193 vertices, 352 triangles, material /World/Looks/Cornea" in out
@@ -64,8 +63,7 @@ def test_info_says_which_colour_preview_glass_transmits(tmp_path):
     bind(quad(stage, "/World/Tinted", z=1).GetPrim(),
          preview_material(stage, "/World/TintedGlass", opacity=0.0, diffuseColor=(0.5, 0.8, 1.0)))
     stage.GetRootLayer().Save()
-    done = snell_usd("info", tmp_path / "glass.usda")
-    assert done.returncode == 0, done.stderr
+    done = snell_usd_ok("info", tmp_path / "glass.usda")
     assert "/World/ClearGlass: UsdPreviewSurface, glass (opacity 0, ior 1.5) transmitting (1, 1, 1) (diffuseColor " \
            "unset: clear)" in done.stdout
     assert "/World/TintedGlass: UsdPreviewSurface, glass (opacity 0, ior 1.5) transmitting (0.5, 0.8, 1)," \
@@ -73,8 +71,7 @@ def test_info_says_which_colour_preview_glass_transmits(tmp_path):
 
 
 def test_render_writes_exactly_the_frames_asked(eyes, tmp_path):
-    done = snell_usd("render", eyes.usd, "-o", tmp_path / "shot.####.exr", "--frames", "1-9x4,20", "--size", SIZE)
-    assert done.returncode == 0, done.stderr
+    done = snell_usd_ok("render", eyes.usd, "-o", tmp_path / "shot.####.exr", "--frames", "1-9x4,20", "--size", SIZE)
     assert sorted(os.listdir(tmp_path)) == ["shot.0001.exr", "shot.0005.exr", "shot.0009.exr", "shot.0020.exr"]
     assert done.stderr.count("frame ") == 4 and "frame 20 (4/4) -> " in done.stderr
     pixels = read_image(tmp_path / "shot.0009.exr")
@@ -82,8 +79,7 @@ def test_render_writes_exactly_the_frames_asked(eyes, tmp_path):
 
 
 def test_render_writes_a_png_of_the_single_frame(eyes, tmp_path):
-    done = snell_usd("render", eyes.usd, "-o", tmp_path / "still.png", "--size", SIZE, "--camera", "/World/Camera")
-    assert done.returncode == 0, done.stderr
+    done = snell_usd_ok("render", eyes.usd, "-o", tmp_path / "still.png", "--size", SIZE, "--camera", "/World/Camera")
     assert done.stdout.startswith(f"wrote {tmp_path / 'still.png'}: 64x48, camera /World/Camera, time code 1")
     assert read_image(tmp_path / "still.png").shape == (48, 64, 4)
 
@@ -104,8 +100,7 @@ def test_quiet_prints_nothing(eyes, tmp_path):
 
 
 def test_a_stage_with_a_missing_texture_renders_its_fallback_with_a_warning(tmp_path):
-    done = snell_usd("render", broken_stage(tmp_path), "-o", tmp_path / "f.png", "--size", SIZE)
-    assert done.returncode == 0, done.stderr
+    done = snell_usd_ok("render", broken_stage(tmp_path), "-o", tmp_path / "f.png", "--size", SIZE)
     assert "warning: /World/M/Texture_diffuseColor: texture file ./gone.png not found" in done.stderr
     assert (tmp_path / "f.png").is_file()
 
@@ -134,8 +129,7 @@ def undecodable_stage(folder) -> object:
 
 def test_a_texture_that_cannot_be_decoded_is_a_warning_naming_the_file_and_its_fallback_is_drawn(tmp_path):
     out = tmp_path / "f.exr"
-    done = snell_usd("render", undecodable_stage(tmp_path), "-o", out, "--size", SIZE)
-    assert done.returncode == 0, done.stderr
+    done = snell_usd_ok("render", undecodable_stage(tmp_path), "-o", out, "--size", SIZE)
     warning = next((line for line in done.stderr.splitlines() if "/World/M/Texture_diffuseColor" in line), "")
     assert "warning" in warning and str(tmp_path / "noise.png") in warning, done.stderr
     assert "the input's fallback is drawn" in warning, warning
@@ -162,8 +156,7 @@ def empty_stage(folder) -> object:
 
 def test_a_stage_with_nothing_to_draw_renders_its_background_with_a_warning(tmp_path):
     out = tmp_path / "e.exr"
-    done = snell_usd("render", empty_stage(tmp_path), "-o", out, "--size", SIZE)
-    assert done.returncode == 0, done.stderr
+    done = snell_usd_ok("render", empty_stage(tmp_path), "-o", out, "--size", SIZE)
     assert "nothing to draw: no visible UsdGeomMesh or gprim with faces" in done.stderr, done.stderr
     assert "the background is drawn" in done.stderr
     background = [0.02, 0.02, 0.025]  # snell.View's default
@@ -184,8 +177,7 @@ def test_a_start_time_code_after_the_end_renders_the_stages_start_frame(tmp_path
     stage = new_stage(tmp_path / "backwards.usda", time_range=(10, 1))
     quad(stage, "/World/Card")
     stage.GetRootLayer().Save()
-    done = snell_usd("render", tmp_path / "backwards.usda", "-o", tmp_path / "f.png", "--size", SIZE)
-    assert done.returncode == 0, done.stderr
+    done = snell_usd_ok("render", tmp_path / "backwards.usda", "-o", tmp_path / "f.png", "--size", SIZE)
     assert "time code 10" in done.stdout and (tmp_path / "f.png").is_file()
     assert "startTimeCode 10 is after endTimeCode 1: snell takes the range 1-10" in done.stderr
 
@@ -273,8 +265,7 @@ def stage_usd_warns_about(folder) -> object:
 
 
 def test_usds_own_diagnostics_are_snell_usds_warnings_and_not_its_raw_stderr(tmp_path):
-    done = snell_usd("render", stage_usd_warns_about(tmp_path), "-o", tmp_path / "f.png", "--size", SIZE)
-    assert done.returncode == 0, done.stderr
+    done = snell_usd_ok("render", stage_usd_warns_about(tmp_path), "-o", tmp_path / "f.png", "--size", SIZE)
     said = "USD says: In </World/Card>: Could not open asset @" + str(tmp_path / "missing_layer.usda@")
     assert f"snell-usd: warning: {said}" in done.stderr, done.stderr
     assert "Warning: in " not in done.stderr, "USD printed its diagnostic itself"

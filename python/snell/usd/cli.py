@@ -91,24 +91,22 @@ def _size(text: str) -> tuple[int, int]:
     return width, height
 
 
-def _budget(text: str) -> int:
-    try:
-        budget = int(text.replace("_", "").replace(",", ""))
-    except ValueError:
-        budget = 0
-    if budget <= 0:
-        raise argparse.ArgumentTypeError(f"a triangle budget is a positive count, not '{text}'")
-    return budget
+def _count(lowest: int, highest: float, what: str):
+    """An argparse type: a whole number from lowest to highest (`_` and `,` may group its digits), else
+    an error saying `what` it must be."""
+    def parse(text: str) -> int:
+        try:
+            value = int(text.replace("_", "").replace(",", ""))
+        except ValueError:
+            value = lowest - 1
+        if not lowest <= value <= highest:
+            raise argparse.ArgumentTypeError(f"{what}, not '{text}'")
+        return value
+    return parse
 
 
-def _level(text: str) -> int:
-    try:
-        level = int(text)
-    except ValueError:
-        level = -1
-    if not 0 <= level <= 8:
-        raise argparse.ArgumentTypeError(f"a subdivision level is 0 to 8, not '{text}'")
-    return level
+_budget = _count(1, float("inf"), "a triangle budget is a positive count")
+_level = _count(0, 8, "a subdivision level is 0 to 8")
 
 
 def _number(text: str) -> float:
