@@ -160,8 +160,13 @@ CrowdRow measureCrowd(vk::Context& context, uint32_t characters, uint32_t width,
 
 struct RefineRow {
   uint32_t cageVertices = 0, cageFaces = 0, refinedVertices = 0;
-  double refineMs = 0, refitMs = 0;
+  double refineMs = 0, refitMs = 0;  ///< medians
+  double refineMinMs = 0, refineMaxMs = 0, refitMinMs = 0, refitMaxMs = 0;  ///< the spread of the frames timed
 };
+
+// Frames drawn before a refine row's timed ones: its tables and the trees
+// come into the caches, and the clocks up from idle.
+constexpr uint32_t kRefineWarmupFrames = 5;  // as the crowds' (--frames says "after 5")
 
 // A wavy open grid of n x n quads as a Catmull-Clark cage refined twice
 // ((4n + 1)^2 vertices), moved by the host every frame: the refine pass and
@@ -198,14 +203,14 @@ RefineRow measureRefine(vk::Context& context, uint64_t target, uint32_t frames) 
   request.views.push_back(view);
   renderer.wait(renderer.submit(request));  // the first build
   std::vector<double> refine, refit;
-  for (uint32_t f = 0; f < frames + 3; ++f) {
+  for (uint32_t f = 0; f < frames + kRefineWarmupFrames; ++f) {
     render::KeptVertices kept = renderer.keptVertices(0);
     for (uint32_t v = 0; v < kept.count; ++v) {
       kept.positions[3 * v + 2] = 0.05f * std::sin(3.0f * kept.positions[3 * v] + 0.3f * float(f));
     }
     renderer.markDirty(0);
     const render::FrameResult& result = renderer.wait(renderer.submit(request));
-    if (f < 3) continue;  // warm-up
+    if (f < kRefineWarmupFrames) continue;
     for (const vk::PassTime& p : result.passes) {
       if (p.name == pass::kRefine) refine.push_back(p.milliseconds);
       if (p.name == pass::kBlasRefit || p.name == pass::kBlasBuild) refit.push_back(p.milliseconds);
@@ -217,6 +222,10 @@ RefineRow measureRefine(vk::Context& context, uint64_t target, uint32_t frames) 
   row.refinedVertices = uint32_t(s.shapes[0].vertexCount());
   row.refineMs = io::median(refine);
   row.refitMs = io::median(refit);
+  if (!refine.empty()) row.refineMinMs = *std::min_element(refine.begin(), refine.end());
+  if (!refine.empty()) row.refineMaxMs = *std::max_element(refine.begin(), refine.end());
+  if (!refit.empty()) row.refitMinMs = *std::min_element(refit.begin(), refit.end());
+  if (!refit.empty()) row.refitMaxMs = *std::max_element(refit.begin(), refit.end());
   return row;
 }
 
@@ -372,14 +381,17 @@ int runScale(const Options& o) {
   }
   std::vector<RefineRow> refineRows;
   if (!refineSizes.empty()) {
-    std::printf("\nsubdivision cages refined twice, moved every frame (median GPU ms of %u frames)\n", frames);
-    std::printf("%12s %12s %14s %11s %14s %10s\n", "cage verts", "cage faces", "refined verts", "refine ms",
-                "M verts/s", "refit ms");
+    std::printf("\nsubdivision cages refined twice, moved every frame (GPU ms: the median of %u frames after %u "
+                "warm-up frames, and their spread)\n",
+                frames, kRefineWarmupFrames);
+    std::printf("%12s %12s %14s %11s %17s %14s %10s %17s\n", "cage verts", "cage faces", "refined verts", "refine ms",
+                "refine min-max", "M verts/s", "refit ms", "refit min-max");
   }
   for (uint64_t target : refineSizes) {
     RefineRow r = measureRefine(*context, target, frames);
-    std::printf("%12u %12u %14u %11.4f %14.1f %10.4f\n", r.cageVertices, r.cageFaces, r.refinedVertices, r.refineMs,
-                r.refineMs > 0 ? r.refinedVertices / r.refineMs / 1e3 : 0.0, r.refitMs);
+    std::printf("%12u %12u %14u %11.4f %8.4f-%-8.4f %14.1f %10.4f %8.4f-%-8.4f\n", r.cageVertices, r.cageFaces,
+                r.refinedVertices, r.refineMs, r.refineMinMs, r.refineMaxMs,
+                r.refineMs > 0 ? r.refinedVertices / r.refineMs / 1e3 : 0.0, r.refitMs, r.refitMinMs, r.refitMaxMs);
     std::fflush(stdout);
     refineRows.push_back(r);
   }
@@ -430,7 +442,12 @@ int runScale(const Options& o) {
                                     {"cage_faces", r.cageFaces},
                                     {"refined_vertices", r.refinedVertices},
                                     {"refine_ms", r.refineMs},
-                                    {"refit_ms", r.refitMs}});
+                                    {"refine_min_ms", r.refineMinMs},
+                                    {"refine_max_ms", r.refineMaxMs},
+                                    {"refit_ms", r.refitMs},
+                                    {"refit_min_ms", r.refitMinMs},
+                                    {"refit_max_ms", r.refitMaxMs},
+                                    {"warmup_frames", kRefineWarmupFrames}});
     }
     j["subdivision"] = std::move(refineJson);
     io::writeJson(o.json, j);
