@@ -1,21 +1,22 @@
 // PNG through snell's own encoder (src/scene/png.h) and tinygltf's
-// decoder, EXR through OpenImageIO where the build has it; the rename makes
-// every write all-or-nothing. Without OpenImageIO the binary carries to a
-// machine that has only the Vulkan loader (the GPU benchmarks do that).
+// decoder, EXR through OpenImageIO in a module opened when a file needs it
+// (exr_codec.h), where the build has it; the rename makes every write
+// all-or-nothing. Without OpenImageIO the binary carries to a machine that
+// has only the Vulkan loader (the GPU benchmarks do that).
 #include "io/image_file.h"
 
+#include "io/exr_codec.h"
 #include "io/file_write.h"
 #include "io/version.h"
 #include "scene/png.h"
 #include "scene/scene.h"
 
-#if SNELL_WITH_OPENIMAGEIO
-#include <OpenImageIO/imageio.h>
-#endif
+#include <dlfcn.h>
 #include <glm/gtc/packing.hpp>
 #include <tiny_gltf.h>
 
 #include <fstream>
+#include <mutex>
 #include <iterator>
 
 #include <algorithm>
@@ -31,8 +32,37 @@ namespace snell::io {
 
 namespace fs = std::filesystem;
 
-float LinearImage::channel(size_t i, int c) const {
-  return rgba.empty() ? glm::unpackHalf1x16(rgbaHalf[4 * i + size_t(c)]) : rgba[i][c];
+const ExrCodec& exrCodec(const std::string& path) {
+#if SNELL_WITH_OPENIMAGEIO
+  // Beside an installed command (SNELL_EXR_MODULE_INSTALLED, from its folder),
+  // else where the build made it (the build tree's commands and tests).
+  static const ExrCodec* codec = nullptr;
+  static std::string why;
+  static std::once_flag opened;
+  std::call_once(opened, [] {
+    std::error_code error;
+    const fs::path self = fs::read_symlink("/proc/self/exe", error);
+    std::vector<std::string> candidates;
+    if (!error) candidates.push_back((self.parent_path() / SNELL_EXR_MODULE_INSTALLED).lexically_normal().string());
+    candidates.push_back(SNELL_EXR_MODULE);
+    for (const std::string& candidate : candidates) {
+      if (!fs::exists(candidate)) continue;
+      void* module = dlopen(candidate.c_str(), RTLD_NOW | RTLD_LOCAL);
+      auto entry = module ? reinterpret_cast<const ExrCodec* (*)()>(dlsym(module, "snell_exr_codec")) : nullptr;
+      if (entry) {
+        codec = entry();
+        return;
+      }
+      why = candidate + ": " + dlerror();
+      return;
+    }
+    why = "no " + candidates.back() + " (nor one beside the command)";
+  });
+  if (codec) return *codec;
+  throw std::runtime_error(path + ": EXR needs snell's OpenImageIO module, which did not load (" + why + ")");
+#else
+  throw std::runtime_error(path + ": this build has no OpenImageIO, so no EXR; write a .png");
+#endif
 }
 
 Rgb8Image toSrgb8(const LinearImage& image) {
@@ -67,74 +97,6 @@ std::vector<uint8_t> pngBytes(uint32_t width, uint32_t height, const std::vector
 
 }  // namespace
 
-#if SNELL_WITH_OPENIMAGEIO
-namespace {
-
-// One EXR part: R, G, B, A then each AOV layer's channels, every channel in
-// its own type (half or float colour, float or uint AOVs), so ids stay exact.
-void writeExr(const std::string& path, const std::string& temp, const LinearImage& image, const ImageExtras& extras) {
-  const OIIO::TypeDesc colourType = extras.floatPixels ? OIIO::TypeDesc::FLOAT : OIIO::TypeDesc::HALF;
-  std::vector<OIIO::TypeDesc> formats(4, colourType);
-  std::vector<std::string> names = {"R", "G", "B", "A"};
-  for (const AovLayer& layer : extras.aovs) {
-    size_t expected = image.pixels() * layer.channels.size();
-    if ((layer.integer ? layer.ids.size() : layer.values.size()) != expected) {
-      throw std::runtime_error(path + ": the " + layer.layer + " layer does not fill the image");
-    }
-    for (const std::string& c : layer.channels) {
-      names.push_back(layer.layer + "." + c);
-      formats.push_back(layer.integer ? OIIO::TypeDesc::UINT : extras.floatPixels ? OIIO::TypeDesc::FLOAT : OIIO::TypeDesc::HALF);
-    }
-  }
-  // The pixels packed as the file holds them, so OpenImageIO converts nothing.
-  size_t pixelBytes = 0;
-  for (const OIIO::TypeDesc& f : formats) pixelBytes += f.size();
-  std::vector<std::byte> packed(pixelBytes * image.pixels());
-  for (size_t i = 0; i < image.pixels(); ++i) {
-    std::byte* at = packed.data() + i * pixelBytes;
-    for (int c = 0; c < 4; ++c) {
-      if (extras.floatPixels) {
-        float v = image.channel(i, c);
-        std::memcpy(at, &v, 4), at += 4;
-      } else {
-        uint16_t h = image.rgba.empty() ? image.rgbaHalf[4 * i + size_t(c)] : glm::packHalf1x16(image.rgba[i][c]);
-        std::memcpy(at, &h, 2), at += 2;
-      }
-    }
-    for (const AovLayer& layer : extras.aovs) {
-      for (size_t c = 0; c < layer.channels.size(); ++c) {
-        size_t k = i * layer.channels.size() + c;
-        if (layer.integer) {
-          std::memcpy(at, &layer.ids[k], 4), at += 4;
-        } else if (extras.floatPixels) {
-          std::memcpy(at, &layer.values[k], 4), at += 4;
-        } else {
-          uint16_t h = glm::packHalf1x16(layer.values[k]);
-          std::memcpy(at, &h, 2), at += 2;
-        }
-      }
-    }
-  }
-  OIIO::ImageSpec spec(int(image.width), int(image.height), int(names.size()), colourType);
-  spec.channelnames = names;
-  spec.channelformats = formats;
-  spec.alpha_channel = 3;
-  spec.attribute("oiio:ColorSpace", "Linear");
-  spec.attribute("compression", "zip");
-  spec.attribute("Software", std::string("snell ") + version());
-  for (const auto& [name, value] : extras.text) spec.attribute(name, value);
-  for (const auto& [name, value] : extras.numbers) spec.attribute(name, value);
-  if (extras.hasWorldToCamera) spec.attribute("worldToCamera", OIIO::TypeMatrix, &extras.worldToCamera);
-  auto out = OIIO::ImageOutput::create(temp);
-  if (!out) throw std::runtime_error(path + ": cannot write EXR (" + OIIO::geterror() + ")");
-  if (!out->open(temp, spec) || !out->write_image(OIIO::TypeDesc::UNKNOWN, packed.data()) || !out->close()) {
-    throw std::runtime_error(path + ": " + out->geterror());
-  }
-}
-
-}  // namespace
-#endif
-
 void writeImage(const std::string& path, const LinearImage& image, const ImageExtras& extras) {
   std::string ext = lowerExtension(path);
   if (ext != ".png" && ext != ".exr") {
@@ -153,9 +115,7 @@ void writeImage(const std::string& path, const LinearImage& image, const ImageEx
       writeBytes(path, temp, pngBytes(image.width, image.height, toSrgb8(image).rgb));
       return;
     }
-#if SNELL_WITH_OPENIMAGEIO
-    writeExr(path, temp, image, extras);
-#endif
+    exrCodec(path).write(path, temp, image, extras, std::string("snell ") + version());
   });
 }
 
@@ -207,29 +167,12 @@ scene::Environment readEnvironment(const std::string& path) {
       for (int c = 0; c < 3; ++c) env.texels[i][c] = float(scene::srgbToLinear(image.rgb[3 * i + size_t(c)]));
     }
   } else {
-#if SNELL_WITH_OPENIMAGEIO
-    auto in = OIIO::ImageInput::open(path);
-    if (!in) throw std::runtime_error(path + ": cannot read the environment (" + OIIO::geterror() + ")");
-    const OIIO::ImageSpec& spec = in->spec();
-    if (spec.width <= 0 || spec.height <= 0 || spec.nchannels < 1 || spec.width > 65536 || spec.height > 65536) {
-      throw std::runtime_error(path + ": an environment of " + std::to_string(spec.width) + "x" +
-                               std::to_string(spec.height) + " texels and " + std::to_string(spec.nchannels) +
-                               " channels cannot be used");
-    }
-    env.width = uint32_t(spec.width);
-    env.height = uint32_t(spec.height);
-    int channels = spec.nchannels;
-    std::vector<float> pixels(size_t(env.width) * env.height * size_t(channels));
-    if (!in->read_image(0, 0, 0, channels, OIIO::TypeDesc::FLOAT, pixels.data())) {
-      throw std::runtime_error(path + ": cannot read the environment's pixels (" + in->geterror() + ")");
-    }
+    int channels = 0;
+    const std::vector<float> pixels = exrCodec(path).read(path, env.width, env.height, channels);
     env.texels.resize(size_t(env.width) * env.height);
     for (size_t i = 0; i < env.texels.size(); ++i) {
       for (int c = 0; c < 3; ++c) env.texels[i][c] = pixels[i * size_t(channels) + size_t(std::min(c, channels - 1))];
     }
-#else
-    throw std::runtime_error(path + ": this build has no OpenImageIO, so only .png environments");
-#endif
   }
   scene::fitEnvironment(env);
   return env;
@@ -242,43 +185,17 @@ void writeBytesFile(const std::string& path, const std::vector<uint8_t>& bytes) 
 void writeRgbaFloatExr(const std::string& path, uint32_t width, uint32_t height, const std::vector<float>& rgba,
                        const std::string& content) {
   if (lowerExtension(path) != ".exr") throw std::runtime_error(path + ": not an .exr name");
-#if SNELL_WITH_OPENIMAGEIO
-  writeAtomically(path, [&](const std::string& temp) {
-    OIIO::ImageSpec spec(int(width), int(height), 4, OIIO::TypeDesc::FLOAT);
-    spec.channelnames = {"R", "G", "B", "A"};
-    spec.attribute("compression", "zip");
-    if (!content.empty()) spec.attribute("snell:content", content);
-    auto out = OIIO::ImageOutput::create(temp);
-    if (!out) throw std::runtime_error(path + ": cannot write EXR (" + OIIO::geterror() + ")");
-    if (!out->open(temp, spec) || !out->write_image(OIIO::TypeDesc::FLOAT, rgba.data()) || !out->close()) {
-      throw std::runtime_error(path + ": " + out->geterror());
-    }
-  });
-#else
-  (void)width, (void)height, (void)rgba, (void)content;
-  throw std::runtime_error(path + ": this build has no OpenImageIO, so no EXR");
-#endif
+  const ExrCodec& codec = exrCodec(path);
+  writeAtomically(path, [&](const std::string& temp) { codec.writeRgbaFloat(path, temp, width, height, rgba, content); });
 }
 
 std::vector<float> readRgbaFloatExr(const std::string& path, uint32_t& width, uint32_t& height) {
-#if SNELL_WITH_OPENIMAGEIO
-  auto in = OIIO::ImageInput::open(path);
-  if (!in) throw std::runtime_error(path + ": cannot read (" + OIIO::geterror() + ")");
-  const OIIO::ImageSpec& spec = in->spec();
-  if (spec.nchannels != 4 || spec.width <= 0 || spec.height <= 0) {
-    throw std::runtime_error(path + ": 4 channels (RGBA) were expected, this has " + std::to_string(spec.nchannels));
-  }
-  width = uint32_t(spec.width);
-  height = uint32_t(spec.height);
-  std::vector<float> rgba(size_t(width) * height * 4);
-  if (!in->read_image(0, 0, 0, 4, OIIO::TypeDesc::FLOAT, rgba.data())) {
-    throw std::runtime_error(path + ": cannot read the pixels (" + in->geterror() + ")");
+  int channels = 0;
+  std::vector<float> rgba = exrCodec(path).read(path, width, height, channels);
+  if (channels != 4) {
+    throw std::runtime_error(path + ": 4 channels (RGBA) were expected, this has " + std::to_string(channels));
   }
   return rgba;
-#else
-  (void)width, (void)height;
-  throw std::runtime_error(path + ": this build has no OpenImageIO, so no EXR");
-#endif
 }
 
 PngRgba readPngRgba(const std::string& path) {

@@ -8,6 +8,7 @@
 #include "scene/optics.h"
 
 #include <glm/glm.hpp>
+#include <glm/gtc/packing.hpp>
 
 #include <cstdint>
 #include <string>
@@ -24,7 +25,9 @@ struct LinearImage {
 
   size_t pixels() const { return size_t(width) * height; }
   /// Pixel i's channel c, whichever way the image is held.
-  float channel(size_t i, int c) const;
+  float channel(size_t i, int c) const {
+    return rgba.empty() ? glm::unpackHalf1x16(rgbaHalf[4 * i + size_t(c)]) : rgba[i][c];
+  }
 };
 
 /// Extra channels for an EXR, named the way compositors read layers:

@@ -24,6 +24,7 @@ for f in ./usr/bin/snell ./usr/include/snell/snell.h ./usr/lib/cmake/snell/snell
   grep -qxF "$f" "$work/contents" || fail "the package lacks $f"
 done
 grep -qE '^\./usr/lib/(.*/)?libsnell\.so\.[0-9]' "$work/contents" || fail "the package lacks libsnell.so"
+grep -qE '^\./usr/lib/(.*/)?snell/libsnell_exr\.so$' "$work/contents" || fail "the package lacks the EXR module"
 grep -qE '^\./usr/lib/python3/dist-packages/snell/_snell\..*\.so$' "$work/contents" || fail "the package lacks the module's extension"
 if grep -q "__pycache__\|/tests/\|snell_tests" "$work/contents"; then fail "the package holds build or test files"; fi
 
@@ -42,6 +43,10 @@ dpkg-deb -x "$deb" "$work/root"
 "$work/root/usr/bin/snell" eye -o "$work/eye.glb" >/dev/null
 "$work/root/usr/bin/snell" render "$work/eye.glb" -o "$work/eye.png" --size 64x48 -q
 [ "$(head -c 8 "$work/eye.png" | od -An -tx1 | tr -d ' \n')" = 89504e470d0a1a0a ] || fail "the unpacked command wrote no PNG"
+# EXR through the package's own OpenImageIO module (usr/lib/snell), found beside the command, not the build's.
+LD_DEBUG=files "$work/root/usr/bin/snell" render "$work/eye.glb" -o "$work/eye.exr" --size 64x48 -q 2>"$work/ld.log"
+[ "$(head -c 4 "$work/eye.exr" | od -An -tx1 | tr -d ' \n')" = 762f3101 ] || fail "the unpacked command wrote no EXR"
+grep -q "file=$work/root/usr/lib/.*snell/libsnell_exr.so" "$work/ld.log" || fail "the EXR module did not come from the package"
 PYTHONPATH="$work/root/usr/lib/python3/dist-packages" /usr/bin/python3 - "$work/eye.glb" <<'PY' || fail "the unpacked module does not render"
 import sys
 import snell
