@@ -3,6 +3,8 @@
 // twin, ref::refineOnCpu) against OpenSubdiv's own refinement of the same
 // cage, and bad cages.
 #include "ref/refine.h"
+#include "scene/scene_builder.h"
+#include "scene/scene_summary.h"
 #include "scene/subdivision.h"
 
 #include <opensubdiv/far/primvarRefiner.h>
@@ -167,6 +169,33 @@ TEST(Subdivision, ACatmullClarkCubeAtLevelTwoHas98VerticesAnd96Quads) {
   EXPECT_EQ(shape.triangleCount(), 192u);  // two a quad
   EXPECT_EQ(shape.cageVertices, 8u);
   EXPECT_EQ(shape.writtenVertexCount(), 8u);
+}
+
+// Each refined triangle knows its cage face, so a material per face splits
+// the surface into parts of one vertex set; the summary counts them all once.
+TEST(Subdivision, ACubeSplitByFaceMaterialsKeepsItsVerticesOnceAndEveryTriangle) {
+  scene::Scene s;
+  scene::Shape shape;
+  std::vector<std::string> warnings;
+  std::vector<uint32_t> faces;
+  scene::subdivide(unitCube(), shape, "cube", warnings, scene::kMaxRefinedVertices, &faces);
+  ASSERT_EQ(faces.size(), 192u);
+  EXPECT_EQ(std::count(faces.begin(), faces.end(), 5u), 32) << "16 quads of each cage face at level 2";
+  scene::addRootShape(s, std::move(shape));
+  std::vector<int> materials;
+  for (uint32_t f : faces) materials.push_back(f == 0 ? 1 : 0);
+  s.materials.resize(2);
+  ASSERT_EQ(scene::splitByMaterial(s, 0, materials), std::vector<int>{1});
+  // The shape keeps the first material met (cage face 0's), the part takes the other five faces.
+  EXPECT_EQ(s.shapes[0].material, 1);
+  EXPECT_EQ(s.shapes[0].triangleCount(), 32u);
+  EXPECT_EQ(s.shapes[1].material, 0);
+  EXPECT_EQ(s.shapes[1].triangleCount(), 160u);
+  EXPECT_EQ(s.meshes[0].shapes, (std::vector<int>{0, 1})) << "the part is drawn wherever its source is";
+  const scene::SceneSummary summary = scene::summarize(s);
+  EXPECT_EQ(summary.vertices, 98u) << "the part's vertices are its source's";
+  EXPECT_EQ(summary.triangles, 192u);
+  EXPECT_NE(scene::describe(s).find("98 vertices and 192 triangles"), std::string::npos) << scene::describe(s);
 }
 
 TEST(Subdivision, TheRefinedCubeIsRoundedInsideItsCageWithNormalsPointingOut) {

@@ -101,12 +101,15 @@ std::string describe(const Scene& scene, uint32_t width, uint32_t height) {
   }
   if (s.subdividedShapes) {
     out << "  subdivision surfaces " << s.subdividedShapes << " (refined on the GPU when their cage moves)\n";
-    for (const Shape& shape : scene.shapes) {
+    for (size_t i = 0; i < scene.shapes.size(); ++i) {
+      const Shape& shape = scene.shapes[i];
       if (!shape.refinement || shape.part()) continue;
       const Refinement& r = *shape.refinement;
+      size_t triangles = 0;  // every material's: the shape's and its parts'
+      for (const Shape& s : scene.shapes) triangles += &s == &shape || s.vertexSource == int(i) ? s.triangleCount() : 0;
       out << "    " << (shape.name.empty() ? "(unnamed)" : "'" + shape.name + "'") << ": " << schemeName(r.scheme)
           << " level " << r.level << ", cage " << r.cageVertices << " vertices and " << r.cageFaces << " faces -> "
-          << shape.vertexCount() << " vertices and " << shape.triangleCount() << " triangles"
+          << shape.vertexCount() << " vertices and " << triangles << " triangles"
           << (r.limitSurface ? ", on the limit surface" : "")
           << (r.normals == SubdivisionNormals::Limit ? ", limit normals" : ", mesh normals") << ", tables "
           << mebibytes(r.bytes()) << "\n";
