@@ -103,9 +103,8 @@ void writeImage(const std::string& path, const LinearImage& image, const ImageEx
     throw std::runtime_error(path + ": unsupported image type '" + ext + "' (use .png or .exr)");
   }
   if (ext == ".png" && !extras.aovs.empty()) throw std::runtime_error(path + ": AOV layers need an .exr file");
-#if !SNELL_WITH_OPENIMAGEIO
-  if (ext == ".exr") throw std::runtime_error(path + ": this build has no OpenImageIO, so no EXR; write a .png");
-#endif
+  // Before any file is made: a build without OpenImageIO, or a module that does not load, refuses here.
+  const ExrCodec* exr = ext == ".exr" ? &exrCodec(path) : nullptr;
   if ((image.rgba.empty() ? image.rgbaHalf.size() / 4 : image.rgba.size()) != image.pixels()) {
     throw std::runtime_error(path + ": the pixels do not fill a " + std::to_string(image.width) + "x" +
                              std::to_string(image.height) + " image");
@@ -115,7 +114,7 @@ void writeImage(const std::string& path, const LinearImage& image, const ImageEx
       writeBytes(path, temp, pngBytes(image.width, image.height, toSrgb8(image).rgb));
       return;
     }
-    exrCodec(path).write(path, temp, image, extras, std::string("snell ") + version());
+    exr->write(path, temp, image, extras, std::string("snell ") + version());
   });
 }
 

@@ -197,10 +197,7 @@ class StageContents:
                 source.drop_cage(read_normals(source.mesh, source.topology, time, self.problems))
                 self._initial[id(source)] = source.pose(time, SkelFrame(time))
                 continue
-            source.cage.level = level
-            for part in source.parts:
-                if part.cage is not None:
-                    part.cage.level = level
+            source.cage.level = level  # the cage's one part holds this Subdivision itself
         if lowered:
             paths = {id(source): source.path for source in cages}
             named = ", ".join(sorted(f"{paths[key]} ({level})" for key, level in lowered.items()))
