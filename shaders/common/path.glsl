@@ -59,6 +59,11 @@ uint firstTriangleOf(uint instance);
 
 // ------------------------------------------------------------------ shading
 
+// A miss's material (tracePath): no textures, glass of IOR 1.
+const GpuTextureSlot kNoSlot = GpuTextureSlot(vec4(0.0), vec4(0.0), kNoTexture, 0u, 0.0, 0u);
+const GpuMaterial kNoMaterial = GpuMaterial(vec4(0.0), vec4(0.0), vec4(0.0), 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, kNoSlot,
+                                            kNoSlot, kNoSlot, kNoSlot, 1.0, 0.0, kAlphaOpaque, 0u);
+
 struct Surface {
   vec3 position;  // camera-relative world space
   vec3 ng;        // geometric normal, unit
@@ -214,8 +219,11 @@ bool tracePath(vec3 origin, vec3 dir, float width, float spread, int channel, ou
     Hit hit = traceClosest(origin, dir, skipInstance, skipPrim, leaving);
     ++segments;
     if (traceFlag(kTraceFlagAov) && leaving != 0.0) path.shortestSegment = min(path.shortestSegment, hit.t);
-    Surface s;
-    GpuMaterial m;
+    // Set on a miss too: left unset there, to a compiler they carried the last
+    // segment's surface and material through the next walk, live in registers
+    // the walk wanted (on an H100 the untextured trace took 128, now 96).
+    Surface s = Surface(vec3(0.0), vec3(0.0), vec3(0.0), vec4(0.0), vec2(0.0), vec2(0.0), 0u);
+    GpuMaterial m = kNoMaterial;
     bool opaque = false;
     float hitWidth = width + spread * hit.t;  // the cone where it meets the face
     // The face's base colour texel (and its alpha), its second texture's (an
