@@ -27,11 +27,12 @@
 # `build` (the GPU machine has no RADV), and puts both side by side in $OUT/pipelines.md. BUILDS
 # (names, space-separated) limits `run` to some of the carried builds, and NAME+VAR=VALUE runs build
 # NAME with VAR=VALUE set (an experiment's switch); ROWS limits it to some rows (same, trace, viewport,
-# registers, pipelines).
+# registers, pipelines, plain). ROWS=plain times the trace on both spheres with a grey floor
+# (make_sphere.py --plain): the pipeline without texture sampling, whose registers are the walk's.
 set -uo pipefail
 cd "$(dirname "$0")/.."
 
-usage() { sed -n '2,23p' "$0" | sed 's/^# \{0,1\}//'; }
+usage() { awk 'NR > 1 && !/^#/ { exit } NR > 1 { sub(/^# ?/, ""); print }' "$0"; }
 
 # The Vulkan loader and what a device build links that the GPU machine's image lacks.
 carry_runtime() {
@@ -110,6 +111,8 @@ run_all() {
   [[ -f $scenes/sphere-100k.gltf ]] || {
     python3 bench/make_sphere.py 100000 $scenes/sphere-100k.gltf
     python3 bench/make_sphere.py 1000000 $scenes/sphere-1m.gltf
+    python3 bench/make_sphere.py --plain 100000 $scenes/sphere-100k-plain.gltf
+    python3 bench/make_sphere.py --plain 1000000 $scenes/sphere-1m-plain.gltf
   } >/dev/null
   # Each build keeps its own warm pipeline caches: what is timed is the frames, not the compiles.
   export __GL_SHADER_DISK_CACHE_PATH=/tmp/compare-nv
@@ -126,8 +129,11 @@ run_all() {
     for b in "${order[@]}"; do
       export SNELL_PIPELINE_CACHE=/tmp/compare-cache-${b//[^A-Za-z0-9_.-]/_}
       mkdir -p "$SNELL_PIPELINE_CACHE"
-      if [[ $rows == *trace* ]]; then
-        for s in sphere-100k sphere-1m eye; do
+      local traced=()
+      [[ $rows == *trace* ]] && traced+=(sphere-100k sphere-1m eye)
+      [[ $rows == *plain* ]] && traced+=(sphere-100k-plain sphere-1m-plain)
+      if ((${#traced[@]})); then
+        for s in "${traced[@]}"; do
           local args=()  # bench methods draws the procedural eye without a scene
           [[ $s != eye ]] && args=("$scenes/$s.gltf")
           echo "@@ round=$round build=$b row=$s"

@@ -2,6 +2,7 @@
 
     python3 bench/make_sphere.py 1000000 sphere-1m.gltf
     python3 bench/make_sphere.py 1000000 sphere-1m-wedges.gltf 10
+    python3 bench/make_sphere.py --plain 1000000 sphere-1m-plain.gltf
 
 The sphere (IOR 1.5, transmission 1) fills most of a 16:9 frame from its
 camera, so nearly every pixel's ray crosses glass twice and lands on the
@@ -14,6 +15,9 @@ With WEDGES the same sphere is written as that many instances of one wedge
 the same picture from a bottom-level tree a WEDGES-th the size, with the top
 level above it. Beside the single mesh it tells what the tree's footprint in
 the caches costs the trace (issue 40, step 0).
+
+With --plain the floor is grey, without its texture: the trace compiled
+without texture sampling, whose registers are the walk's (issue 53, step 5).
 """
 
 from __future__ import annotations
@@ -45,8 +49,10 @@ def sphere(triangles: int, wedges: int = 1):
 
 
 def main(argv: list[str]) -> None:
+    plain = "--plain" in argv
+    argv = [a for a in argv if a != "--plain"]
     if len(argv) not in (2, 3):
-        raise SystemExit("usage: make_sphere.py TRIANGLES OUT.gltf [WEDGES]")
+        raise SystemExit("usage: make_sphere.py [--plain] TRIANGLES OUT.gltf [WEDGES]")
     wedges = int(argv[2]) if len(argv) == 3 else 1
     positions, normals, indices = sphere(int(argv[0]), wedges)
     floor = np.float32([[-8, -1.2, -8], [8, -1.2, -8], [8, -1.2, 8], [-8, -1.2, 8]])
@@ -117,12 +123,15 @@ def main(argv: list[str]) -> None:
         "bufferViews": views,
     }
     document["extensionsUsed"].append("KHR_lights_punctual")
+    if plain:
+        del document["textures"], document["images"]
+        document["materials"][1]["pbrMetallicRoughness"] = {"baseColorFactor": [0.6, 0.6, 0.6, 1.0], "metallicFactor": 0.0}
     out = Path(argv[1])
     (out.with_suffix(".bin")).write_bytes(bytes(blob))
     document["buffers"] = [{"byteLength": len(blob), "uri": out.with_suffix(".bin").name}]
     out.write_text(json.dumps(document))
     what = f"{wedges} wedges of {len(indices)} triangles" if wedges > 1 else f"{len(indices)} triangles"
-    print(f"{out}: a glass sphere of {what} over a checkered floor")
+    print(f"{out}: a glass sphere of {what} over a {'grey' if plain else 'checkered'} floor")
 
 
 if __name__ == "__main__":
