@@ -16,14 +16,20 @@ vec3 srgbToLinear(uint rgba) {
   return vec3(srgbDecode[rgba & 0xffu], srgbDecode[(rgba >> 8) & 0xffu], srgbDecode[(rgba >> 16) & 0xffu]);
 }
 
+// i modulo n, in [0, n): one remainder, whichever sign GLSL's % gives it.
+int floorMod(int i, int n) {
+  int m = i % n;
+  return m < 0 ? m + n : m;
+}
+
 int wrapIndex(int i, int size, uint mode) {
   if (mode == kWrapClamp) return clamp(i, 0, size - 1);
   if (mode == kWrapMirror) {
     int period = 2 * size;
-    int m = ((i % period) + period) % period;
+    int m = floorMod(i, period);
     return m < size ? m : period - 1 - m;
   }
-  return ((i % size) + size) % size;
+  return floorMod(i, size);
 }
 
 // One mip level of a texture: where it starts in its page and its size.

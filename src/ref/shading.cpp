@@ -22,13 +22,19 @@ uint32_t wrapMode(bool repeat, bool mirror) {
   return repeat ? gpu::kWrapRepeat : gpu::kWrapClamp;
 }
 
+// i modulo n, in [0, n).
+int64_t floorMod(int64_t i, int64_t n) {
+  int64_t m = i % n;
+  return m < 0 ? m + n : m;
+}
+
 int64_t wrapIndex(int64_t i, int64_t n, uint32_t mode) {
   if (mode == gpu::kWrapClamp) return std::clamp<int64_t>(i, 0, n - 1);
   if (mode == gpu::kWrapMirror) {
-    int64_t m = ((i % (2 * n)) + 2 * n) % (2 * n);
+    int64_t m = floorMod(i, 2 * n);
     return m < n ? m : 2 * n - 1 - m;
   }
-  return ((i % n) + n) % n;
+  return floorMod(i, n);
 }
 
 glm::dvec4 bilinear(const LinearTexture& t, size_t level, const glm::dvec2& uv, bool srgb) {
