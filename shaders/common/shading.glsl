@@ -65,7 +65,7 @@ vec4 bilinear(GpuTexture tex, uint level, vec2 uv, bool srgb) {
   vec2 f = p - base;
   int x = int(base.x), y = int(base.y);
   // The four corners from one call site of texel(), rolled (see sampleTexture).
-  vec4 top, bottom, left;
+  vec4 top = vec4(0.0), bottom = vec4(0.0), left = vec4(0.0);  // set before the loop, as tracePath's surface is
   [[dont_unroll]] for (int k = 0; k < 4; ++k) {
     vec4 c = texel(tex, m, x + (k & 1), y + (k >> 1), srgb);
     if (k == 1) top = mix(left, c, f.x);
@@ -167,6 +167,7 @@ vec3 normalMapped(vec3 ns, vec3 ng, vec3 t, vec3 b, vec3 texel, float scale) {
 // towards it and the irradiance it brings; lightCount 0 means the headlight
 // shining along `headlight`. False where it has no direction (a light on the point).
 bool lightAt(uint i, uint lightCount, vec3 headlight, vec3 position, out vec3 l, out vec3 e) {
+  l = e = vec3(0.0);  // set on every return, as tracePath's surface is (path.glsl)
   if (lightCount == 0u) {
     l = -headlight;
     e = vec3(kHeadlight);

@@ -107,6 +107,7 @@ float enterBox(ShearedRay r, vec3 lo, vec3 hi, float tMax) {
 // the other way, out of the side the ray went to, is a corner the ray
 // clips, and is hit.
 float intersectTriangle(ShearedRay r, uint tri, float leaving, float tMax, float cullSign, out vec3 bary) {
+  bary = vec3(0.0);  // set on every return (path.glsl: tracePath's surface)
   precise vec3 A = vertexAt(indices[3u * tri]) - r.origin;
   precise vec3 B = vertexAt(indices[3u * tri + 1u]) - r.origin;
   precise vec3 C = vertexAt(indices[3u * tri + 2u]) - r.origin;
