@@ -59,7 +59,7 @@ uint firstTriangleOf(uint instance);
 
 // ------------------------------------------------------------------ shading
 
-// A miss's material (tracePath): no textures, glass of IOR 1.
+// A miss's material (tracePath): no textures; never shaded, only a defined value.
 const GpuTextureSlot kNoSlot = GpuTextureSlot(vec4(0.0), vec4(0.0), kNoTexture, 0u, 0.0, 0u);
 const GpuMaterial kNoMaterial = GpuMaterial(vec4(0.0), vec4(0.0), vec4(0.0), 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, kNoSlot,
                                             kNoSlot, kNoSlot, kNoSlot, 1.0, 0.0, kAlphaOpaque, 0u);
