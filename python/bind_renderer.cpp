@@ -133,9 +133,10 @@ void bindRenderer(py::module_& m) {
       .def("close", [](PySharedImage& s) { s.image.reset(); });
 
   py::class_<PyRenderer>(m, "Renderer", "Draws views of one scene, updating only what changed between frames.")
-      .def(py::init([](const PyDevice& device, const PyScene& scene, uint32_t framesInFlight) {
+      .def(py::init([](const PyDevice& device, const PyScene& scene, uint32_t framesInFlight, bool compactTrees) {
              snell::RendererOptions options;
              options.framesInFlight = framesInFlight;
+             options.compactTrees = compactTrees;
              std::shared_ptr<snell::Device> d = device.device;
              std::shared_ptr<snell::Scene> s = scene.scene;
              if (!d) throw snell::Error("the device is closed");
@@ -144,7 +145,9 @@ void bindRenderer(py::module_& m) {
              snell::Renderer r(*d, *s, options);
              return PyRenderer{std::make_shared<RendererState>(RendererState{d, s, std::move(r)})};
            }),
-           "device"_a, "scene"_a, "frames_in_flight"_a = 2, "Uploads the scene to the device.")
+           "device"_a, "scene"_a, "frames_in_flight"_a = 2, "compact_trees"_a = false,
+           "Uploads the scene to the device. compact_trees: trees of 40 bytes a triangle (88 by default), whose "
+           "walk is slower and draws the same pictures.")
       .def("set_time", [](PyRenderer& r, double seconds) { r.get().renderer.setTime(seconds); }, "seconds"_a,
            "Poses a glTF scene at `seconds` (animations, morphs, skins).")
       .def_property_readonly("instance_count", [](const PyRenderer& r) { return r.get().renderer.instanceCount(); })

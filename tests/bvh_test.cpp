@@ -103,7 +103,7 @@ bool contains(const float* outerLo, const float* outerHi, const float* lo, const
 
 // Walks one group's tree; returns its primitives and checks that every box
 // (as stored: quantised, so rounded outwards) holds the exact box of the
-// triangles below it, the parent links, the refit arrival bits, and that
+// triangles below it, that the exact child boxes the trace reads are that box, the parent links, the refit arrival bits, and that
 // every reference stays inside the group's own slots.
 std::multiset<uint32_t> walk(const BvhSnapshot& s, uint32_t group, const Soup& soup) {
   std::multiset<uint32_t> seen;
@@ -132,6 +132,11 @@ std::multiset<uint32_t> walk(const BvhSnapshot& s, uint32_t group, const Soup& s
       }
       render::BoxFloats exact = subtree(child), stored = BvhSnapshot::childBox(node, c);
       EXPECT_TRUE(contains(&stored[0], &stored[3], &exact[0], &exact[3])) << "child " << c << " of node " << ref;
+      if (!s.exactChildBoxes.empty()) {  // the trace's exact boxes are the subtree's, to the bit
+        render::BoxFloats kept = s.exactChildBoxes[2 * size_t(ref) + size_t(c)], expected = exact;
+        if (!(exact[0] <= exact[3] && exact[1] <= exact[4] && exact[2] <= exact[5])) expected.fill(INFINITY);  // empty
+        EXPECT_EQ(kept, expected) << "exact box of child " << c << " of node " << ref;
+      }
       for (int k = 0; k < 3; ++k) {
         box[size_t(k)] = std::min(box[size_t(k)], exact[size_t(k)]);
         box[size_t(k) + 3] = std::max(box[size_t(k) + 3], exact[size_t(k) + 3]);

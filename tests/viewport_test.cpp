@@ -220,9 +220,10 @@ class MaskedLanes : public GpuTest {
     const render::FrameResult& r = renderer.wait(renderer.submit(request));
     return {r.views.at(0).composite, r.stats};
   }
-  LanesFrame drawWith(uint32_t lanes) {
+  LanesFrame drawWith(uint32_t lanes, bool compactTrees = false) {
     render::RendererOptions options;
     options.traceLanes = lanes;
+    options.compactTrees = compactTrees;
     render::Renderer renderer(context(), scene_, pose_, options);
     return draw(renderer);
   }
@@ -242,6 +243,18 @@ TEST_F(MaskedLanes, SeveralLanesAPixelDrawWhatOneLaneDraws) {
     EXPECT_EQ(several.stats.traceLanes, lanes);
     EXPECT_EQ(several.stats.pixelsTraced, one.stats.pixelsTraced);
     EXPECT_TRUE(several.composite == one.composite) << lanes << " lanes a pixel composited another picture";
+  }
+}
+
+// Compact trees keep only each node's quantised child boxes, which hold the
+// exact ones the walk reads by default: one lane or several, a pixel's
+// nearest hit is the same face, and the picture the same, bit for bit.
+TEST_F(MaskedLanes, CompactTreesDrawWhatExactChildBoxesDraw) {
+  for (uint32_t lanes : {1u, 4u}) {
+    if (lanes > context().facts().minSubgroupSize) continue;
+    LanesFrame exact = drawWith(lanes), compact = drawWith(lanes, true);
+    ASSERT_GT(exact.stats.pixelsTraced, 0u);
+    EXPECT_TRUE(compact.composite == exact.composite) << lanes << " lanes a pixel";
   }
 }
 

@@ -17,12 +17,15 @@ layout(local_size_x = 64) in;  // one kTraceTile x kTraceTile tile of pixels
 #include "../common/dispatch.glsl"
 layout(push_constant) uniform Push { TracePush pc; };
 layout(constant_id = kTraceSpecLanes) const uint kLanes = 1u;
+layout(constant_id = kTraceSpecChildBoxes) const bool kExactChildBoxes = false;
 
 // Nodes are 40 bytes: read as five 8-byte words rather than ten 4-byte ones.
 layout(std430, binding = kTraceBindingTlasNodes) readonly buffer TlasNodes { uvec2 tlasWords[]; };
 layout(std430, binding = kTraceBindingTlasGroups) readonly buffer TlasGroups { BvhGroup tlasGroups[]; };
 layout(std430, binding = kTraceBindingBlasNodes) readonly buffer BlasNodes { uvec2 blasWords[]; };
 layout(std430, binding = kTraceBindingBlasGroups) readonly buffer BlasGroups { BvhGroup blasGroups[]; };
+layout(std430, binding = kTraceBindingTlasChildBoxes) readonly buffer TlasChildBoxes { vec4 tlasChildBoxes[]; };
+layout(std430, binding = kTraceBindingBlasChildBoxes) readonly buffer BlasChildBoxes { vec4 blasChildBoxes[]; };
 layout(std430, binding = kTraceBindingEnvironment) readonly buffer Environment { vec4 environment[]; };
 layout(binding = kTraceBindingImage, rgba16f) uniform writeonly image2D outImage;
 layout(std430, binding = kTraceBindingAov) writeonly buffer Aovs { TraceAov aovs[]; };
@@ -159,16 +162,36 @@ BvhNode blasNode(uint i) {
   return nodeFromWords(blasWords[w], blasWords[w + 1u], blasWords[w + 2u], blasWords[w + 3u], blasWords[w + 4u]);
 }
 
-// The children of `node` the ray enters before tMax, nearer first: their
-// entry distances (kInf where missed or empty) and references.
-void enterChildren(BvhNode node, ShearedRay r, float tMax, out float tNear, out float tFar, out uint nearRef,
-                   out uint farRef) {
+// A node's two children's boxes as the walk tests them: lo0 hi0 lo1 hi1 in
+// three vec4s, as shared/bvh.h keeps exact child boxes.
+struct ChildBoxes {
+  vec4 a, b, c;
+};
+
+// Node `slot` of a level: its exact child boxes where the trees keep them,
+// else its own quantised ones, decoded.
+ChildBoxes childBoxes(BvhNode node, uint slot, bool top) {
+  if (kExactChildBoxes) {
+    uint i = 3u * slot;
+    return top ? ChildBoxes(tlasChildBoxes[i], tlasChildBoxes[i + 1u], tlasChildBoxes[i + 2u])
+               : ChildBoxes(blasChildBoxes[i], blasChildBoxes[i + 1u], blasChildBoxes[i + 2u]);
+  }
   vec3 lo0, hi0, lo1, hi1;
   decodeChild(node, 0u, lo0, hi0);
   decodeChild(node, 1u, lo1, hi1);
-  // An empty child (its triangles dropped as non-finite) is never entered.
-  float t0 = lo0.x <= hi0.x ? enterBox(r, lo0, hi0, tMax) : kInf;
-  float t1 = lo1.x <= hi1.x ? enterBox(r, lo1, hi1, tMax) : kInf;
+  return ChildBoxes(vec4(lo0, hi0.x), vec4(hi0.yz, lo1.xy), vec4(lo1.z, hi1));
+}
+
+// The children of `node` the ray enters before tMax, nearer first: their
+// entry distances (kInf where missed or empty) and references.
+void enterChildren(BvhNode node, ChildBoxes b, ShearedRay r, float tMax, out float tNear, out float tFar,
+                   out uint nearRef, out uint farRef) {
+  vec3 lo0 = b.a.xyz, hi0 = vec3(b.a.w, b.b.xy), lo1 = vec3(b.b.zw, b.c.x), hi1 = b.c.yzw;
+  // An empty child (its triangles dropped as non-finite) is never entered:
+  // an exact one is the point at +infinity, which no slab enters, a decoded
+  // one has its low x above its high x.
+  float t0 = kExactChildBoxes || lo0.x <= hi0.x ? enterBox(r, lo0, hi0, tMax) : kInf;
+  float t1 = kExactChildBoxes || lo1.x <= hi1.x ? enterBox(r, lo1, hi1, tMax) : kInf;
   bool swapOrder = t1 < t0;
   tNear = min(t0, t1);
   tFar = max(t0, t1);
@@ -179,12 +202,12 @@ void enterChildren(BvhNode node, ShearedRay r, float tMax, out float tNear, out 
 // A visit that entered no child, counted for the AOV (TraceAov::deadVisits),
 // and whether the nearest hit alone culled them: the ray enters one beyond
 // it. Only the AOV's pipelines test the node's children again.
-void countDeadVisit(BvhNode node, ShearedRay r, float tNear) {
+void countDeadVisit(BvhNode node, ChildBoxes b, ShearedRay r, float tNear) {
   if (!traceFlag(kTraceFlagAov) || tNear < kInf) return;
   ++deadVisits;
   float t0, t1;
   uint ref0, ref1;
-  enterChildren(node, r, kInf, t0, t1, ref0, ref1);
+  enterChildren(node, b, r, kInf, t0, t1, ref0, ref1);
   if (t0 < kInf) ++culledVisits;
 }
 
@@ -258,8 +281,9 @@ void traverseBlas(uint instance, vec3 origin, vec3 dir, uint skipPrim, float lea
     uint nearRef, farRef;
     boxTests += 2u;
     BvhNode node = blasNode(ref);
-    enterChildren(node, r, hit.t, tNear, tFar, nearRef, farRef);
-    countDeadVisit(node, r, tNear);
+    ChildBoxes boxes = childBoxes(node, ref, false);
+    enterChildren(node, boxes, r, hit.t, tNear, tFar, nearRef, farRef);
+    countDeadVisit(node, boxes, r, tNear);
     if (tFar < kInf) {
       if ((farRef & kBvhLeafBit) != 0u) leaves[leafCount++] = farRef & ~kBvhLeafBit;
       else if (sp < kStackSize) stack[sp++] = farRef;  // a full stack drops it: only a corrupted tree is that deep
@@ -300,8 +324,9 @@ Hit traverse(vec3 origin, vec3 dir, uint skipInstance, uint skipPrim, float leav
     uint nearRef, farRef;
     boxTests += 2u;
     BvhNode node = tlasNode(ref);
-    enterChildren(node, r, hit.t, tNear, tFar, nearRef, farRef);
-    countDeadVisit(node, r, tNear);
+    ChildBoxes boxes = childBoxes(node, ref, true);
+    enterChildren(node, boxes, r, hit.t, tNear, tFar, nearRef, farRef);
+    countDeadVisit(node, boxes, r, tNear);
     // The nearer on top. A full stack drops them (only a corrupted tree is that deep): the ray still ends.
     if (tFar < kInf && sp < kStackSize) stack[sp++] = farRef;
     if (tNear < kInf && sp < kStackSize) stack[sp++] = nearRef;
@@ -380,8 +405,9 @@ Hit traverseLanes(vec3 origin, vec3 dir, uint skipInstance, uint skipPrim, float
         } else if (node < nodeEnd) {
           boxTests += 2u;
           BvhNode n = tlasNode(node);
-          enterChildren(n, world, tMax, tNear, tFar, nearRef, farRef);
-          countDeadVisit(n, world, tNear);
+          ChildBoxes boxes = childBoxes(n, node, true);
+          enterChildren(n, boxes, world, tMax, tNear, tFar, nearRef, farRef);
+          countDeadVisit(n, boxes, world, tNear);
           if (tNear < kInf) ref = nearRef;
           if (tFar < kInf) farRefGiven = farRef;
         }
@@ -400,8 +426,9 @@ Hit traverseLanes(vec3 origin, vec3 dir, uint skipInstance, uint skipPrim, float
         } else if (node >= group.first && node + 1u < end) {
           boxTests += 2u;
           BvhNode n = blasNode(node);
-          enterChildren(n, r, tMax, tNear, tFar, nearRef, farRef);
-          countDeadVisit(n, r, tNear);
+          ChildBoxes boxes = childBoxes(n, node, false);
+          enterChildren(n, boxes, r, tMax, tNear, tFar, nearRef, farRef);
+          countDeadVisit(n, boxes, r, tNear);
           if (tNear < kInf) {
             if ((nearRef & kBvhLeafBit) != 0u) leaves[leafCount++] = nearRef & ~kBvhLeafBit;
             else ref = nearRef, inst = nodeInst;

@@ -63,6 +63,7 @@ SNELL_CONST kBvhBindingBlasGroups = 16;   // BvhGroup[] of the bottom level
 SNELL_CONST kBvhBindingCounters = 17;     // uint[nodes]: arrivals of the restructuring pass
 SNELL_CONST kBvhBindingNodeStats = 18;    // uvec2[nodes]: subtree cost and leaf count (restructuring)
 SNELL_CONST kBvhBindingExactBoxes = 19;   // float[6 * nodes]: each node's exact box during a build or a refit
+SNELL_CONST kBvhBindingChildBoxes = 20;   // vec4[3 * nodes]: each node's children's exact boxes (kBvhFlagChildBoxes)
 
 SNELL_CONST kBvhSpecWorkgroupSize = 0;
 SNELL_CONST kBvhSpecSlots = 1;  // H-PLOC: window slots per invocation, window / smallest subgroup
@@ -70,6 +71,7 @@ SNELL_CONST kBvhSpecTeams = 2;  // H-PLOC: subgroups per workgroup at the smalle
 
 SNELL_CONST kBvhFlagInstances = 1u;  // leaves are instances (top level), else triangles
 SNELL_CONST kBvhFlagKeys32 = 2u;     // sort keys are 32-bit
+SNELL_CONST kBvhFlagChildBoxes = 4u; // the forest keeps each node's children's exact boxes for the trace
 
 // A node holds its two children's boxes quantised to 8 bits per coordinate
 // within its own box (Ylitie, Karras and Laine 2017 do the same for wide
@@ -77,6 +79,12 @@ SNELL_CONST kBvhFlagKeys32 = 2u;     // sort keys are 32-bit
 // for each child the number of steps to its box's faces, rounded outwards,
 // so a decoded box always holds what it bounds. A child whose low step on x
 // exceeds its high one is empty.
+//
+// Unless a forest is compact, builds and refits also keep each node's two
+// children's exact boxes beside it (kBvhBindingChildBoxes, 48 bytes: lo0 hi0
+// lo1 hi1 in three vec4s, an empty child as the point at +infinity), and the
+// trace reads those: a child test is then a slab and no decode, which is
+// most of what a walk spends (bench/results/walk-counts.md).
 // 40 bytes, total: 40 bytes
 struct BvhNode {
   float origin[3];  // 12: the node box's low corner

@@ -279,6 +279,9 @@ SNELL_CONST kTraceSpecLanes = 2;
 // they are the scene's, fixed when it is uploaded (SceneGpu::surface), and a
 // scene without them draws the same pixels with them compiled in.
 SNELL_CONST kTraceSpecSurface = 3;
+// 1: the trees keep each node's children's exact boxes (shared/bvh.h:
+// kBvhFlagChildBoxes) and the walk reads those; 0: it decodes the nodes' own.
+SNELL_CONST kTraceSpecChildBoxes = 4;
 SNELL_CONST kSurfaceTextures = 1u;      // some material reads a texture (any slot)
 SNELL_CONST kSurfaceEmissiveMaps = 2u;  // some material has an emissive texture
 SNELL_CONST kSurfaceIorMaps = 4u;       // some material has an IOR texture
@@ -302,6 +305,8 @@ SNELL_CONST kTraceBindingMask = kSceneBindingCount + 8;           // r32ui image
 SNELL_CONST kTraceBindingGeometryFirst = kSceneBindingCount + 9;  // uint[geometryCount]: first triangle (driver-rt pipeline only)
 SNELL_CONST kTraceBindingEnvironment = kSceneBindingCount + 10;   // vec4[]: (width, height, 0, 0), then width * height linear RGB texels, row 0 at +Y
 SNELL_CONST kTraceBindingHits = kSceneBindingCount + 11;          // TraceHitRecord[width * height * kTraceReplaySegments], record/replay only
+SNELL_CONST kTraceBindingTlasChildBoxes = kSceneBindingCount + 12;  // vec4[3 * nodes] (kTraceSpecChildBoxes)
+SNELL_CONST kTraceBindingBlasChildBoxes = kSceneBindingCount + 13;
 
 // A primary ray from a list, relative to the frame origin like everything the trace sees.
 // 32 bytes, total: 32 bytes

@@ -265,6 +265,7 @@ struct Renderer::Impl {
     render::RendererOptions o;
     o.framesInFlight = options.framesInFlight;
     o.passTimes = options.passTimes;
+    o.compactTrees = options.compactTrees;
     o.host = scene.host;
     o.keepVertices = scene.keep;
     renderer = std::make_unique<render::Renderer>(context, scene.scene, pose, o);

@@ -42,7 +42,7 @@ struct Options {
   float offsetStrength = render::RasterOptions{}.offsetStrength;
   std::vector<std::string> methods;  ///< empty: every method
   scene::EyeOptions eye;
-  bool optics = false, noReference = false, pipelineStats = false;
+  bool optics = false, noReference = false, pipelineStats = false, compactTrees = false;
   std::string json, svg, images;
 };
 
@@ -355,7 +355,10 @@ int runMethods(const Options& o) {
       std::printf("%s: unsupported: %s\n", results[m].name.c_str(), results[m].unsupported.c_str());
       continue;
     }
-    renderers[m] = std::make_unique<render::Renderer>(*context, *results[m].scene, results[m].frames->at(0).pose);
+    render::RendererOptions rendererOptions;
+    rendererOptions.compactTrees = o.compactTrees;
+    renderers[m] = std::make_unique<render::Renderer>(*context, *results[m].scene, results[m].frames->at(0).pose,
+                                                      rendererOptions);
     if (results[m].info.method == render::Method::RefractionMap) {
       // Baked once, by the trace, at the first frame's pose and view; every frame after drifts from it.
       const Frame& first = results[m].frames->at(0);
@@ -656,6 +659,8 @@ void addBenchMethods(CLI::App& bench, Runner& run) {
   addEyeOptions(*sub, o->eye);
   sub->add_flag("--optics", o->optics, "rows per optics feature (trace) instead of per method")->excludes(methods);
   sub->add_flag("--no-reference", o->noReference, "time only: no CPU reference, no errors (for scaling runs)");
+  sub->add_flag("--compact-trees", o->compactTrees,
+                "trees of 40 bytes a triangle, whose walk decodes quantised child boxes (default: 88, exact boxes)");
   sub->add_flag("--pipeline-stats", o->pipelineStats,
                 "print the driver's statistics of each trace pipeline (registers, spills), where it offers them");
   sub->add_option("--json", o->json, "write the results as JSON")->type_name("FILE");

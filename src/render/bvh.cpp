@@ -21,7 +21,10 @@ namespace snell::render {
 
 namespace {
 
-uint32_t flagsOf(const Bvh& bvh) { return bvh.leaves == BvhLeaves::Instances ? gpu::kBvhFlagInstances : 0u; }
+uint32_t flagsOf(const Bvh& bvh) {
+  return (bvh.leaves == BvhLeaves::Instances ? gpu::kBvhFlagInstances : 0u) |
+         (bvh.childBoxes == BvhChildBoxes::Exact ? gpu::kBvhFlagChildBoxes : 0u);
+}
 
 // One subgroup per workgroup for the passes that hand boxes from one
 // invocation to another through device atomics: lavapipe (Mesa 22.3) lost
@@ -34,7 +37,9 @@ uint32_t handOffWorkgroup(const vk::Context& context) {
 
 }  // namespace
 
-uint64_t Bvh::treeBytes() const { return nodes.size() + groups.size(); }
+uint64_t Bvh::treeBytes() const {
+  return nodes.size() + groups.size() + (childBoxes == BvhChildBoxes::Exact ? exactChildBoxes.size() : 0);
+}
 
 uint64_t Bvh::workBytes() const {
   uint64_t bytes = 0;
@@ -84,9 +89,11 @@ BvhBuilder::BvhBuilder(vk::Context& context, BvhTuning tuning)
 
 BvhBuilder::~BvhBuilder() = default;
 
-Bvh BvhBuilder::makeBvh(const std::vector<uint32_t>& groupSizes, BvhLeaves leaves, const std::string& name) const {
+Bvh BvhBuilder::makeBvh(const std::vector<uint32_t>& groupSizes, BvhLeaves leaves, const std::string& name,
+                        BvhChildBoxes childBoxes) const {
   Bvh bvh;
   bvh.leaves = leaves;
+  bvh.childBoxes = childBoxes;
   bvh.name = name;
   bvh.groupSizes = groupSizes;
   uint64_t primitives = 0;
@@ -109,6 +116,8 @@ Bvh BvhBuilder::makeBvh(const std::vector<uint32_t>& groupSizes, BvhLeaves leave
   bvh.refitEntries = vk::storageBuffer(context_, groupCount * sizeof(gpu::BvhRefitEntry), name + " refit list");
   // Every build and refit passes exact boxes up through them.
   bvh.exactBoxes = vk::storageBuffer(context_, primitives * 24, name + " exact boxes");
+  bool exact = childBoxes == BvhChildBoxes::Exact;
+  bvh.exactChildBoxes = vk::storageBuffer(context_, exact ? primitives * 48 : 16, name + " exact child boxes");
 
   std::vector<gpu::BvhGroup> groups(groupCount);
   for (size_t g = 0; g < groups.size(); ++g) {
@@ -243,6 +252,7 @@ void BvhBuilder::recordBuild(vk::Commands& commands, Bvh& bvh, const BvhInputs& 
                              {{gpu::kBvhBindingBuildEntries, &bvh.buildEntries},
                               {gpu::kBvhBindingPrimBoxes, &s.primBoxes},
                               {gpu::kBvhBindingExactBoxes, &bvh.exactBoxes},
+                              {gpu::kBvhBindingChildBoxes, &bvh.exactChildBoxes},
                               {gpu::kBvhBindingNodes, &bvh.nodes}},
                              push, positions);
   commands.computeToCompute();
@@ -304,6 +314,7 @@ void BvhBuilder::recordRefit(vk::Commands& commands, Bvh& bvh, const BvhInputs& 
                            {gpu::kBvhBindingBlasGroups, instances ? &inputs.blas->groups : &placeholder_},
                            {gpu::kBvhBindingNodes, &bvh.nodes},
                            {gpu::kBvhBindingExactBoxes, &bvh.exactBoxes},
+                           {gpu::kBvhBindingChildBoxes, &bvh.exactChildBoxes},
                            {gpu::kBvhBindingGroups, &bvh.groups},
                            {gpu::kBvhBindingStats, &bvh.stats},
                            {gpu::kBvhBindingDropped, &bvh.dropped}},
@@ -318,6 +329,10 @@ BvhSnapshot BvhBuilder::download(const Bvh& bvh) const {
   s.groups.resize(std::max<size_t>(bvh.groupSizes.size(), 1));
   std::vector<glm::uvec4> stats(s.groups.size());
   vk::download(context_, bvh.nodes, s.nodes.data(), s.nodes.size() * sizeof(gpu::BvhNode));
+  if (bvh.childBoxes == BvhChildBoxes::Exact) {
+    s.exactChildBoxes.resize(2 * s.nodes.size());
+    vk::download(context_, bvh.exactChildBoxes, s.exactChildBoxes.data(), s.exactChildBoxes.size() * sizeof(BoxFloats));
+  }
   vk::download(context_, bvh.groups, s.groups.data(), s.groups.size() * sizeof(gpu::BvhGroup));
   vk::download(context_, bvh.stats, stats.data(), stats.size() * 16);
   for (const glm::uvec4& v : stats) s.sah.push_back(sahCost(v));

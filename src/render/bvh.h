@@ -38,10 +38,17 @@ enum class BvhLeaves {
   Instances,  ///< top level
 };
 
+/// What a forest keeps of each node's two children's boxes for the trace (shared/bvh.h).
+enum class BvhChildBoxes {
+  Exact,      ///< their exact boxes in float beside the node (48 bytes more a node): no decode in a child test
+  Quantised,  ///< only the node's own 8-bit steps (40 bytes a node in all): compact trees
+};
+
 /// One forest's trees, which live as long as it does. Group g owns
 /// primitives [first[g], + groupSizes[g]) and node slots [first[g], + groupSizes[g] - 1).
 struct Bvh {
   BvhLeaves leaves = BvhLeaves::Triangles;
+  BvhChildBoxes childBoxes = BvhChildBoxes::Exact;
   std::string name;
   std::vector<uint32_t> groupSizes, first;
   uint32_t primitiveCount = 0;
@@ -51,9 +58,10 @@ struct Bvh {
   vk::Buffer dropped;  ///< uint: non-finite triangles the box passes met since the caller last zeroed it
   vk::Buffer buildEntries, refitEntries;  ///< this forest's lists, copied in per build or refit
   vk::Buffer exactBoxes;  ///< float[6] per node slot: a build's or refit's exact boxes on their way up
+  vk::Buffer exactChildBoxes;  ///< float[12] per node slot with BvhChildBoxes::Exact (else 16 unused bytes)
 
   uint32_t groupCount() const { return static_cast<uint32_t>(groupSizes.size()); }
-  /// Memory of the trees the trace reads: nodes and group records.
+  /// Memory of the trees the trace reads: nodes, their exact child boxes and group records.
   uint64_t treeBytes() const;
   /// Memory builds and refits work in besides the trees (exact boxes), and the per-group tables and lists.
   uint64_t workBytes() const;
@@ -77,6 +85,9 @@ struct BvhSnapshot {
   static BoxFloats childBox(const gpu::BvhNode& node, int c);
 
   std::vector<gpu::BvhNode> nodes;
+  /// With BvhChildBoxes::Exact, each node's children's exact boxes as the
+  /// trace reads them (child 0's at 2 n, child 1's at 2 n + 1); else empty.
+  std::vector<BoxFloats> exactChildBoxes;
   std::vector<gpu::BvhGroup> groups;
   std::vector<double> sah;  ///< per group: SAH cost its last refit measured (a multiple of the root's area)
 };
@@ -110,7 +121,8 @@ class BvhBuilder {
   static std::vector<vk::ComputeProgramDesc> programDescs(const vk::Context& context, BvhTuning tuning = {});
 
   /// Allocates a forest whose group g holds primitives [sum of earlier sizes, + groupSizes[g]).
-  Bvh makeBvh(const std::vector<uint32_t>& groupSizes, BvhLeaves leaves, const std::string& name) const;
+  Bvh makeBvh(const std::vector<uint32_t>& groupSizes, BvhLeaves leaves, const std::string& name,
+              BvhChildBoxes childBoxes = BvhChildBoxes::Exact) const;
 
   /// Records a build of the listed groups (every group when `groups` is
   /// empty; empty groups are skipped). The inputs must be visible to compute;

@@ -25,6 +25,10 @@ bool sameBytes(const std::vector<T>& a, const std::vector<T>& b) {
   return a.size() == b.size() && (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof(T)) == 0);
 }
 
+BvhChildBoxes childBoxesOf(const RendererOptions& o) {
+  return o.compactTrees ? BvhChildBoxes::Quantised : BvhChildBoxes::Exact;
+}
+
 }  // namespace
 
 // What one view does this frame, decided once from its request and where the glass is.
@@ -88,7 +92,7 @@ Renderer::Renderer(vk::Context& context, const scene::Scene& scene, const scene:
     : context_(context), sceneModel_(scene), options_(options),
       scene_(uploadScene(context, scene, pose, options.host.positions ? &options.host : nullptr)),
       trees_(context, scene_, scene.source.empty() ? std::string("scene") : scene.source, options.rebuildGrowth,
-             options.rebuildBudget),
+             options.rebuildBudget, childBoxesOf(options)),
       targets_(context), bounds_(scene) {
   if (options_.framesInFlight == 0) throw std::invalid_argument("renderer: framesInFlight must be at least 1");
   if (options_.traceLanes & (options_.traceLanes - 1) || options_.traceLanes > 8) {
@@ -102,7 +106,7 @@ Renderer::Renderer(vk::Context& context, const scene::Scene& scene, const scene:
     throw std::logic_error("deforming item without a geometry");
   });
   raster_ = std::make_unique<RasterPass>(context);
-  trace_ = std::make_unique<TracePass>(context, scene, scene_);
+  trace_ = std::make_unique<TracePass>(context, scene, scene_, childBoxesOf(options));
   std::string name = scene.source.empty() ? std::string("scene") : scene.source;
   feed_ = std::make_unique<VertexFeed>(context, scene, scene_, options_.keepVertices, name);
   size_t lightNodes = 0;

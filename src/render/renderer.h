@@ -67,6 +67,11 @@ struct RendererOptions {
   /// (no wider than the device's smallest subgroup) fixes it, for benchmarks
   /// and tests. Independent frames, which know no last count, use one.
   uint32_t traceLanes = 0;
+  /// Trees of 40 bytes a triangle: the walk decodes each node's 8-bit
+  /// quantised child boxes. Off, the trees also keep every node's children's
+  /// exact boxes (88 bytes a triangle), and the walk reads those and decodes
+  /// nothing (bench/results/walk-counts.md: how much faster).
+  bool compactTrees = false;
 };
 
 class Renderer {

@@ -29,8 +29,8 @@ struct StatisticsLayout {
 }  // namespace
 
 SceneTrees::SceneTrees(vk::Context& context, const SceneGpu& gpu, std::string name, double rebuildGrowth,
-                       uint64_t rebuildBudget)
-    : context_(context), gpu_(gpu), name_(std::move(name)), rebuildBudget_(rebuildBudget),
+                       uint64_t rebuildBudget, BvhChildBoxes childBoxes)
+    : context_(context), gpu_(gpu), name_(std::move(name)), rebuildBudget_(rebuildBudget), childBoxes_(childBoxes),
       rebuilds_(gpu.geometries.size(), rebuildGrowth), moved_(gpu.geometries.size(), 1) {
   int shapes = 0;
   for (const GeometryRange& g : gpu.geometries) shapes = std::max(shapes, g.shape + 1);
@@ -51,9 +51,9 @@ void SceneTrees::prepare() {
   builder_ = std::make_unique<BvhBuilder>(context_);
   std::vector<uint32_t> counts;
   for (const GeometryRange& g : gpu_.geometries) counts.push_back(g.triangleCount);
-  blas_ = std::make_unique<Bvh>(builder_->makeBvh(counts, BvhLeaves::Triangles, name_ + " bottom level"));
+  blas_ = std::make_unique<Bvh>(builder_->makeBvh(counts, BvhLeaves::Triangles, name_ + " bottom level", childBoxes_));
   tlas_ = std::make_unique<Bvh>(builder_->makeBvh({static_cast<uint32_t>(gpu_.itemGeometry.size())},
-                                                  BvhLeaves::Instances, name_ + " top level"));
+                                                  BvhLeaves::Instances, name_ + " top level", childBoxes_));
 }
 
 SceneTrees::Work SceneTrees::plan(bool instancesChanged, bool fresh, FrameStats& stats) {

@@ -35,7 +35,8 @@ struct ShapeBox {
 class SceneTrees {
  public:
   /// Makes nothing on the GPU until the first frame that needs trees plans.
-  SceneTrees(vk::Context& context, const SceneGpu& gpu, std::string name, double rebuildGrowth, uint64_t rebuildBudget);
+  SceneTrees(vk::Context& context, const SceneGpu& gpu, std::string name, double rebuildGrowth, uint64_t rebuildBudget,
+             BvhChildBoxes childBoxes = BvhChildBoxes::Exact);
   ~SceneTrees();
 
   /// Bottom-level group `group`'s positions changed: the next frame with trees refits it.
@@ -86,6 +87,7 @@ class SceneTrees {
   const SceneGpu& gpu_;
   std::string name_;
   uint64_t rebuildBudget_;
+  BvhChildBoxes childBoxes_;
   std::unique_ptr<BvhBuilder> builder_;
   std::unique_ptr<Bvh> blas_, tlas_;
   RebuildQueue rebuilds_;

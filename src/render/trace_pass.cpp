@@ -28,8 +28,8 @@ uint32_t opticsOfScene(const scene::Scene& scene) {
 
 }  // namespace
 
-TracePass::TracePass(vk::Context& context, const scene::Scene& scene, const SceneGpu& gpu)
-    : context_(context), sceneOptics_(opticsOfScene(scene)), sceneSurface_(gpu.surface) {
+TracePass::TracePass(vk::Context& context, const scene::Scene& scene, const SceneGpu& gpu, BvhChildBoxes childBoxes)
+    : context_(context), sceneOptics_(opticsOfScene(scene)), sceneSurface_(gpu.surface), childBoxes_(childBoxes) {
   compact_ = std::make_unique<vk::ComputeProgram>(context, compactDesc());
   placeholder_ = vk::Buffer(context, {sizeof(gpu::TracePixelListHeader), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
                                       vk::MemoryDomain::Device, "placeholder"});
@@ -74,14 +74,15 @@ bool TracePass::manyLanesNeedWave32(const vk::DeviceFacts& device) {
 }
 
 vk::ComputeProgramDesc TracePass::programDesc(const vk::DeviceFacts& device, uint32_t optics, uint32_t flags,
-                                              uint32_t lanes, uint32_t surface) {
+                                              uint32_t lanes, uint32_t surface, BvhChildBoxes childBoxes) {
   // Several lanes a pixel must share a subgroup: full subgroups keep them together.
   vk::ComputeProgramDesc desc{"trace",
                               kSpvTrace,
                               {{gpu::kTraceSpecOptics, optics},
                                {gpu::kTraceSpecFlags, flags},
                                {gpu::kTraceSpecLanes, lanes},
-                               {gpu::kTraceSpecSurface, surface}},
+                               {gpu::kTraceSpecSurface, surface},
+                               {gpu::kTraceSpecChildBoxes, childBoxes == BvhChildBoxes::Exact ? 1u : 0u}},
                               lanes > 1};
   if (lanes > 1 && manyLanesNeedWave32(device)) desc.requiredSubgroupSize = 32;
   return desc;
@@ -93,7 +94,7 @@ const vk::ComputeProgram& TracePass::program(uint32_t optics, uint32_t flags, ui
   uint64_t key = uint64_t(optics) << 32 | uint64_t(lanes) << 16 | flags;
   auto found = programs_.find(key);
   if (found != programs_.end()) return *found->second;
-  vk::ComputeProgramDesc desc = programDesc(context_.facts(), optics, flags, lanes, sceneSurface_);
+  vk::ComputeProgramDesc desc = programDesc(context_.facts(), optics, flags, lanes, sceneSurface_, childBoxes_);
   return *programs_.emplace(key, std::make_unique<vk::ComputeProgram>(context_, desc)).first->second;
 }
 
@@ -220,6 +221,8 @@ uint64_t TracePass::record(vk::Commands& commands, const TraceInputs& in, const 
                                    {gpu::kTraceBindingTlasGroups, &in.tlas->groups},
                                    {gpu::kTraceBindingBlasNodes, &in.blas->nodes},
                                    {gpu::kTraceBindingBlasGroups, &in.blas->groups},
+                                   {gpu::kTraceBindingTlasChildBoxes, &in.tlas->exactChildBoxes},
+                                   {gpu::kTraceBindingBlasChildBoxes, &in.blas->exactChildBoxes},
                                    {gpu::kTraceBindingPixels, masked ? target.pixels : &placeholder_},
                                    {gpu::kTraceBindingHits, &hitRecords(settings)}});
   if (masked) {

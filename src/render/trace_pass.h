@@ -53,7 +53,8 @@ struct TraceTarget {
 
 class TracePass {
  public:
-  TracePass(vk::Context& context, const scene::Scene& scene, const SceneGpu& gpu);
+  /// `childBoxes`: what the scene's trees keep for the walk (SceneTrees' forests).
+  TracePass(vk::Context& context, const scene::Scene& scene, const SceneGpu& gpu, BvhChildBoxes childBoxes);
   ~TracePass();
   TracePass(const TracePass&) = delete;
   TracePass& operator=(const TracePass&) = delete;
@@ -92,10 +93,12 @@ class TracePass {
 
   /// The trace pipeline specialised to the optics a view traces with
   /// (gpu::kOptics*), its flags (gpu::kTraceFlag*), the lanes a pixel and the
-  /// surface features a scene's materials use (gpu::kSurface*), as every
-  /// trace pass makes it on `device`; and the masked trace's compaction.
+  /// surface features a scene's materials use (gpu::kSurface*), for trees
+  /// with `childBoxes`, as every trace pass makes it on `device`; and the
+  /// masked trace's compaction.
   static vk::ComputeProgramDesc programDesc(const vk::DeviceFacts& device, uint32_t optics, uint32_t flags,
-                                            uint32_t lanes, uint32_t surface);
+                                            uint32_t lanes, uint32_t surface,
+                                            BvhChildBoxes childBoxes = BvhChildBoxes::Exact);
   /// Whether the several-lanes walk must be compiled for 32-lane subgroups:
   /// on AMD's RDNA1 and RDNA2 (gfx10) through RADV. Mesa 22.3's compiler
   /// (Debian 12's) corrupts its own heap compiling it in wave64, the default
@@ -132,6 +135,7 @@ class TracePass {
   vk::Context& context_;
   uint32_t sceneOptics_ = 0;  ///< gpu::kOptics* bits the scene's materials can show
   uint32_t sceneSurface_ = 0;  ///< gpu::kSurface* bits its materials use (SceneGpu::surface)
+  BvhChildBoxes childBoxes_;
   std::map<uint64_t, std::unique_ptr<vk::ComputeProgram>> programs_;  ///< by optics << 32 | lanes << 16 | flags
   std::unique_ptr<vk::ComputeProgram> compact_;
   vk::Buffer placeholder_;

@@ -34,6 +34,14 @@ def test_render_into_fills_the_callers_array(device, lens_gltf):
     np.testing.assert_array_equal(out, renderer.render(view))
 
 
+def test_compact_trees_draw_the_same_picture(device, lens_gltf):
+    scene = snell.Scene.load(str(lens_gltf))
+    view = snell.View(WIDTH, HEIGHT, camera=0)
+    exact = snell.Renderer(device, scene).render(view)
+    compact = snell.Renderer(device, scene, compact_trees=True).render(view)
+    np.testing.assert_array_equal(compact, exact)
+
+
 def test_view_matrices_give_the_scene_cameras_picture(device, lens_gltf):
     scene = snell.Scene.load(str(lens_gltf))
     renderer = snell.Renderer(device, scene)

@@ -85,3 +85,14 @@ void encodeNode(inout BvhNode node, vec3 lo0, vec3 hi0, vec3 lo1, vec3 hi1) {
     node.quant[w] = bytes[4u * w] | (bytes[4u * w + 1u] << 8) | (bytes[4u * w + 2u] << 16) | (bytes[4u * w + 3u] << 24);
   }
 }
+
+// Two children's exact boxes as the trace reads them: lo0 hi0 lo1 hi1 in three
+// vec4s. An empty child is the point at +infinity on every axis: every slab
+// then puts its entry at +infinity or its exit at -infinity, so no ray enters.
+void packChildBoxes(vec3 lo0, vec3 hi0, vec3 lo1, vec3 hi1, out vec4 a, out vec4 b, out vec4 c) {
+  if (!all(lessThanEqual(lo0, hi0))) lo0 = hi0 = vec3(kBvhInfinity);
+  if (!all(lessThanEqual(lo1, hi1))) lo1 = hi1 = vec3(kBvhInfinity);
+  a = vec4(lo0, hi0.x);
+  b = vec4(hi0.yz, lo1.xy);
+  c = vec4(lo1.z, hi1);
+}

@@ -2,7 +2,8 @@
 // stores its children's boxes quantised within its own box (shared/bvh.h:
 // BvhNode), from the exact boxes of the build: a leaf's primitive box, an
 // inner child's box as H-PLOC (or the restructuring) left it in the exact
-// boxes. A pass of its own, one invocation per node: in H-PLOC each merge's
+// boxes; and, unless the forest is compact, keeps those exact boxes beside
+// the node for the trace (shared/bvh.h). A pass of its own, one invocation per node: in H-PLOC each merge's
 // quantisation held up the whole team at its next barrier. The nodes are the
 // same, bit for bit, as a quantisation inside the merge made them: the same
 // exact boxes go in.
@@ -15,6 +16,7 @@ layout(std430, binding = kBvhBindingBuildEntries) readonly buffer Entries { BvhB
 layout(std430, binding = kBvhBindingPrimBoxes) readonly buffer PrimBoxes { float primBoxes[]; };
 layout(std430, binding = kBvhBindingExactBoxes) readonly buffer ExactBoxes { float exact[]; };
 layout(std430, binding = kBvhBindingNodes) buffer Nodes { BvhNode nodes[]; };
+layout(std430, binding = kBvhBindingChildBoxes) writeonly buffer ChildBoxes { vec4 childBoxes[]; };
 
 #include "bvh_entry_of.glsl"
 
@@ -35,4 +37,7 @@ void main() {
   nodes[node].origin = n.origin;
   nodes[node].scale = n.scale;
   nodes[node].quant = n.quant;
+  if ((pc.flags & kBvhFlagChildBoxes) != 0u) {
+    packChildBoxes(lo0, hi0, lo1, hi1, childBoxes[3u * node], childBoxes[3u * node + 1u], childBoxes[3u * node + 2u]);
+  }
 }

@@ -11,7 +11,8 @@
 // (shared/bvh.h), which is only known once both children are, so exact boxes
 // travel through a scratch array: a node's own once it is complete, and a
 // half-leaf node's leaf box meanwhile. min/max make every box independent of
-// arrival order, and the quantisation depends on nothing else.
+// arrival order, and the quantisation depends on nothing else. A forest that
+// is not compact keeps the children's exact boxes beside each node too.
 //
 // It also prices each tree with the surface area heuristic (Ct = Ci = 1,
 // exact boxes), in fixed point against the root area of the group's last
@@ -35,6 +36,7 @@ layout(std430, binding = kBvhBindingBlasGroups) readonly buffer BlasGroups { Bvh
 // Coherent: what one invocation writes is read by another after the atomic.
 layout(std430, binding = kBvhBindingNodes) coherent buffer Nodes { BvhNode nodes[]; };
 layout(std430, binding = kBvhBindingExactBoxes) coherent buffer ExactBoxes { float exact[]; };
+layout(std430, binding = kBvhBindingChildBoxes) writeonly buffer ChildBoxes { vec4 childBoxes[]; };
 layout(std430, binding = kBvhBindingGroups) buffer Groups { BvhGroup groups[]; };
 layout(std430, binding = kBvhBindingStats) buffer Stats { uvec4 stats[]; };
 layout(std430, binding = kBvhBindingDropped) buffer Dropped { uint dropped; };
@@ -122,6 +124,10 @@ void main() {
       nodes[node].origin = n.origin;
       nodes[node].quant = n.quant;
       nodes[node].scale = n.scale;
+      if ((pc.flags & kBvhFlagChildBoxes) != 0u) {
+        packChildBoxes(childLo[0], childHi[0], childLo[1], childHi[1], childBoxes[3u * node], childBoxes[3u * node + 1u],
+                       childBoxes[3u * node + 2u]);
+      }
       lo = min(childLo[0], childLo[1]);
       hi = max(childHi[0], childHi[1]);
       sah += sahTerm(boxArea(lo, hi), unitScale);
