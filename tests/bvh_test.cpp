@@ -103,8 +103,9 @@ bool contains(const float* outerLo, const float* outerHi, const float* lo, const
 
 // Walks one group's tree; returns its primitives and checks that every box
 // (as stored: quantised, so rounded outwards) holds the exact box of the
-// triangles below it, that the exact child boxes the trace reads are that box, the parent links, the refit arrival bits, and that
-// every reference stays inside the group's own slots.
+// triangles below it, that the exact child boxes the trace reads are that
+// box, the parent links, the refit arrival bits, and that every reference
+// stays inside the group's own slots.
 std::multiset<uint32_t> walk(const BvhSnapshot& s, uint32_t group, const Soup& soup) {
   std::multiset<uint32_t> seen;
   const gpu::BvhGroup& g = s.groups[group];

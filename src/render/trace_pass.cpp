@@ -191,6 +191,11 @@ std::vector<vk::BufferBinding> TracePass::pathBindings(const TraceInputs& in, co
 
 uint64_t TracePass::record(vk::Commands& commands, const TraceInputs& in, const FrameSettings& settings,
                            const TraceTarget& target, bool masked, uint32_t lanes) {
+  // The pipelines are specialised to what the trees keep: trees of the other
+  // kind would be walked through a 16-byte placeholder.
+  if (in.tlas->childBoxes != childBoxes_ || in.blas->childBoxes != childBoxes_) {
+    throw std::logic_error("trace: trees whose child boxes are not the kind its pipelines were made for");
+  }
   gpu::TracePush p = push(in, settings, target, masked);
   if (!masked) lanes = 1;
   uint32_t tilesY = (settings.height + gpu::kTraceTile - 1) / gpu::kTraceTile;

@@ -3,10 +3,10 @@
 // BvhNode), from the exact boxes of the build: a leaf's primitive box, an
 // inner child's box as H-PLOC (or the restructuring) left it in the exact
 // boxes; and, unless the forest is compact, keeps those exact boxes beside
-// the node for the trace (shared/bvh.h). A pass of its own, one invocation per node: in H-PLOC each merge's
-// quantisation held up the whole team at its next barrier. The nodes are the
-// same, bit for bit, as a quantisation inside the merge made them: the same
-// exact boxes go in.
+// the node for the trace (shared/bvh.h). A pass of its own, one invocation
+// per node: in H-PLOC each merge's quantisation held up the whole team at its
+// next barrier. The nodes are the same, bit for bit, as a quantisation inside
+// the merge made them: the same exact boxes go in.
 #version 460
 #extension GL_GOOGLE_include_directive : require
 #include "bvh_common.glsl"
