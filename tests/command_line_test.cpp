@@ -210,6 +210,24 @@ INSTANTIATE_TEST_SUITE_P(
       return name;
     });
 
+// `bench scale --compact-trees` measures the trees RendererOptions::compactTrees
+// makes: 40 bytes a triangle, without the exact child boxes the default keeps.
+TEST(BenchScale, CompactTreesAreMeasuredWithoutTheirExactChildBoxes) {
+  TempFolder dir("bench_scale");
+  auto bytesPerTriangle = [&](const std::string& name, const std::string& flags) {
+    std::string out = dir / (name + ".json");
+    CommandRun run = snell("bench scale --triangles 10000 --crowds 0 --refined 0 --runs 1 --sah-limit 0 " + flags +
+                           " --json " + shellQuoted(out));
+    EXPECT_EQ(run.exitCode, 0) << run.output;
+    io::Json j = readJson(out);
+    EXPECT_EQ(j.at("compact_trees").get<bool>(), !flags.empty());
+    return j.at("spheres").at(0).at("tree_bytes_per_triangle").get<double>();
+  };
+  double compact = bytesPerTriangle("compact", "--compact-trees"), exact = bytesPerTriangle("exact", "");
+  EXPECT_NEAR(compact, 40.0, 0.1);
+  EXPECT_GT(exact, compact + 40.0);
+}
+
 TEST(JsonWriter, DeviceNamesWithQuotesAndNonAsciiComeOutAsValidJson) {
   vk::DeviceFacts facts;
   facts.name = "GPU \"fast\" \\ Größe \x01";

@@ -41,6 +41,7 @@ struct Options {
   std::vector<double> refined = {1e4, 1e5, 1e6};  ///< refined vertices of a subdivision cage
   uint32_t runs = 10, restructure = 0, width = 3840, height = 2160, frames = 20;
   uint64_t sahLimit = 1000000;
+  bool compactTrees = false;  ///< trees without the exact child boxes (RendererOptions::compactTrees)
   render::BvhTuning tuning;
   std::string json;
 };
@@ -115,13 +116,16 @@ std::vector<uint64_t> counts(const std::vector<double>& list) {
 // deform that trees and trace both wait for.
 bool refractionPass(const std::string& name) { return name == pass::kDeform || render::isRefractionPass(name); }
 
-CrowdRow measureCrowd(vk::Context& context, uint32_t characters, uint32_t width, uint32_t height, uint32_t frames) {
+CrowdRow measureCrowd(vk::Context& context, uint32_t characters, uint32_t width, uint32_t height, uint32_t frames,
+                      bool compactTrees) {
   scene::EyeOptions options;
   options.crowd = characters;
   scene::Scene scene = scene::makeEye(options);
   double duration = std::max(scene::animationDuration(scene), 1e-3);
   scene::Pose firstPose = scene::evaluate(scene, 0.0);
-  render::Renderer renderer(context, scene, firstPose);
+  render::RendererOptions rendererOptions;
+  rendererOptions.compactTrees = compactTrees;
+  render::Renderer renderer(context, scene, firstPose, rendererOptions);
   CrowdRow row;
   row.characters = characters;
   for (const scene::DrawItem& item : firstPose.items) row.triangles += scene.shapes[size_t(item.shape)].triangleCount();
@@ -171,7 +175,7 @@ constexpr uint32_t kRefineWarmupFrames = 5;  // as the crowds' (--frames says "a
 // A wavy open grid of n x n quads as a Catmull-Clark cage refined twice
 // ((4n + 1)^2 vertices), moved by the host every frame: the refine pass and
 // the refit of its tree, medians over `frames`.
-RefineRow measureRefine(vk::Context& context, uint64_t target, uint32_t frames) {
+RefineRow measureRefine(vk::Context& context, uint64_t target, uint32_t frames, bool compactTrees) {
   const uint32_t n = std::max<uint32_t>(1, uint32_t(std::lround((std::sqrt(double(target)) - 1.0) / 4.0)));
   scene::SubdivisionCage cage;
   for (uint32_t y = 0; y <= n; ++y) {
@@ -193,6 +197,7 @@ RefineRow measureRefine(vk::Context& context, uint64_t target, uint32_t frames) 
   scene::Pose pose = scene::evaluate(s, 0.0);
   render::RendererOptions options;
   options.keepVertices = true;
+  options.compactTrees = compactTrees;
   render::Renderer renderer(context, s, pose, options);
   scene::ViewRequest look;
   look.lookAt = scene::LookAt{{0.0, 0.0, 2.0}, {0.0, 0.0, 0.0}, {0.0, 1.0, 0.0}};
@@ -237,8 +242,9 @@ int runScale(const Options& o) {
   desc.driverAccelerationStructures = true;
   auto context = vk::Context::create(desc);
   bool driver = context->caps().driverAccelerationStructures;
-  std::printf("device: %s; the driver's acceleration structures: %s\n", context->facts().name.c_str(),
-              driver ? "measured beside snell's" : "unsupported");
+  std::printf("device: %s; the driver's acceleration structures: %s; trees: %s\n", context->facts().name.c_str(),
+              driver ? "measured beside snell's" : "unsupported",
+              o.compactTrees ? "compact (no exact child boxes)" : "with exact child boxes");
   render::BvhBuilder builder(*context, o.tuning);
   vk::UploadArena arena(*context, "bench scale uploads");
   std::vector<Row> rows;
@@ -259,7 +265,8 @@ int runScale(const Options& o) {
     };
     vk::Buffer positions = buffer(mesh.positions.data(), mesh.positions.size() * 4, "sphere positions");
     vk::Buffer indices = buffer(mesh.indices.data(), mesh.indices.size() * 4, "sphere indices");
-    render::Bvh bvh = builder.makeBvh({triangles}, render::BvhLeaves::Triangles, "sphere");
+    render::Bvh bvh = builder.makeBvh({triangles}, render::BvhLeaves::Triangles, "sphere",
+                                      o.compactTrees ? render::BvhChildBoxes::Quantised : render::BvhChildBoxes::Exact);
     render::BvhInputs inputs{&positions, &indices, nullptr, nullptr};
     vk::Commands commands(*context, "bench scale");
     std::vector<double> build, refit;
@@ -369,7 +376,7 @@ int runScale(const Options& o) {
                 "tlas", "r.depth", "trace", "r.shade", "frame", "refract", "pixels", "Grays/s", "B/tri");
   }
   for (uint64_t characters : crowds) {
-    CrowdRow r = measureCrowd(*context, static_cast<uint32_t>(characters), width, height, frames);
+    CrowdRow r = measureCrowd(*context, static_cast<uint32_t>(characters), width, height, frames, o.compactTrees);
     auto passMs = [&](const char* name) { return r.passMs.count(name) ? r.passMs.at(name) : 0.0; };
     double trace = passMs(pass::kTrace);
     std::printf("%6u %10llu %7.3f %7.3f %7.3f %7.3f %7.3f %7.3f %8.3f %8.3f %10.0f %7.2f %6.1f\n", r.characters,
@@ -388,7 +395,7 @@ int runScale(const Options& o) {
                 "refine min-max", "M verts/s", "refit ms", "refit min-max");
   }
   for (uint64_t target : refineSizes) {
-    RefineRow r = measureRefine(*context, target, frames);
+    RefineRow r = measureRefine(*context, target, frames, o.compactTrees);
     std::printf("%12u %12u %14u %11.4f %8.4f-%-8.4f %14.1f %10.4f %8.4f-%-8.4f\n", r.cageVertices, r.cageFaces,
                 r.refinedVertices, r.refineMs, r.refineMinMs, r.refineMaxMs,
                 r.refineMs > 0 ? r.refinedVertices / r.refineMs / 1e3 : 0.0, r.refitMs, r.refitMinMs, r.refitMaxMs);
@@ -399,6 +406,7 @@ int runScale(const Options& o) {
     io::Json j = io::reportHead("bench-scale", &context->facts());
     j["driver_acceleration_structures"] = driver;
     j["restructure_rounds"] = restructure;
+    j["compact_trees"] = o.compactTrees;
     j["runs"] = runs;
     io::Json spheres = io::Json::array();
     for (const Row& r : rows) {
@@ -493,6 +501,8 @@ void addBenchScale(CLI::App& bench, Runner& run) {
       ->type_name("N");
   sub->add_option("--sah-limit", o->sahLimit, "price the tree against binned SAH up to this size (default 1000000)")
       ->type_name("N");
+  sub->add_flag("--compact-trees", o->compactTrees,
+                "trees without each node's exact child boxes (40 bytes a triangle): what builds and refits cost without them");
   sub->add_option("--hploc-workgroup", o->tuning.hplocWorkgroup, "H-PLOC's workgroup size (default: the device's choice)")
       ->type_name("N");
   sub->add_option("--refit-workgroup", o->tuning.refitWorkgroup, "the refit's workgroup size (default: the device's choice)")
