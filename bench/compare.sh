@@ -56,7 +56,8 @@ build_one() {
   name=${spec%%=*} rev=${spec#*=}
   [[ $spec == *=* ]] || name=$rev
   local src=build/compare/$name
-  git rev-parse --verify -q "$rev^{commit}" >/dev/null || { echo "compare: no revision '$rev'" >&2; return 2; }
+  # Resolved here: inside the build's worktree, HEAD (or a relative name) would mean that worktree's own.
+  rev=$(git rev-parse --verify -q "$rev^{commit}") || { echo "compare: no revision '${spec#*=}'" >&2; return 2; }
   if [[ -d $src ]]; then
     git -C "$src" checkout -q --detach "$rev"
   else
