@@ -102,10 +102,10 @@ bool contains(const float* outerLo, const float* outerHi, const float* lo, const
 }
 
 // Walks one group's tree; returns its primitives and checks that every box
-// (as stored: quantised, so rounded outwards) holds the exact box of the
-// triangles below it, that the exact child boxes the trace reads are that
-// box, the parent links, the refit arrival bits, and that every reference
-// stays inside the group's own slots.
+// as the trace tests it (quantised and rounded outwards in a compact forest)
+// holds the exact box of the triangles below it, that kept exact child boxes
+// are that box to the bit, the parent links, the refit arrival bits, and that
+// every reference stays inside the group's own slots.
 std::multiset<uint32_t> walk(const BvhSnapshot& s, uint32_t group, const Soup& soup) {
   std::multiset<uint32_t> seen;
   const gpu::BvhGroup& g = s.groups[group];
@@ -131,7 +131,7 @@ std::multiset<uint32_t> walk(const BvhSnapshot& s, uint32_t group, const Soup& s
       if (!(child & gpu::kBvhLeafBit)) {
         EXPECT_EQ(s.nodes[child].parent, ref | (c == 1 ? gpu::kBvhParentRight : 0u));
       }
-      render::BoxFloats exact = subtree(child), stored = BvhSnapshot::childBox(node, c);
+      render::BoxFloats exact = subtree(child), stored = s.storedChildBox(ref, c);
       EXPECT_TRUE(contains(&stored[0], &stored[3], &exact[0], &exact[3])) << "child " << c << " of node " << ref;
       if (!s.exactChildBoxes.empty()) {  // the trace's exact boxes are the subtree's, to the bit
         render::BoxFloats kept = s.exactChildBoxes[2 * size_t(ref) + size_t(c)], expected = exact;
@@ -260,6 +260,23 @@ TEST_F(BvhTest, ARefitHoldsTheMovedTrianglesAndKeepsTheTopology) {
   BvhSnapshot again = refit(builder, bvh, soup, {1});
   EXPECT_EQ(std::memcmp(after.nodes.data(), again.nodes.data(), after.nodes.size() * sizeof(gpu::BvhNode)), 0);
   EXPECT_EQ(walk(again, 1, soup).size(), 2000u);
+}
+
+// A compact forest's nodes hold their children's boxes quantised, rounded
+// outwards, after a build and after a refit (a forest with exact child boxes
+// leaves them unwritten: its trace never decodes them).
+TEST_F(BvhTest, ACompactForestsQuantisedBoxesHoldTheTrianglesAfterABuildAndARefit) {
+  Soup soup = randomSoup(3000, 9);
+  BvhBuilder builder(context());
+  Bvh bvh = builder.makeBvh({1000, 2000}, render::BvhLeaves::Triangles, "compact", render::BvhChildBoxes::Quantised);
+  BvhSnapshot built = build(builder, bvh, soup);
+  ASSERT_TRUE(built.exactChildBoxes.empty());
+  EXPECT_EQ(walk(built, 0, soup).size(), 1000u);
+  EXPECT_EQ(walk(built, 1, soup).size(), 2000u);
+  for (size_t i = 9 * 1000; i < soup.positions.size(); ++i) soup.positions[i] = soup.positions[i] * 3.0f + 50.0f;
+  BvhSnapshot moved = refit(builder, bvh, soup, {1});
+  EXPECT_EQ(walk(moved, 1, soup).size(), 2000u);
+  EXPECT_EQ(walk(moved, 0, soup).size(), 1000u);
 }
 
 // The refit's fixed-point SAH is the same price the host computes from the boxes.

@@ -13,8 +13,8 @@
 // collision, so slots are deterministic, whatever order the GPU runs the
 // merges in, and a group owns exactly [first, first + count - 1). H-PLOC
 // writes each node's links and its exact box (in the forest's exact boxes,
-// which refits use the same way); one pass then quantises every node's
-// children's boxes into it.
+// which refits use the same way); one pass then stores every node's
+// children's boxes as the trace reads them (exact, or quantised in it).
 #ifndef SNELL_BVH_H
 #define SNELL_BVH_H
 #include "shared_types.h"
@@ -84,7 +84,9 @@ SNELL_CONST kBvhFlagChildBoxes = 4u; // the forest keeps each node's children's 
 // children's exact boxes beside it (kBvhBindingChildBoxes, 48 bytes: lo0 hi0
 // lo1 hi1 in three vec4s, an empty child as the point at +infinity), and the
 // trace reads those: a child test is then a slab and no decode, which is
-// most of what a walk spends (bench/results/walk-counts.md).
+// most of what a walk spends (bench/results/walk-counts.md). Such a forest's
+// nodes hold only links (child, parent, the refit's arrival bit): no pass
+// writes or reads their quantised fields.
 // 40 bytes, total: 40 bytes
 struct BvhNode {
   float origin[3];  // 12: the node box's low corner

@@ -361,6 +361,13 @@ BoxFloats BvhSnapshot::childBox(const gpu::BvhNode& node, int c) {
   return box;
 }
 
+BoxFloats BvhSnapshot::storedChildBox(uint32_t node, int c) const {
+  if (exactChildBoxes.empty()) return childBox(nodes.at(node), c);
+  BoxFloats box = exactChildBoxes.at(2 * size_t(node) + size_t(c));
+  if (box[0] == INFINITY) box = {INFINITY, INFINITY, INFINITY, -INFINITY, -INFINITY, -INFINITY};  // the point at +inf
+  return box;
+}
+
 BvhSnapshot::TreeBoxes BvhSnapshot::treeBoxes(uint32_t group) const {
   const gpu::BvhGroup& g = groups.at(group);
   TreeBoxes boxes;
@@ -379,7 +386,7 @@ BvhSnapshot::TreeBoxes BvhSnapshot::treeBoxes(uint32_t group) const {
     if (n >= nodes.size()) break;
     const gpu::BvhNode& node = nodes[n];
     for (int c = 0; c < 2; ++c) {
-      BoxFloats b = childBox(node, c);
+      BoxFloats b = storedChildBox(n, c);
       if (node.child[c] & gpu::kBvhLeafBit) {
         boxes.leaves.push_back(b);
       } else {

@@ -73,9 +73,9 @@ using BoxFloats = std::array<float, 6>;
 /// A forest brought back to the host, for tests and the quality benchmark.
 struct BvhSnapshot {
   /// Group g's boxes: the root's first, then every internal node's, and every
-  /// leaf's (what the SAH prices): as the parents' child slots store them
-  /// (quantised, so what a ray tests), or, given each primitive's box, the
-  /// exact boxes of the tree's topology (what the build chose).
+  /// leaf's (what the SAH prices): as the trace tests them (storedChildBox), or,
+  /// given each primitive's box, the exact boxes of the tree's topology (what
+  /// the build chose).
   struct TreeBoxes {
     std::vector<BoxFloats> internal, leaves;
   };
@@ -83,6 +83,10 @@ struct BvhSnapshot {
   TreeBoxes exactTreeBoxes(uint32_t group, const std::function<BoxFloats(uint32_t prim)>& primitiveBox) const;
   /// Child c's box as `node` stores it, decoded as the trace decodes it.
   static BoxFloats childBox(const gpu::BvhNode& node, int c);
+  /// Child c's box of node slot `node` as the trace tests it: its exact box
+  /// where the forest keeps them (whose nodes then hold no quantised boxes),
+  /// else the node's own, decoded. An empty child has lo above hi.
+  BoxFloats storedChildBox(uint32_t node, int c) const;
 
   std::vector<gpu::BvhNode> nodes;
   /// With BvhChildBoxes::Exact, each node's children's exact boxes as the

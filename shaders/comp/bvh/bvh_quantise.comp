@@ -1,9 +1,9 @@
 // Build step 5 (6 after a restructuring): each node of the groups just built
-// stores its children's boxes quantised within its own box (shared/bvh.h:
-// BvhNode), from the exact boxes of the build: a leaf's primitive box, an
-// inner child's box as H-PLOC (or the restructuring) left it in the exact
-// boxes; and, unless the forest is compact, keeps those exact boxes beside
-// the node for the trace (shared/bvh.h). A pass of its own, one invocation
+// gets its children's boxes in the form the trace reads, from the exact
+// boxes of the build (a leaf's primitive box, an inner child's box as H-PLOC
+// or the restructuring left it in the exact boxes): kept exact beside the
+// node (shared/bvh.h), or, in a compact forest, quantised within the node's
+// own box (BvhNode). Either way the node's refit arrivals start cleared. A pass of its own, one invocation
 // per node: in H-PLOC each merge's quantisation held up the whole team at its
 // next barrier. The nodes are the same, bit for bit, as a quantisation inside
 // the merge made them: the same exact boxes go in.
@@ -33,11 +33,13 @@ void main() {
   vec3 lo0, hi0, lo1, hi1;
   childBox(entry, n.child[0], lo0, hi0);
   childBox(entry, n.child[1], lo1, hi1);
+  if ((pc.flags & kBvhFlagChildBoxes) != 0u) {  // the trace reads these, not the node's quantised boxes
+    packChildBoxes(lo0, hi0, lo1, hi1, childBoxes[3u * node], childBoxes[3u * node + 1u], childBoxes[3u * node + 2u]);
+    nodes[node].scale = 0u;
+    return;
+  }
   encodeNode(n, lo0, hi0, lo1, hi1);
   nodes[node].origin = n.origin;
   nodes[node].scale = n.scale;
   nodes[node].quant = n.quant;
-  if ((pc.flags & kBvhFlagChildBoxes) != 0u) {
-    packChildBoxes(lo0, hi0, lo1, hi1, childBoxes[3u * node], childBoxes[3u * node + 1u], childBoxes[3u * node + 2u]);
-  }
 }

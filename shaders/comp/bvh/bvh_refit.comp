@@ -7,12 +7,12 @@
 // arrival bit was set: every refit flips it twice, a build clears it)
 // finishes the node and goes on up. No invocation waits for another.
 //
-// Nodes store their children's boxes quantised within their own box
-// (shared/bvh.h), which is only known once both children are, so exact boxes
-// travel through a scratch array: a node's own once it is complete, and a
-// half-leaf node's leaf box meanwhile. min/max make every box independent of
-// arrival order, and the quantisation depends on nothing else. A forest that
-// is not compact keeps the children's exact boxes beside each node too.
+// A node's children's boxes are known once both children are, so exact
+// boxes travel through a scratch array: a node's own once it is complete,
+// and a half-leaf node's leaf box meanwhile. min/max make every box
+// independent of arrival order. A complete node keeps its children's exact
+// boxes beside it for the trace (shared/bvh.h), or, in a compact forest,
+// stores them quantised within its own box, which depends on nothing else.
 //
 // It also prices each tree with the surface area heuristic (Ct = Ci = 1,
 // exact boxes), in fixed point against the root area of the group's last
@@ -117,16 +117,17 @@ void main() {
       if (complete) readExact(children[1u - leafSide], childLo[1u - leafSide], childHi[1u - leafSide]);
     }
     for (uint step = 0u; complete && step < kBvhMaxDepth; ++step) {
-      // `node` is complete: quantise its children, then hand its exact box up.
+      // `node` is complete: store its children's boxes, then hand its exact box up.
       uint parent = nodes[node].parent;
-      BvhNode n = nodes[node];
-      encodeNode(n, childLo[0], childHi[0], childLo[1], childHi[1]);
-      nodes[node].origin = n.origin;
-      nodes[node].quant = n.quant;
-      nodes[node].scale = n.scale;
       if ((pc.flags & kBvhFlagChildBoxes) != 0u) {
         packChildBoxes(childLo[0], childHi[0], childLo[1], childHi[1], childBoxes[3u * node], childBoxes[3u * node + 1u],
                        childBoxes[3u * node + 2u]);
+      } else {
+        BvhNode n = nodes[node];
+        encodeNode(n, childLo[0], childHi[0], childLo[1], childHi[1]);
+        nodes[node].origin = n.origin;
+        nodes[node].quant = n.quant;
+        nodes[node].scale = n.scale;
       }
       lo = min(childLo[0], childLo[1]);
       hi = max(childHi[0], childHi[1]);
