@@ -4,7 +4,9 @@
 # against a base that already has the change's cost in it.
 #
 # On the Debian machine:
-#   bench/compare.sh build [NAME=]REV ...   each revision's `snell` (device preset: no OpenImageIO) built in
+#   bench/compare.sh build [NAME=]REV[+PATCH...] ...
+#                                           each revision's `snell` (device preset: no OpenImageIO), with
+#                                           the patches named applied (an experiment of bench/experiments), built in
 #                                           build/compare/NAME, stripped into .carry/snell-NAME, with the
 #                                           Debian libraries the GPU machine lacks in .carry/lib, the
 #                                           validation layer in .carry/layer and the Vulkan loader's
@@ -52,21 +54,32 @@ carry_runtime() {
 }
 
 build_one() {
-  local spec=$1 name rev
+  local spec=$1 name rev patches=()
   name=${spec%%=*} rev=${spec#*=}
   [[ $spec == *=* ]] || name=$rev
+  if [[ $rev == *+* ]]; then
+    IFS=+ read -r -a patches <<<"${rev#*+}"
+    rev=${rev%%+*}
+  fi
   local src=build/compare/$name
   # Resolved here: inside the build's worktree, HEAD (or a relative name) would mean that worktree's own.
   rev=$(git rev-parse --verify -q "$rev^{commit}") || { echo "compare: no revision '${spec#*=}'" >&2; return 2; }
   if [[ -d $src ]]; then
-    git -C "$src" checkout -q --detach "$rev"
+    git -C "$src" reset -q --hard && git -C "$src" checkout -q --detach "$rev"
   else
     git worktree add -q --detach "$src" "$rev"
   fi
-  echo "== $name: $(git log -1 --format='%h %s' "$rev" | cut -c1-100)"
+  local patch
+  for patch in "${patches[@]}"; do
+    git -C "$src" apply "$PWD/$patch" || { echo "compare: $patch does not apply on $rev" >&2; return 2; }
+  done
+  local what
+  what="$(git log -1 --format='%h %s' "$rev" | cut -c1-80)${patches[*]:+ + ${patches[*]}}"
+  echo "== $name: $what"
   (cd "$src" && cmake --preset device -DSNELL_BUILD_TESTS=OFF -DCMAKE_CXX_COMPILER_LAUNCHER=ccache >/dev/null &&
      cmake --build --preset device -j "$(nproc)" --target snell >/dev/null) || { echo "compare: $name did not build" >&2; return 1; }
   strip -o ".carry/snell-$name" "$src/build/device/snell"
+  echo "$what" >".carry/snell-$name.rev"  # `run` names what each build is
   # Its trace as SPIR-V, for ROWS=pipelines.
   glslangValidator --quiet --target-env vulkan1.3 -g0 -o ".carry/trace-$name.spv" "$src/shaders/comp/trace.comp"
   # Libraries of Debian's that the GPU machine's image does not have.
@@ -81,7 +94,7 @@ build_one() {
 # The newest carried snell that has `bench pipelines` (it compiles any build's trace: --trace-spirv).
 pipelines_tool() {
   local f
-  for f in $(ls -t .carry/snell-* 2>/dev/null); do
+  for f in $(ls -t .carry/snell-* 2>/dev/null | grep -v '\.rev$'); do
     "$f" bench pipelines --help >/dev/null 2>&1 && { echo "$f"; return 0; }
   done
   return 1
@@ -104,7 +117,7 @@ run_all() {
   nvidia-smi --query-gpu=name,driver_version --format=csv,noheader 2>/dev/null
   local builds=()
   if [[ -n ${BUILDS:-} ]]; then read -r -a builds <<<"$BUILDS"; else
-    for f in .carry/snell-*; do builds+=("${f#.carry/snell-}"); done
+    for f in .carry/snell-*; do [[ $f == *.rev ]] || builds+=("${f#.carry/snell-}"); done
   fi
   ((${#builds[@]})) || { echo "compare: no builds in .carry (bench/compare.sh build REV ...)" >&2; exit 2; }
   local rows=${ROWS:-same trace viewport} scenes=/tmp/compare-scenes log=$OUT/compare.log
@@ -118,6 +131,8 @@ run_all() {
   # Each build keeps its own warm pipeline caches: what is timed is the frames, not the compiles.
   export __GL_SHADER_DISK_CACHE_PATH=/tmp/compare-nv
   : >"$log"
+  local b
+  for b in "${builds[@]}"; do echo "build ${b}: $(cat ".carry/snell-${b%%+*}.rev" 2>/dev/null || echo '(revision not recorded)')"; done
   # A warm-up run, not counted: the first run of a lease met a GPU still raising its clocks (15-45% slower).
   snell_of "${builds[0]}" bench methods "$scenes/sphere-100k.gltf" --methods trace --no-reference --frames 8 \
     --size 1920x1080 >/dev/null 2>&1
