@@ -228,6 +228,20 @@ TEST(BenchScale, CompactTreesAreMeasuredWithoutTheirExactChildBoxes) {
   EXPECT_GT(exact, compact + 40.0);
 }
 
+// A subdivision cage whose faces carry three materials is one shape split in
+// parts that share its refined vertices: one refine pass a frame, not three.
+TEST(BenchScale, ACageOfSeveralMaterialsIsRefinedOnceAFrame) {
+  TempFolder dir("bench_scale_materials");
+  std::string out = dir / "scale.json";
+  CommandRun run = snell("bench scale --triangles 0 --crowds 0 --refined 10000 --refined-materials 3 --frames 2 --json " +
+                         shellQuoted(out));
+  ASSERT_EQ(run.exitCode, 0) << run.output;
+  io::Json row = readJson(out).at("subdivision").at(0);
+  EXPECT_EQ(row.at("materials").get<int>(), 3);
+  EXPECT_EQ(row.at("refine_passes_per_frame").get<double>(), 1.0);
+  EXPECT_GT(row.at("refit_ms").get<double>(), 0.0);
+}
+
 TEST(JsonWriter, DeviceNamesWithQuotesAndNonAsciiComeOutAsValidJson) {
   vk::DeviceFacts facts;
   facts.name = "GPU \"fast\" \\ Größe \x01";

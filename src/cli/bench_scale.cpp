@@ -40,6 +40,7 @@ struct Options {
   std::vector<double> triangles = {1e4, 1e5, 1e6, 1e7}, crowds = {1, 2, 10, 100, 1000};
   std::vector<double> refined = {1e4, 1e5, 1e6};  ///< refined vertices of a subdivision cage
   uint32_t runs = 10, restructure = 0, width = 3840, height = 2160, frames = 20;
+  uint32_t refinedMaterials = 1;  ///< materials of each subdivision cage, in bands of faces
   uint64_t sahLimit = 1000000;
   bool compactTrees = false;  ///< trees without the exact child boxes (RendererOptions::compactTrees)
   render::BvhTuning tuning;
@@ -163,7 +164,8 @@ CrowdRow measureCrowd(vk::Context& context, uint32_t characters, uint32_t width,
 }
 
 struct RefineRow {
-  uint32_t cageVertices = 0, cageFaces = 0, refinedVertices = 0;
+  uint32_t cageVertices = 0, cageFaces = 0, refinedVertices = 0, materials = 1;
+  double refinePasses = 0;  ///< refine passes a frame (median): one whatever the materials
   double refineMs = 0, refitMs = 0;  ///< medians
   double refineMinMs = 0, refineMaxMs = 0, refitMinMs = 0, refitMaxMs = 0;  ///< the spread of the frames timed
 };
@@ -174,8 +176,10 @@ constexpr uint32_t kRefineWarmupFrames = 5;  // as the crowds' (--frames says "a
 
 // A wavy open grid of n x n quads as a Catmull-Clark cage refined twice
 // ((4n + 1)^2 vertices), moved by the host every frame: the refine pass and
-// the refit of its tree, medians over `frames`.
-RefineRow measureRefine(vk::Context& context, uint64_t target, uint32_t frames, bool compactTrees) {
+// the refit of its trees, medians over `frames` of each frame's sums. With
+// several materials (bands of faces) the cage is one shape split into parts
+// that share its refined vertices: refined once, a tree a part.
+RefineRow measureRefine(vk::Context& context, uint64_t target, uint32_t frames, bool compactTrees, uint32_t materials) {
   const uint32_t n = std::max<uint32_t>(1, uint32_t(std::lround((std::sqrt(double(target)) - 1.0) / 4.0)));
   scene::SubdivisionCage cage;
   for (uint32_t y = 0; y <= n; ++y) {
@@ -192,8 +196,15 @@ RefineRow measureRefine(vk::Context& context, uint64_t target, uint32_t frames, 
   s.source = "a refined grid";
   scene::Shape shape;
   std::vector<std::string> warnings;
-  scene::subdivide(cage, shape, "grid", warnings);
+  std::vector<uint32_t> triangleFaces;
+  scene::subdivide(cage, shape, "grid", warnings, scene::kMaxRefinedVertices, &triangleFaces);
   scene::addRootShape(s, std::move(shape));
+  if (materials > 1) {
+    s.materials.resize(materials);
+    std::vector<int> bands(triangleFaces.size());
+    for (size_t t = 0; t < bands.size(); ++t) bands[t] = int(uint64_t(triangleFaces[t] / n) * materials / n);
+    scene::splitByMaterial(s, 0, bands);
+  }
   scene::Pose pose = scene::evaluate(s, 0.0);
   render::RendererOptions options;
   options.keepVertices = true;
@@ -207,7 +218,7 @@ RefineRow measureRefine(vk::Context& context, uint64_t target, uint32_t frames, 
   request.pose = &pose;
   request.views.push_back(view);
   renderer.wait(renderer.submit(request));  // the first build
-  std::vector<double> refine, refit;
+  std::vector<double> refine, refit, refinePasses;
   for (uint32_t f = 0; f < frames + kRefineWarmupFrames; ++f) {
     render::KeptVertices kept = renderer.keptVertices(0);
     for (uint32_t v = 0; v < kept.count; ++v) {
@@ -216,15 +227,21 @@ RefineRow measureRefine(vk::Context& context, uint64_t target, uint32_t frames, 
     renderer.markDirty(0);
     const render::FrameResult& result = renderer.wait(renderer.submit(request));
     if (f < kRefineWarmupFrames) continue;
+    double refineMs = 0, refitMs = 0, passes = 0;
     for (const vk::PassTime& p : result.passes) {
-      if (p.name == pass::kRefine) refine.push_back(p.milliseconds);
-      if (p.name == pass::kBlasRefit || p.name == pass::kBlasBuild) refit.push_back(p.milliseconds);
+      if (p.name == pass::kRefine) refineMs += p.milliseconds, ++passes;
+      if (p.name == pass::kBlasRefit || p.name == pass::kBlasBuild) refitMs += p.milliseconds;
     }
+    refine.push_back(refineMs);
+    refit.push_back(refitMs);
+    refinePasses.push_back(passes);
   }
   RefineRow row;
   row.cageVertices = uint32_t(cage.positions.size());
   row.cageFaces = uint32_t(cage.faceVertexCounts.size());
   row.refinedVertices = uint32_t(s.shapes[0].vertexCount());
+  row.materials = materials;
+  row.refinePasses = io::median(refinePasses);
   row.refineMs = io::median(refine);
   row.refitMs = io::median(refit);
   if (!refine.empty()) row.refineMinMs = *std::min_element(refine.begin(), refine.end());
@@ -389,16 +406,18 @@ int runScale(const Options& o) {
   std::vector<RefineRow> refineRows;
   if (!refineSizes.empty()) {
     std::printf("\nsubdivision cages refined twice, moved every frame (GPU ms: the median of %u frames after %u "
-                "warm-up frames, and their spread)\n",
-                frames, kRefineWarmupFrames);
-    std::printf("%12s %12s %14s %11s %17s %14s %10s %17s\n", "cage verts", "cage faces", "refined verts", "refine ms",
-                "refine min-max", "M verts/s", "refit ms", "refit min-max");
+                "warm-up frames, and their spread)%s\n",
+                frames, kRefineWarmupFrames,
+                o.refinedMaterials > 1 ? (", " + std::to_string(o.refinedMaterials) + " materials a cage").c_str() : "");
+    std::printf("%12s %12s %14s %11s %17s %14s %10s %17s %8s\n", "cage verts", "cage faces", "refined verts", "refine ms",
+                "refine min-max", "M verts/s", "refit ms", "refit min-max", "refines");
   }
   for (uint64_t target : refineSizes) {
-    RefineRow r = measureRefine(*context, target, frames, o.compactTrees);
-    std::printf("%12u %12u %14u %11.4f %8.4f-%-8.4f %14.1f %10.4f %8.4f-%-8.4f\n", r.cageVertices, r.cageFaces,
+    RefineRow r = measureRefine(*context, target, frames, o.compactTrees, o.refinedMaterials);
+    std::printf("%12u %12u %14u %11.4f %8.4f-%-8.4f %14.1f %10.4f %8.4f-%-8.4f %8.0f\n", r.cageVertices, r.cageFaces,
                 r.refinedVertices, r.refineMs, r.refineMinMs, r.refineMaxMs,
-                r.refineMs > 0 ? r.refinedVertices / r.refineMs / 1e3 : 0.0, r.refitMs, r.refitMinMs, r.refitMaxMs);
+                r.refineMs > 0 ? r.refinedVertices / r.refineMs / 1e3 : 0.0, r.refitMs, r.refitMinMs, r.refitMaxMs,
+                r.refinePasses);
     std::fflush(stdout);
     refineRows.push_back(r);
   }
@@ -449,6 +468,8 @@ int runScale(const Options& o) {
       refineJson.push_back(io::Json{{"cage_vertices", r.cageVertices},
                                     {"cage_faces", r.cageFaces},
                                     {"refined_vertices", r.refinedVertices},
+                                    {"materials", r.materials},
+                                    {"refine_passes_per_frame", r.refinePasses},
                                     {"refine_ms", r.refineMs},
                                     {"refine_min_ms", r.refineMinMs},
                                     {"refine_max_ms", r.refineMaxMs},
@@ -486,7 +507,10 @@ void addBenchScale(CLI::App& bench, Runner& run) {
       "\n"
       "Refined vertices: a Catmull-Clark cage of n x n quads refined twice, which\n"
       "the host moves every frame: the refine pass's GPU time, vertices refined per\n"
-      "second, and the refit of the refined surface's tree after it.");
+      "second, and the refit of the refined surface's tree after it. With\n"
+      "--refined-materials the cage's faces carry that many materials in bands:\n"
+      "it is still refined once (\"refines\": refine passes a frame), with a tree\n"
+      "a material.");
   sub->footer(kHelpFooter);
   // Lists take one word each, so they never swallow the words after them.
   sub->add_option("--triangles", o->triangles, "sphere sizes (default 10000,100000,1000000,10000000; 0 skips)")
@@ -518,6 +542,10 @@ void addBenchScale(CLI::App& bench, Runner& run) {
       ->delimiter(',')
       ->allow_extra_args(false)
       ->check(countOrZero(4194304));
+  sub->add_option("--refined-materials", o->refinedMaterials,
+                  "materials of each subdivision cage, in bands of its faces (default 1): refined once, a tree each")
+      ->type_name("N")
+      ->check(CLI::Range(1u, 64u));
   addSize(*sub, "--size", o->width, o->height, "viewport size of the crowd frames (default 3840x2160)");
   sub->add_option("--frames", o->frames, "animated frames measured per crowd and refined cage (default 20, after 5)")
       ->type_name("N")
