@@ -3,10 +3,11 @@
 // boxes of the build (a leaf's primitive box, an inner child's box as H-PLOC
 // or the restructuring left it in the exact boxes): kept exact beside the
 // node (shared/bvh.h), or, in a compact forest, quantised within the node's
-// own box (BvhNode). Either way the node's refit arrivals start cleared. A pass of its own, one invocation
-// per node: in H-PLOC each merge's quantisation held up the whole team at its
-// next barrier. The nodes are the same, bit for bit, as a quantisation inside
-// the merge made them: the same exact boxes go in.
+// own box (BvhNode). Either way the node's refit arrivals start cleared. A
+// pass of its own, one invocation per node: in H-PLOC each merge's
+// quantisation held up the whole team at its next barrier. The nodes are the
+// same, bit for bit, as a quantisation inside the merge made them: the same
+// exact boxes go in.
 #version 460
 #extension GL_GOOGLE_include_directive : require
 #include "bvh_common.glsl"
