@@ -85,9 +85,10 @@ struct Case {
   std::function<void(const scene::Scene&, const scene::Pose&, std::vector<scene::Ray>&, std::vector<double>&)> aim;
   /// Rays aimed through the trees' own boxes (the edges group): the case renders
   /// a camera frame first, which builds the trees, and this gets every child
-  /// box of the first shape's bottom-level tree as the trace decodes it
-  /// (quantised, in the shape's own space, which is the world for these cases'
-  /// root shapes) instead of `aim`.
+  /// box of the first shape's bottom-level tree as the walk tests it
+  /// (BvhSnapshot::storedChildBox: the exact boxes the default trees keep, in
+  /// the shape's own space, which is the world for these cases' root shapes)
+  /// instead of `aim`.
   std::function<void(const scene::Scene&, const scene::Pose&, const std::vector<std::array<float, 6>>& boxes,
                      std::vector<scene::Ray>&, std::vector<double>&)>
       aimAtBoxes;

@@ -344,7 +344,7 @@ std::vector<Case> grid(const GridOptions& o) {
 
   // Edges and corners, each aimed ray's first hit held to the reference's:
   // shared edges and vertices of a finer sphere, the corners, edges and faces
-  // of the trees' quantised boxes (axis-parallel rays among them), and rays
+  // of the boxes the walk tests (axis-parallel rays among them), and rays
   // grazing a flat face or running parallel just above it.
   auto edgesCase = [&](std::string name, std::function<scene::Scene()> make, AimFn aim, bool closed) {
     cases.push_back(aimed("edges: " + name, "edges", std::move(make), sphereView, o, std::move(aim), closed));
@@ -352,10 +352,10 @@ std::vector<Case> grid(const GridOptions& o) {
   };
   edgesCase("shared edges and vertices of a sphere of 20000 triangles (IOR 1)", [] { return sphereScene(100, 1.0f); },
             aimAt(3.0), true);
-  edgesCase("through corners, edges and faces of the sphere's quantised boxes (IOR 1)",
+  edgesCase("through corners, edges and faces of the sphere's tree boxes (IOR 1)",
             [] { return sphereScene(48, 1.0f); }, nullptr, true);
   cases.back().aimAtBoxes = aimAtBoxes(3.0, true);
-  edgesCase("through corners, edges and faces of the cube's quantised boxes (IOR 1)", [] { return cubeScene(6, 1.0f); },
+  edgesCase("through corners, edges and faces of the cube's tree boxes (IOR 1)", [] { return cubeScene(6, 1.0f); },
             nullptr, true);
   cases.back().aimAtBoxes = aimAtBoxes(3.0, false);
   edgesCase("grazing the cube's face at 0.05 to 3 degrees, and parallel 1e-4 above it (IOR 1)",
