@@ -6,6 +6,7 @@
 
 #include "ref/sah_bvh.h"
 #include "render/bvh.h"
+#include "shared/trace.h"
 #include "vk/commands.h"
 
 #include <gtest/gtest.h>
@@ -13,6 +14,7 @@
 #include <cmath>
 #include <cstring>
 #include <functional>
+#include <numbers>
 #include <random>
 #include <set>
 
@@ -101,11 +103,43 @@ bool contains(const float* outerLo, const float* outerHi, const float* lo, const
   return true;
 }
 
+// Entry i of node slot `node`'s 4-wide record holds `box` (an exact child
+// box as kept, the point at +infinity where empty), `ref` and its `parent`.
+void expectWideEntry(const BvhSnapshot& s, uint32_t node, int i, const render::BoxFloats& box, uint32_t ref,
+                     uint32_t parent) {
+  const gpu::BvhWideEntry& e = s.wideRecords.at(4 * size_t(node) + size_t(i));
+  bool empty = box[0] == INFINITY;
+  render::BoxFloats stored{e.lo[0], e.lo[1], e.lo[2], e.hi[0], e.hi[1], e.hi[2]};
+  EXPECT_EQ(stored, box) << "entry " << i << " of node " << node << "'s 4-wide record";
+  EXPECT_EQ(e.ref, empty ? gpu::kBvhNone : ref) << "entry " << i << " of node " << node << "'s 4-wide record";
+  EXPECT_EQ(e.parent, parent) << "entry " << i << " of node " << node << "'s 4-wide record";
+}
+
+// Node slot `node`'s 4-wide record: each child's two children with their
+// kept exact boxes, or a leaf child itself and an empty entry.
+void expectWideRecord(const BvhSnapshot& s, uint32_t node) {
+  const render::BoxFloats none{INFINITY, INFINITY, INFINITY, INFINITY, INFINITY, INFINITY};
+  for (int c = 0; c < 2; ++c) {
+    uint32_t child = s.nodes[node].child[c];
+    if (!(child & gpu::kBvhLeafBit) && child >= s.nodes.size()) continue;  // the walk reports the reference
+    if (child & gpu::kBvhLeafBit) {
+      expectWideEntry(s, node, 2 * c, s.exactChildBoxes[2 * size_t(node) + size_t(c)], child, gpu::kBvhNone);
+      expectWideEntry(s, node, 2 * c + 1, none, gpu::kBvhNone, gpu::kBvhNone);
+    } else {
+      for (int k = 0; k < 2; ++k) {
+        expectWideEntry(s, node, 2 * c + k, s.exactChildBoxes[2 * size_t(child) + size_t(k)], s.nodes[child].child[k],
+                        child);
+      }
+    }
+  }
+}
+
 // Walks one group's tree; returns its primitives and checks that every box
 // as the trace tests it (quantised and rounded outwards in a compact forest)
 // holds the exact box of the triangles below it, that kept exact child boxes
-// are that box to the bit, the parent links, the refit arrival bits, and that
-// every reference stays inside the group's own slots.
+// are that box to the bit and 4-wide records hold them, the parent links,
+// the refit arrival bits, and that every reference stays inside the group's
+// own slots.
 std::multiset<uint32_t> walk(const BvhSnapshot& s, uint32_t group, const Soup& soup) {
   std::multiset<uint32_t> seen;
   const gpu::BvhGroup& g = s.groups[group];
@@ -126,6 +160,7 @@ std::multiset<uint32_t> walk(const BvhSnapshot& s, uint32_t group, const Soup& s
     if (ref >= s.nodes.size() || ++visited > s.nodes.size()) return box;
     const gpu::BvhNode& node = s.nodes[ref];
     EXPECT_EQ(node.scale & gpu::kBvhArrivalBit, 0u) << "node " << ref << " was left half-refitted";
+    if (!s.wideRecords.empty()) expectWideRecord(s, ref);
     for (int c = 0; c < 2; ++c) {
       uint32_t child = node.child[c];
       if (!(child & gpu::kBvhLeafBit)) {
@@ -210,7 +245,9 @@ TEST_F(BvhTest, BuildsAreBitForBitRepeatable) {
   BvhSnapshot sb = build(builder, b, soup);
   ASSERT_EQ(sa.nodes.size(), sb.nodes.size());
   EXPECT_EQ(std::memcmp(sa.nodes.data(), sb.nodes.data(), sa.nodes.size() * sizeof(gpu::BvhNode)), 0);
-
+  ASSERT_EQ(sa.wideRecords.size(), 4 * sa.nodes.size());
+  EXPECT_EQ(std::memcmp(sa.wideRecords.data(), sb.wideRecords.data(), sa.wideRecords.size() * sizeof(gpu::BvhWideEntry)),
+            0);
 }
 
 // The issue's own words: batched builds give the same trees as one shape at a time.
@@ -225,7 +262,9 @@ TEST_F(BvhTest, ABatchedBuildGivesTheSameTreesAsOneGroupAtATime) {
   for (uint32_t g = 0; g < sizes.size(); ++g) apart = build(builder, single, soup, {g});
   EXPECT_EQ(std::memcmp(together.nodes.data(), apart.nodes.data(), together.nodes.size() * sizeof(gpu::BvhNode)), 0);
   EXPECT_EQ(std::memcmp(together.groups.data(), apart.groups.data(), together.groups.size() * sizeof(gpu::BvhGroup)), 0);
-
+  EXPECT_EQ(std::memcmp(together.wideRecords.data(), apart.wideRecords.data(),
+                        together.wideRecords.size() * sizeof(gpu::BvhWideEntry)),
+            0);
 }
 
 TEST_F(BvhTest, RebuildingOneGroupLeavesTheOthersUntouched) {
@@ -271,6 +310,7 @@ TEST_F(BvhTest, ACompactForestsQuantisedBoxesHoldTheTrianglesAfterABuildAndARefi
   Bvh bvh = builder.makeBvh({1000, 2000}, render::BvhLeaves::Triangles, "compact", render::BvhChildBoxes::Quantised);
   BvhSnapshot built = build(builder, bvh, soup);
   ASSERT_TRUE(built.exactChildBoxes.empty());
+  ASSERT_TRUE(built.wideRecords.empty()) << "a compact forest keeps no 4-wide records";
   EXPECT_EQ(walk(built, 0, soup).size(), 1000u);
   EXPECT_EQ(walk(built, 1, soup).size(), 2000u);
   for (size_t i = 9 * 1000; i < soup.positions.size(); ++i) soup.positions[i] = soup.positions[i] * 3.0f + 50.0f;
@@ -339,6 +379,62 @@ TEST_F(BvhTest, ARefitAfterRestructuringFindsEveryLeafsNewParent) {
   build(builder, bvh, soup, {}, 3);
   for (float& p : soup.positions) p = -2.0f * p + 7.0f;
   EXPECT_EQ(walk(refit(builder, bvh, soup), 0, soup).size(), 3000u);  // every box holds its moved triangles
+}
+
+// The deepest internal node of one group's tree, its root at depth 0.
+uint32_t deepestNode(const BvhSnapshot& s, uint32_t group) {
+  uint32_t root = s.groups[group].root, deepest = 0;
+  if (root == gpu::kBvhNone || (root & gpu::kBvhLeafBit)) return 0;
+  std::vector<std::pair<uint32_t, uint32_t>> stack{{root, 0u}};
+  while (!stack.empty()) {
+    auto [node, depth] = stack.back();
+    stack.pop_back();
+    deepest = std::max(deepest, depth);
+    for (uint32_t child : s.nodes.at(node).child) {
+      if (!(child & gpu::kBvhLeafBit)) stack.push_back({child, depth + 1});
+    }
+  }
+  return deepest;
+}
+
+// A latitude-longitude sphere of 2 rows x columns triangles, the bench's glass sphere's shape.
+Soup sphere(uint32_t rows, uint32_t columns) {
+  Soup s;
+  auto point = [&](uint32_t i, uint32_t j) {
+    double theta = std::numbers::pi * i / rows, phi = 2.0 * std::numbers::pi * j / columns;
+    for (double v : {std::sin(theta) * std::cos(phi), std::cos(theta), std::sin(theta) * std::sin(phi)}) {
+      s.positions.push_back(float(v));
+    }
+    s.indices.push_back(uint32_t(s.indices.size()));
+  };
+  for (uint32_t i = 0; i < rows; ++i) {
+    for (uint32_t j = 0; j < columns; ++j) {
+      point(i, j), point(i + 1, j), point(i + 1, j + 1);
+      point(i, j), point(i + 1, j + 1), point(i, j + 1);
+    }
+  }
+  return s;
+}
+
+// Once the stack runs short, the 4-wide walk pushes at most one entry a
+// level of a tree, as the binary walk does (trace.comp, narrowToBinary), so
+// a path to a node at depth d needs d entries of the trace's stack beside
+// the top level's; a full stack drops entries, and with them hits. The
+// deepest trees of a million triangles the tests know, a sphere with its
+// poles' slivers and five strands (near-equal Morton codes), leave room for
+// a top level 6 deep. (Triangles on one centroid, a seventh of randomSoup's,
+// build a chain: a million of those reach depth 244, where either walk drops
+// entries of that chain, which all lie on the one spot.)
+TEST_F(BvhTest, TheDeepestTreesOfAMillionTrianglesLeaveTheStackRoomForATopLevel) {
+  constexpr uint32_t kTopLevel = 6;
+  for (auto [name, soup] : {std::pair{"sphere", sphere(500, 1000)}, std::pair{"strands", strands(1000000)}}) {
+    uint32_t triangles = uint32_t(soup.indices.size() / 3);
+    BvhBuilder builder(context());
+    Bvh bvh = builder.makeBvh({triangles}, render::BvhLeaves::Triangles, name);
+    uint32_t depth = deepestNode(build(builder, bvh, soup), 0);
+    std::printf("    %s: deepest node at %u\n", name, depth);
+    EXPECT_LE(depth + kTopLevel, gpu::kTraceStackSize) << name;
+  }
 }
 
 }  // namespace

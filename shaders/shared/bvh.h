@@ -64,6 +64,7 @@ SNELL_CONST kBvhBindingCounters = 17;     // uint[nodes]: arrivals of the restru
 SNELL_CONST kBvhBindingNodeStats = 18;    // uvec2[nodes]: subtree cost and leaf count (restructuring)
 SNELL_CONST kBvhBindingExactBoxes = 19;   // float[6 * nodes]: each node's exact box during a build or a refit
 SNELL_CONST kBvhBindingChildBoxes = 20;   // vec4[3 * nodes]: each node's children's exact boxes (kBvhFlagChildBoxes)
+SNELL_CONST kBvhBindingWideRecords = 21;  // BvhWideEntry[4 * nodes]: each node's 4-wide record (kBvhFlagWideRecords)
 
 SNELL_CONST kBvhSpecWorkgroupSize = 0;
 SNELL_CONST kBvhSpecSlots = 1;  // H-PLOC: window slots per invocation, window / smallest subgroup
@@ -72,6 +73,7 @@ SNELL_CONST kBvhSpecTeams = 2;  // H-PLOC: subgroups per workgroup at the smalle
 SNELL_CONST kBvhFlagInstances = 1u;  // leaves are instances (top level), else triangles
 SNELL_CONST kBvhFlagKeys32 = 2u;     // sort keys are 32-bit
 SNELL_CONST kBvhFlagChildBoxes = 4u; // the forest keeps each node's children's exact boxes for the trace
+SNELL_CONST kBvhFlagWideRecords = 8u; // and each node's 4-wide record (BvhWideEntry)
 
 // A node holds its two children's boxes quantised to 8 bits per coordinate
 // within its own box (Ylitie, Karras and Laine 2017 do the same for wide
@@ -94,6 +96,26 @@ struct BvhNode {
   uint quant[3];    // 12: bytes 0-5: child 0's lo xyz, hi xyz in steps; bytes 6-11: child 1's
   uint child[2];    // 8: node index, or a leaf reference
   uint parent;      // 4: kBvhNone at a group's root; else the parent's slot, kBvhParentRight set when this is its child 1
+};
+
+// A bottom-level forest with exact child boxes also keeps, for each node, a
+// record of four entries the trace walks 4 wide (kBvhBindingWideRecords):
+// entries 2 c and 2 c + 1 are child c's two children, or child c itself and
+// an empty entry where child c is a leaf. A visit reads one record and tests
+// four boxes, and enters a grandchild, so a walk visits every other level:
+// 39-45% fewer dependent node reads than the binary walk for the same
+// triangles (bench/results/walk-counts.md, step 2e). Each node writes its
+// share as a build or refit completes it: its children into its parent's
+// record, a leaf child into its own, so records need no depth and no pass of
+// their own. An empty entry is the point at +infinity (no slab enters it)
+// with kBvhNone. The trace reads an entry as two vec4s: lo and the ref's
+// bits, hi and the parent's.
+// 32 bytes, total: 32 bytes
+struct BvhWideEntry {
+  float lo[3];  // 12
+  uint ref;     // 4: node slot or leaf reference; kBvhNone where empty
+  float hi[3];  // 12
+  uint parent;  // 4: child c of the record's node for entries 2 c and 2 c + 1; kBvhNone where child c stands for itself
 };
 
 // 64 bytes, total: 64 bytes

@@ -291,6 +291,12 @@ SNELL_CONST kSurfaceSingleSided = 32u;  // some opaque material is single-sided:
 SNELL_CONST kSurfaceAll = 63u;
 // Nodes one ray segment may visit before it gives up: a corrupted tree ends here.
 SNELL_CONST kTraceMaxVisits = 1u << 20;
+// Entries of a walk's stack, both levels together. The binary walk pushes at
+// most one a level of a tree, and so does the 4-wide walk once the stack
+// runs short (three every other level before that), so a bottom-level tree
+// of depth d needs d entries above the top level's (tests/bvh_test.cpp: the
+// builder's trees of a million triangles reach 57).
+SNELL_CONST kTraceStackSize = 64u;
 
 // The trace's own binding slots, after the scene binding set (shared/scene.h).
 SNELL_CONST kTraceBindingTlasNodes = kSceneBindingCount + 0;
@@ -307,6 +313,7 @@ SNELL_CONST kTraceBindingEnvironment = kSceneBindingCount + 10;   // vec4[]: (wi
 SNELL_CONST kTraceBindingHits = kSceneBindingCount + 11;          // TraceHitRecord[width * height * kTraceReplaySegments], record/replay only
 SNELL_CONST kTraceBindingTlasChildBoxes = kSceneBindingCount + 12;  // vec4[3 * nodes] (kTraceSpecChildBoxes)
 SNELL_CONST kTraceBindingBlasChildBoxes = kSceneBindingCount + 13;
+SNELL_CONST kTraceBindingBlasWideRecords = kSceneBindingCount + 14;  // BvhWideEntry[4 * nodes] (kTraceSpecChildBoxes)
 
 // A primary ray from a list, relative to the frame origin like everything the trace sees.
 // 32 bytes, total: 32 bytes

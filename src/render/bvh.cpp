@@ -23,7 +23,8 @@ namespace {
 
 uint32_t flagsOf(const Bvh& bvh) {
   return (bvh.leaves == BvhLeaves::Instances ? gpu::kBvhFlagInstances : 0u) |
-         (bvh.childBoxes == BvhChildBoxes::Exact ? gpu::kBvhFlagChildBoxes : 0u);
+         (bvh.childBoxes == BvhChildBoxes::Exact ? gpu::kBvhFlagChildBoxes : 0u) |
+         (bvh.hasWideRecords() ? gpu::kBvhFlagWideRecords : 0u);
 }
 
 // One subgroup per workgroup for the passes that hand boxes from one
@@ -38,7 +39,8 @@ uint32_t handOffWorkgroup(const vk::Context& context) {
 }  // namespace
 
 uint64_t Bvh::treeBytes() const {
-  return nodes.size() + groups.size() + (childBoxes == BvhChildBoxes::Exact ? exactChildBoxes.size() : 0);
+  return nodes.size() + groups.size() + (childBoxes == BvhChildBoxes::Exact ? exactChildBoxes.size() : 0) +
+         (hasWideRecords() ? wideRecords.size() : 0);
 }
 
 uint64_t Bvh::workBytes() const {
@@ -118,6 +120,8 @@ Bvh BvhBuilder::makeBvh(const std::vector<uint32_t>& groupSizes, BvhLeaves leave
   bvh.exactBoxes = vk::storageBuffer(context_, primitives * 24, name + " exact boxes");
   bool exact = childBoxes == BvhChildBoxes::Exact;
   bvh.exactChildBoxes = vk::storageBuffer(context_, exact ? primitives * 48 : 16, name + " exact child boxes");
+  bvh.wideRecords = vk::storageBuffer(context_, bvh.hasWideRecords() ? primitives * 4 * sizeof(gpu::BvhWideEntry) : 16,
+                                      name + " 4-wide records");
 
   std::vector<gpu::BvhGroup> groups(groupCount);
   for (size_t g = 0; g < groups.size(); ++g) {
@@ -133,8 +137,10 @@ Bvh BvhBuilder::makeBvh(const std::vector<uint32_t>& groupSizes, BvhLeaves leave
   vk::upload(context_, bvh.groups, groups.data(), groups.size() * sizeof(gpu::BvhGroup));
   vk::Commands commands(context_, name + " setup");
   commands.begin();
-  // Slots of unbuilt groups read the same every time; arrival counts start even.
+  // Slots of unbuilt groups (and a group's one slot no node takes) read the
+  // same every time; arrival counts start even.
   commands.fillBuffer(bvh.nodes, 0);
+  commands.fillBuffer(bvh.wideRecords, 0);
   commands.fillBuffer(bvh.dropped, 0);
   commands.fillBuffer(bvh.stats, 0);
   commands.transferToCompute();
@@ -253,6 +259,7 @@ void BvhBuilder::recordBuild(vk::Commands& commands, Bvh& bvh, const BvhInputs& 
                               {gpu::kBvhBindingPrimBoxes, &s.primBoxes},
                               {gpu::kBvhBindingExactBoxes, &bvh.exactBoxes},
                               {gpu::kBvhBindingChildBoxes, &bvh.exactChildBoxes},
+                              {gpu::kBvhBindingWideRecords, &bvh.wideRecords},
                               {gpu::kBvhBindingNodes, &bvh.nodes}},
                              push, positions);
   commands.computeToCompute();
@@ -315,6 +322,7 @@ void BvhBuilder::recordRefit(vk::Commands& commands, Bvh& bvh, const BvhInputs& 
                            {gpu::kBvhBindingNodes, &bvh.nodes},
                            {gpu::kBvhBindingExactBoxes, &bvh.exactBoxes},
                            {gpu::kBvhBindingChildBoxes, &bvh.exactChildBoxes},
+                           {gpu::kBvhBindingWideRecords, &bvh.wideRecords},
                            {gpu::kBvhBindingGroups, &bvh.groups},
                            {gpu::kBvhBindingStats, &bvh.stats},
                            {gpu::kBvhBindingDropped, &bvh.dropped}},
@@ -332,6 +340,10 @@ BvhSnapshot BvhBuilder::download(const Bvh& bvh) const {
   if (bvh.childBoxes == BvhChildBoxes::Exact) {
     s.exactChildBoxes.resize(2 * s.nodes.size());
     vk::download(context_, bvh.exactChildBoxes, s.exactChildBoxes.data(), s.exactChildBoxes.size() * sizeof(BoxFloats));
+  }
+  if (bvh.hasWideRecords()) {
+    s.wideRecords.resize(4 * s.nodes.size());
+    vk::download(context_, bvh.wideRecords, s.wideRecords.data(), s.wideRecords.size() * sizeof(gpu::BvhWideEntry));
   }
   vk::download(context_, bvh.groups, s.groups.data(), s.groups.size() * sizeof(gpu::BvhGroup));
   vk::download(context_, bvh.stats, stats.data(), stats.size() * 16);

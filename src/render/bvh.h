@@ -59,9 +59,13 @@ struct Bvh {
   vk::Buffer buildEntries, refitEntries;  ///< this forest's lists, copied in per build or refit
   vk::Buffer exactBoxes;  ///< float[6] per node slot: a build's or refit's exact boxes on their way up
   vk::Buffer exactChildBoxes;  ///< float[12] per node slot with BvhChildBoxes::Exact (else 16 unused bytes)
+  vk::Buffer wideRecords;      ///< gpu::BvhWideEntry[4] per node slot where hasWideRecords() (else 16 unused bytes)
 
   uint32_t groupCount() const { return static_cast<uint32_t>(groupSizes.size()); }
-  /// Memory of the trees the trace reads: nodes, their exact child boxes and group records.
+  /// Whether builds and refits keep 4-wide records (shared/bvh.h, BvhWideEntry): a bottom level with
+  /// exact child boxes, which the trace walks 4 wide (128 bytes more a node).
+  bool hasWideRecords() const { return leaves == BvhLeaves::Triangles && childBoxes == BvhChildBoxes::Exact; }
+  /// Memory of the trees the trace reads: nodes, their exact child boxes, 4-wide records and group records.
   uint64_t treeBytes() const;
   /// Memory builds and refits work in besides the trees (exact boxes), and the per-group tables and lists.
   uint64_t workBytes() const;
@@ -92,6 +96,8 @@ struct BvhSnapshot {
   /// With BvhChildBoxes::Exact, each node's children's exact boxes as the
   /// trace reads them (child 0's at 2 n, child 1's at 2 n + 1); else empty.
   std::vector<BoxFloats> exactChildBoxes;
+  /// Where the forest keeps them, each node's 4-wide record (entries 4 n to 4 n + 3); else empty.
+  std::vector<gpu::BvhWideEntry> wideRecords;
   std::vector<gpu::BvhGroup> groups;
   std::vector<double> sah;  ///< per group: SAH cost its last refit measured (a multiple of the root's area)
 };

@@ -33,6 +33,8 @@ static_assert(sizeof(glm::uvec4) == 16 && sizeof(glm::vec4) == 16 && sizeof(glm:
 
 static_assert(sizeof(BvhNode) == 40 && offsetof(BvhNode, scale) == 12 && offsetof(BvhNode, quant) == 16 &&
               offsetof(BvhNode, child) == 28 && offsetof(BvhNode, parent) == 36);
+static_assert(sizeof(BvhWideEntry) == 32 && offsetof(BvhWideEntry, ref) == 12 && offsetof(BvhWideEntry, hi) == 16 &&
+              offsetof(BvhWideEntry, parent) == 28);
 static_assert(sizeof(BvhGroup) == 64 && offsetof(BvhGroup, boxHi) == 12 && offsetof(BvhGroup, root) == 24 &&
               offsetof(BvhGroup, first) == 28 && offsetof(BvhGroup, count) == 32 && offsetof(BvhGroup, buildArea) == 36);
 static_assert(sizeof(BvhBuildEntry) == 48 && offsetof(BvhBuildEntry, base) == 12 &&

@@ -228,6 +228,7 @@ uint64_t TracePass::record(vk::Commands& commands, const TraceInputs& in, const 
                                    {gpu::kTraceBindingBlasGroups, &in.blas->groups},
                                    {gpu::kTraceBindingTlasChildBoxes, &in.tlas->exactChildBoxes},
                                    {gpu::kTraceBindingBlasChildBoxes, &in.blas->exactChildBoxes},
+                                   {gpu::kTraceBindingBlasWideRecords, &in.blas->wideRecords},
                                    {gpu::kTraceBindingPixels, masked ? target.pixels : &placeholder_},
                                    {gpu::kTraceBindingHits, &hitRecords(settings)}});
   if (masked) {

@@ -18,8 +18,10 @@ layout(std430, binding = kBvhBindingPrimBoxes) readonly buffer PrimBoxes { float
 layout(std430, binding = kBvhBindingExactBoxes) readonly buffer ExactBoxes { float exact[]; };
 layout(std430, binding = kBvhBindingNodes) buffer Nodes { BvhNode nodes[]; };
 layout(std430, binding = kBvhBindingChildBoxes) writeonly buffer ChildBoxes { vec4 childBoxes[]; };
+layout(std430, binding = kBvhBindingWideRecords) writeonly buffer WideRecords { vec4 wideRecords[]; };
 
 #include "bvh_entry_of.glsl"
+#include "bvh_wide_record.glsl"
 
 #include "bvh_child_box.glsl"
 
@@ -36,6 +38,7 @@ void main() {
   childBox(entry, n.child[1], lo1, hi1);
   if ((pc.flags & kBvhFlagChildBoxes) != 0u) {  // the trace reads these, not the node's quantised boxes
     packChildBoxes(lo0, hi0, lo1, hi1, childBoxes[3u * node], childBoxes[3u * node + 1u], childBoxes[3u * node + 2u]);
+    writeWideShare(node, n.parent, lo0, hi0, lo1, hi1, n.child[0], n.child[1]);
     nodes[node].scale = 0u;
     return;
   }

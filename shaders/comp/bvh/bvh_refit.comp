@@ -37,6 +37,7 @@ layout(std430, binding = kBvhBindingBlasGroups) readonly buffer BlasGroups { Bvh
 layout(std430, binding = kBvhBindingNodes) coherent buffer Nodes { BvhNode nodes[]; };
 layout(std430, binding = kBvhBindingExactBoxes) coherent buffer ExactBoxes { float exact[]; };
 layout(std430, binding = kBvhBindingChildBoxes) writeonly buffer ChildBoxes { vec4 childBoxes[]; };
+layout(std430, binding = kBvhBindingWideRecords) writeonly buffer WideRecords { vec4 wideRecords[]; };
 layout(std430, binding = kBvhBindingGroups) buffer Groups { BvhGroup groups[]; };
 layout(std430, binding = kBvhBindingStats) buffer Stats { uvec4 stats[]; };
 layout(std430, binding = kBvhBindingDropped) buffer Dropped { uint dropped; };
@@ -44,6 +45,7 @@ layout(std430, binding = kBvhBindingDropped) buffer Dropped { uint dropped; };
 
 #define JOB_FIRST(i) entries[i].threadBase
 #include "bvh_entry_of.glsl"
+#include "bvh_wide_record.glsl"
 
 // A 64-bit add from two 32-bit atomics: the low word's carry is seen by the
 // adder that caused it, and the high word's additions commute.
@@ -122,6 +124,8 @@ void main() {
       if ((pc.flags & kBvhFlagChildBoxes) != 0u) {
         packChildBoxes(childLo[0], childHi[0], childLo[1], childHi[1], childBoxes[3u * node], childBoxes[3u * node + 1u],
                        childBoxes[3u * node + 2u]);
+        writeWideShare(node, parent, childLo[0], childHi[0], childLo[1], childHi[1], nodes[node].child[0],
+                       nodes[node].child[1]);
       } else {
         BvhNode n = nodes[node];
         encodeNode(n, childLo[0], childHi[0], childLo[1], childHi[1]);
