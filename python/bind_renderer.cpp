@@ -146,7 +146,7 @@ void bindRenderer(py::module_& m) {
              return PyRenderer{std::make_shared<RendererState>(RendererState{d, s, std::move(r)})};
            }),
            "device"_a, "scene"_a, "frames_in_flight"_a = 2, "compact_trees"_a = false,
-           "Uploads the scene to the device. compact_trees: trees of 40 bytes a triangle (88 by default), whose "
+           "Uploads the scene to the device. compact_trees: trees of 40 bytes a triangle (216 by default), whose "
            "walk is slower and draws the same pictures.")
       .def("set_time", [](PyRenderer& r, double seconds) { r.get().renderer.setTime(seconds); }, "seconds"_a,
            "Poses a glTF scene at `seconds` (animations, morphs, skins).")

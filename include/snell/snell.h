@@ -438,9 +438,10 @@ struct RendererOptions {
   /// GPU timestamps around each pass, for FrameInfo::passes; off, frames record none.
   bool passTimes = true;
   /// Trees of 40 bytes a triangle, whose walk decodes each node's 8-bit
-  /// quantised child boxes; off (the default), 88 bytes a triangle, the
-  /// children's exact boxes kept beside each node, and a walk about a fifth
-  /// faster. The pictures are the same.
+  /// quantised child boxes; off (the default), 216 bytes a triangle, the
+  /// children's exact boxes and grandchildren's 4-wide records kept beside
+  /// each node, and a faster walk (bench/results/walk-counts.md). The
+  /// pictures are the same.
   bool compactTrees = false;
 };
 

@@ -69,8 +69,9 @@ struct RendererOptions {
   uint32_t traceLanes = 0;
   /// Trees of 40 bytes a triangle: the walk decodes each node's 8-bit
   /// quantised child boxes. Off, the trees also keep every node's children's
-  /// exact boxes (88 bytes a triangle), and the walk reads those and decodes
-  /// nothing (bench/results/walk-counts.md: how much faster).
+  /// exact boxes and a bottom level's 4-wide records (216 bytes a triangle),
+  /// and the walk reads those 4 wide and decodes nothing
+  /// (bench/results/walk-counts.md: how much faster).
   bool compactTrees = false;
 };
 
