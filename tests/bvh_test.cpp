@@ -437,5 +437,17 @@ TEST_F(BvhTest, TheDeepestTreesOfAMillionTrianglesLeaveTheStackRoomForATopLevel)
   }
 }
 
+// 4-wide records take 128 bytes a node in one buffer: a bottom level keeps
+// them while they fit the largest storage buffer the device binds (lavapipe's
+// 128 MiB: a million triangles), and a larger one keeps the binary walk;
+// top levels and compact trees keep none.
+TEST_F(BvhTest, ABottomLevelKeepsWideRecordsWhileTheyFitOneBuffer) {
+  const uint64_t fit = context().caps().maxStorageBufferRange / (4 * sizeof(gpu::BvhWideEntry));
+  EXPECT_TRUE(render::keepsWideRecords(context(), render::BvhLeaves::Triangles, render::BvhChildBoxes::Exact, fit));
+  EXPECT_FALSE(render::keepsWideRecords(context(), render::BvhLeaves::Triangles, render::BvhChildBoxes::Exact, fit + 1));
+  EXPECT_FALSE(render::keepsWideRecords(context(), render::BvhLeaves::Instances, render::BvhChildBoxes::Exact, 2));
+  EXPECT_FALSE(render::keepsWideRecords(context(), render::BvhLeaves::Triangles, render::BvhChildBoxes::Quantised, 2));
+}
+
 }  // namespace
 }  // namespace snell::test

@@ -18,6 +18,7 @@ layout(local_size_x = 64) in;  // one kTraceTile x kTraceTile tile of pixels
 layout(push_constant) uniform Push { TracePush pc; };
 layout(constant_id = kTraceSpecLanes) const uint kLanes = 1u;
 layout(constant_id = kTraceSpecChildBoxes) const bool kExactChildBoxes = false;
+layout(constant_id = kTraceSpecWideWalk) const bool kWideWalk = false;
 
 // Nodes are 40 bytes: read as five 8-byte words rather than ten 4-byte ones.
 layout(std430, binding = kTraceBindingTlasNodes) readonly buffer TlasNodes { uvec2 tlasWords[]; };
@@ -343,7 +344,7 @@ void narrowToBinary(uint node, inout float t[4], inout uint refs[4]) {
   }
 }
 
-// One instance's tree walked 4 wide, where the trees keep exact child boxes:
+// One instance's tree walked 4 wide, where the bottom level keeps records:
 // a visit reads the node's record of its grandchildren (shared/bvh.h,
 // BvhWideEntry) and tests four boxes, so the walk visits every other level,
 // and a chain of dependent node reads is 39-45% shorter than traverseBlas's
@@ -425,7 +426,7 @@ Hit traverse(vec3 origin, vec3 dir, uint skipInstance, uint skipPrim, float leav
     if ((ref & kBvhLeafBit) != 0u) {
       uint instance = ref & ~kBvhLeafBit;
       if (instance >= top.count) continue;
-      if (kExactChildBoxes) {
+      if (kWideWalk) {
         traverseBlasWide(instance, origin, dir, instance == skipInstance ? skipPrim : kNoHit, leaving, sp, hit);
       } else {
         traverseBlas(instance, origin, dir, instance == skipInstance ? skipPrim : kNoHit, leaving, sp, hit);

@@ -282,6 +282,9 @@ SNELL_CONST kTraceSpecSurface = 3;
 // 1: the trees keep each node's children's exact boxes (shared/bvh.h:
 // kBvhFlagChildBoxes) and the walk reads those; 0: it decodes the nodes' own.
 SNELL_CONST kTraceSpecChildBoxes = 4;
+// 1: the bottom level also keeps 4-wide records (shared/bvh.h: BvhWideEntry)
+// and its walk reads those; 0: it walks the binary nodes.
+SNELL_CONST kTraceSpecWideWalk = 5;
 SNELL_CONST kSurfaceTextures = 1u;      // some material reads a texture (any slot)
 SNELL_CONST kSurfaceEmissiveMaps = 2u;  // some material has an emissive texture
 SNELL_CONST kSurfaceIorMaps = 4u;       // some material has an IOR texture
@@ -313,7 +316,7 @@ SNELL_CONST kTraceBindingEnvironment = kSceneBindingCount + 10;   // vec4[]: (wi
 SNELL_CONST kTraceBindingHits = kSceneBindingCount + 11;          // TraceHitRecord[width * height * kTraceReplaySegments], record/replay only
 SNELL_CONST kTraceBindingTlasChildBoxes = kSceneBindingCount + 12;  // vec4[3 * nodes] (kTraceSpecChildBoxes)
 SNELL_CONST kTraceBindingBlasChildBoxes = kSceneBindingCount + 13;
-SNELL_CONST kTraceBindingBlasWideRecords = kSceneBindingCount + 14;  // BvhWideEntry[4 * nodes] (kTraceSpecChildBoxes)
+SNELL_CONST kTraceBindingBlasWideRecords = kSceneBindingCount + 14;  // BvhWideEntry[4 * nodes] (kTraceSpecWideWalk)
 
 // A primary ray from a list, relative to the frame origin like everything the trace sees.
 // 32 bytes, total: 32 bytes

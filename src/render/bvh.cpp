@@ -38,6 +38,11 @@ uint32_t handOffWorkgroup(const vk::Context& context) {
 
 }  // namespace
 
+bool keepsWideRecords(const vk::Context& context, BvhLeaves leaves, BvhChildBoxes childBoxes, uint64_t primitives) {
+  return leaves == BvhLeaves::Triangles && childBoxes == BvhChildBoxes::Exact &&
+         primitives * 4 * sizeof(gpu::BvhWideEntry) <= context.caps().maxStorageBufferRange;
+}
+
 uint64_t Bvh::treeBytes() const {
   return nodes.size() + groups.size() + (childBoxes == BvhChildBoxes::Exact ? exactChildBoxes.size() : 0) +
          (hasWideRecords() ? wideRecords.size() : 0);
@@ -109,6 +114,7 @@ Bvh BvhBuilder::makeBvh(const std::vector<uint32_t>& groupSizes, BvhLeaves leave
                           " primitives are more than one BVH can hold on this device (" + std::to_string(limit) + ")");
   }
   bvh.primitiveCount = static_cast<uint32_t>(primitives);
+  bvh.wide = keepsWideRecords(context_, leaves, childBoxes, primitives);
   size_t groupCount = std::max<size_t>(groupSizes.size(), 1);
   bvh.nodes = vk::storageBuffer(context_, primitives * sizeof(gpu::BvhNode), name + " nodes");
   bvh.groups = vk::storageBuffer(context_, groupCount * sizeof(gpu::BvhGroup), name + " groups");

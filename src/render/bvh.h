@@ -49,6 +49,7 @@ enum class BvhChildBoxes {
 struct Bvh {
   BvhLeaves leaves = BvhLeaves::Triangles;
   BvhChildBoxes childBoxes = BvhChildBoxes::Exact;
+  bool wide = false;  ///< hasWideRecords()
   std::string name;
   std::vector<uint32_t> groupSizes, first;
   uint32_t primitiveCount = 0;
@@ -62,14 +63,21 @@ struct Bvh {
   vk::Buffer wideRecords;      ///< gpu::BvhWideEntry[4] per node slot where hasWideRecords() (else 16 unused bytes)
 
   uint32_t groupCount() const { return static_cast<uint32_t>(groupSizes.size()); }
-  /// Whether builds and refits keep 4-wide records (shared/bvh.h, BvhWideEntry): a bottom level with
-  /// exact child boxes, which the trace walks 4 wide (128 bytes more a node).
-  bool hasWideRecords() const { return leaves == BvhLeaves::Triangles && childBoxes == BvhChildBoxes::Exact; }
+  /// Whether builds and refits keep 4-wide records (shared/bvh.h, BvhWideEntry), which the trace then
+  /// walks 4 wide: keepsWideRecords at makeBvh.
+  bool hasWideRecords() const { return wide; }
   /// Memory of the trees the trace reads: nodes, their exact child boxes, 4-wide records and group records.
   uint64_t treeBytes() const;
   /// Memory builds and refits work in besides the trees (exact boxes), and the per-group tables and lists.
   uint64_t workBytes() const;
 };
+
+/// Whether a forest keeps 4-wide records: a bottom level with exact child
+/// boxes whose records (128 bytes a node) fit one storage buffer the device
+/// binds. Vulkan promises 128 MiB, a million triangles, and lavapipe gives no
+/// more; NVIDIA's and AMD's drivers bind 4 GiB. A larger forest keeps the
+/// binary walk.
+bool keepsWideRecords(const vk::Context& context, BvhLeaves leaves, BvhChildBoxes childBoxes, uint64_t primitives);
 
 /// A box as six floats: lo xyz, hi xyz.
 using BoxFloats = std::array<float, 6>;

@@ -106,7 +106,9 @@ Renderer::Renderer(vk::Context& context, const scene::Scene& scene, const scene:
     throw std::logic_error("deforming item without a geometry");
   });
   raster_ = std::make_unique<RasterPass>(context);
-  trace_ = std::make_unique<TracePass>(context, scene, scene_, childBoxesOf(options));
+  trace_ = std::make_unique<TracePass>(
+      context, scene, scene_, childBoxesOf(options),
+      keepsWideRecords(context, BvhLeaves::Triangles, childBoxesOf(options), scene_.triangleCount));
   std::string name = scene.source.empty() ? std::string("scene") : scene.source;
   feed_ = std::make_unique<VertexFeed>(context, scene, scene_, options_.keepVertices, name);
   size_t lightNodes = 0;

@@ -28,8 +28,10 @@ uint32_t opticsOfScene(const scene::Scene& scene) {
 
 }  // namespace
 
-TracePass::TracePass(vk::Context& context, const scene::Scene& scene, const SceneGpu& gpu, BvhChildBoxes childBoxes)
-    : context_(context), sceneOptics_(opticsOfScene(scene)), sceneSurface_(gpu.surface), childBoxes_(childBoxes) {
+TracePass::TracePass(vk::Context& context, const scene::Scene& scene, const SceneGpu& gpu, BvhChildBoxes childBoxes,
+                     bool wideWalk)
+    : context_(context), sceneOptics_(opticsOfScene(scene)), sceneSurface_(gpu.surface), childBoxes_(childBoxes),
+      wideWalk_(wideWalk) {
   compact_ = std::make_unique<vk::ComputeProgram>(context, compactDesc());
   placeholder_ = vk::Buffer(context, {sizeof(gpu::TracePixelListHeader), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
                                       vk::MemoryDomain::Device, "placeholder"});
@@ -74,7 +76,8 @@ bool TracePass::manyLanesNeedWave32(const vk::DeviceFacts& device) {
 }
 
 vk::ComputeProgramDesc TracePass::programDesc(const vk::DeviceFacts& device, uint32_t optics, uint32_t flags,
-                                              uint32_t lanes, uint32_t surface, BvhChildBoxes childBoxes) {
+                                              uint32_t lanes, uint32_t surface, BvhChildBoxes childBoxes,
+                                              bool wideWalk) {
   // Several lanes a pixel must share a subgroup: full subgroups keep them together.
   vk::ComputeProgramDesc desc{"trace",
                               kSpvTrace,
@@ -82,7 +85,8 @@ vk::ComputeProgramDesc TracePass::programDesc(const vk::DeviceFacts& device, uin
                                {gpu::kTraceSpecFlags, flags},
                                {gpu::kTraceSpecLanes, lanes},
                                {gpu::kTraceSpecSurface, surface},
-                               {gpu::kTraceSpecChildBoxes, childBoxes == BvhChildBoxes::Exact ? 1u : 0u}},
+                               {gpu::kTraceSpecChildBoxes, childBoxes == BvhChildBoxes::Exact ? 1u : 0u},
+                               {gpu::kTraceSpecWideWalk, wideWalk && childBoxes == BvhChildBoxes::Exact ? 1u : 0u}},
                               lanes > 1};
   if (lanes > 1 && manyLanesNeedWave32(device)) desc.requiredSubgroupSize = 32;
   return desc;
@@ -94,7 +98,7 @@ const vk::ComputeProgram& TracePass::program(uint32_t optics, uint32_t flags, ui
   uint64_t key = uint64_t(optics) << 32 | uint64_t(lanes) << 16 | flags;
   auto found = programs_.find(key);
   if (found != programs_.end()) return *found->second;
-  vk::ComputeProgramDesc desc = programDesc(context_.facts(), optics, flags, lanes, sceneSurface_, childBoxes_);
+  vk::ComputeProgramDesc desc = programDesc(context_.facts(), optics, flags, lanes, sceneSurface_, childBoxes_, wideWalk_);
   return *programs_.emplace(key, std::make_unique<vk::ComputeProgram>(context_, desc)).first->second;
 }
 
@@ -193,8 +197,8 @@ uint64_t TracePass::record(vk::Commands& commands, const TraceInputs& in, const 
                            const TraceTarget& target, bool masked, uint32_t lanes) {
   // The pipelines are specialised to what the trees keep: trees of the other
   // kind would be walked through a 16-byte placeholder.
-  if (in.tlas->childBoxes != childBoxes_ || in.blas->childBoxes != childBoxes_) {
-    throw std::logic_error("trace: trees whose child boxes are not the kind its pipelines were made for");
+  if (in.tlas->childBoxes != childBoxes_ || in.blas->childBoxes != childBoxes_ || in.blas->hasWideRecords() != wideWalk_) {
+    throw std::logic_error("trace: trees whose child boxes or 4-wide records are not the kind its pipelines were made for");
   }
   gpu::TracePush p = push(in, settings, target, masked);
   if (!masked) lanes = 1;

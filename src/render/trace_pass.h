@@ -53,8 +53,10 @@ struct TraceTarget {
 
 class TracePass {
  public:
-  /// `childBoxes`: what the scene's trees keep for the walk (SceneTrees' forests).
-  TracePass(vk::Context& context, const scene::Scene& scene, const SceneGpu& gpu, BvhChildBoxes childBoxes);
+  /// `childBoxes`: what the scene's trees keep for the walk (SceneTrees' forests); `wideWalk`: whether
+  /// the bottom level keeps 4-wide records (keepsWideRecords), which the walk then reads.
+  TracePass(vk::Context& context, const scene::Scene& scene, const SceneGpu& gpu, BvhChildBoxes childBoxes,
+            bool wideWalk);
   ~TracePass();
   TracePass(const TracePass&) = delete;
   TracePass& operator=(const TracePass&) = delete;
@@ -94,11 +96,11 @@ class TracePass {
   /// The trace pipeline specialised to the optics a view traces with
   /// (gpu::kOptics*), its flags (gpu::kTraceFlag*), the lanes a pixel and the
   /// surface features a scene's materials use (gpu::kSurface*), for trees
-  /// with `childBoxes`, as every trace pass makes it on `device`; and the
-  /// masked trace's compaction.
+  /// with `childBoxes` and, with `wideWalk`, 4-wide records, as every trace
+  /// pass makes it on `device`; and the masked trace's compaction.
   static vk::ComputeProgramDesc programDesc(const vk::DeviceFacts& device, uint32_t optics, uint32_t flags,
                                             uint32_t lanes, uint32_t surface,
-                                            BvhChildBoxes childBoxes = BvhChildBoxes::Exact);
+                                            BvhChildBoxes childBoxes = BvhChildBoxes::Exact, bool wideWalk = true);
   /// Whether the several-lanes walk must be compiled for 32-lane subgroups:
   /// on AMD's RDNA1 and RDNA2 (gfx10) through RADV. Mesa 22.3's compiler
   /// (Debian 12's) corrupts its own heap compiling it in wave64, the default
@@ -136,6 +138,7 @@ class TracePass {
   uint32_t sceneOptics_ = 0;  ///< gpu::kOptics* bits the scene's materials can show
   uint32_t sceneSurface_ = 0;  ///< gpu::kSurface* bits its materials use (SceneGpu::surface)
   BvhChildBoxes childBoxes_;
+  bool wideWalk_;
   std::map<uint64_t, std::unique_ptr<vk::ComputeProgram>> programs_;  ///< by optics << 32 | lanes << 16 | flags
   std::unique_ptr<vk::ComputeProgram> compact_;
   vk::Buffer placeholder_;
