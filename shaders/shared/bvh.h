@@ -99,7 +99,9 @@ struct BvhNode {
 };
 
 // A bottom-level forest with exact child boxes also keeps, for each node, a
-// record of four entries the trace walks 4 wide (kBvhBindingWideRecords):
+// record of four entries the trace walks 4 wide (kBvhBindingWideRecords),
+// where the records fit one buffer the device binds (render/bvh.h:
+// keepsWideRecords):
 // entries 2 c and 2 c + 1 are child c's two children, or child c itself and
 // an empty entry where child c is a leaf. A visit reads one record and tests
 // four boxes, and enters a grandchild, so a walk visits every other level:
