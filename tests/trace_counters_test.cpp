@@ -11,6 +11,8 @@
 
 #include <gtest/gtest.h>
 
+#include <vector>
+
 namespace snell::test {
 namespace {
 
@@ -18,7 +20,8 @@ constexpr uint32_t kSize = 16;
 
 // Opaque unit quads about the z axis facing +z at the depths given; the middle
 // pixel's ray runs down -z from (x, 0.2, 2).
-gpu::TraceAov middlePixelThroughQuadsAt(vk::Context& context, std::initializer_list<float> depths, double x = 0.1) {
+// Every pixel's counters, the view looking down -z from (x, 0.2, 2) over the quads.
+std::vector<gpu::TraceAov> pixelsThroughQuadsAt(vk::Context& context, std::initializer_list<float> depths, double x = 0.1) {
   scene::Scene s;
   s.source = "quads one behind another";
   scene::Material grey;
@@ -37,8 +40,11 @@ gpu::TraceAov middlePixelThroughQuadsAt(vk::Context& context, std::initializer_l
   request.yfov = 0.2;
   render::FrameSettings settings{kSize, kSize, scene::resolveView(s, pose, request), glm::vec3(0.0f), 8};
   render::Renderer renderer(context, s, pose);
-  render::RenderedFrame frame = render::renderFrame(renderer, pose, settings, true);
-  return frame.aov.at(size_t(kSize / 2) * kSize + kSize / 2);
+  return render::renderFrame(renderer, pose, settings, true).aov;
+}
+
+gpu::TraceAov middlePixelThroughQuadsAt(vk::Context& context, std::initializer_list<float> depths, double x = 0.1) {
+  return pixelsThroughQuadsAt(context, depths, x).at(size_t(kSize / 2) * kSize + kSize / 2);
 }
 
 class TraceCounters : public GpuTest {};
@@ -70,6 +76,21 @@ TEST_F(TraceCounters, ARayPastEveryQuadSpendsOneDeadVisitThatNoHitCulled) {
   EXPECT_EQ(a.deadVisits, 1u);
   EXPECT_EQ(a.culledVisits, 0u);
   EXPECT_EQ(a.leafVisits, 0u);
+}
+
+TEST_F(TraceCounters, LanesThatReachTheirLeavesTogetherTestThemInOnePassEach) {
+  // The quad fills the view: every ray reaches its two triangles at once.
+  std::vector<gpu::TraceAov> aov = pixelsThroughQuadsAt(context(), {0.0f});
+  uint32_t subgroupSize = aov.front().subgroupSize;
+  ASSERT_GT(subgroupSize, 0u);
+  uint64_t leafVisits = 0, leafSteps = 0;
+  for (const gpu::TraceAov& a : aov) {
+    ASSERT_NE(a.instance, gpu::kNoHit);
+    ASSERT_EQ(a.leafVisits, 2u);
+    leafVisits += a.leafVisits;
+    leafSteps += a.leafSteps;
+  }
+  EXPECT_EQ(leafSteps * subgroupSize, leafVisits) << "every pass of a leaf loop keeps all of a subgroup's lanes at work";
 }
 
 }  // namespace

@@ -35,7 +35,7 @@ bool surfaceUses(uint bit) { return (kSpecSurface & bit) != 0u; }
 uint visits;  // nodes visited by this pixel's whole path (the driver's pipeline cannot count them: 0)
 uint boxTests, triangleTests;  // child boxes and triangles tested over the path (trace.comp counts them)
 uint deadVisits, culledVisits, leafVisits;  // TraceAov's visits that found nothing, and leaves reached (trace.comp)
-uint walkSteps, subgroupSteps;  // traversal loop passes of this lane, and of its subgroup it led (trace.comp)
+uint walkSteps, subgroupSteps, leafSteps;  // traversal and leaf loop passes this lane made, or led for its subgroup (trace.comp)
 uint segments;  // closest-hit queries of the path so far
 uint tracedPixel;  // row-major index of the pixel being traced
 
@@ -420,7 +420,7 @@ void tracePixel(uvec2 pixel) {
   if (!opticsOn(kOpticsTextureLod)) width = spread = 0.0;
 
   visits = boxTests = triangleTests = segments = walkSteps = subgroupSteps = 0u;
-  deadVisits = culledVisits = leafVisits = 0u;
+  deadVisits = culledVisits = leafVisits = leafSteps = 0u;
   tracedPixel = pixel.y * pc.width + pixel.x;
   // One call site for the path (a compiler that inlines would copy it per
   // call): the first pass at the base IOR, then, where it met dispersion,
@@ -454,7 +454,7 @@ void tracePixel(uvec2 pixel) {
                                                   path.landingMaterial, path.landingLod, shine.r, shine.g, shine.b,
                                                   weight.r, weight.g, weight.b, segments, boxTests, triangleTests,
                                                   walkSteps, subgroupSteps, subgroupVisits, SNELL_SUBGROUP_SIZE,
-                                                  path.shortestSegment, deadVisits, culledVisits, leafVisits);
+                                                  path.shortestSegment, deadVisits, culledVisits, leafVisits, leafSteps);
   }
 }
 

@@ -62,6 +62,12 @@ void countStep() {
   if (subgroupElect()) ++subgroupSteps;
 }
 
+// One pass of a leaf loop, whose lanes each test a triangle (TraceAov::leafSteps;
+// the lane's own tests are its leafVisits): the subgroup's other lanes wait.
+void countLeafStep() {
+  if (traceFlag(kTraceFlagAov) && subgroupElect()) ++leafSteps;
+}
+
 // Woop, Benthin & Wald 2013: the ray's shear, computed once per space.
 struct ShearedRay {
   vec3 origin;
@@ -275,6 +281,7 @@ void traverseBlas(uint instance, vec3 origin, vec3 dir, uint skipPrim, float lea
   for (;;) {
     countStep();
     for (uint k = 0u; k < leafCount; ++k) {
+      countLeafStep();
       testTriangle(r, instance, leaves[k], skipPrim, group.first, end, leaving, hit.t, cullSign, hit);
     }
     leafCount = 0u;
@@ -367,6 +374,7 @@ void traverseBlasWide(uint instance, vec3 origin, vec3 dir, uint skipPrim, float
   for (;;) {
     countStep();
     for (uint k = 0u; k < leafCount; ++k) {
+      countLeafStep();
       testTriangle(r, instance, leaves[k], skipPrim, group.first, end, leaving, hit.t, cullSign, hit);
     }
     leafCount = 0u;

@@ -199,7 +199,7 @@ SNELL_CONST kOutcomeInterfaceLimit = 2;  // more refractive faces than maxInterf
 
 
 // Per-pixel outputs for tests and tools, written when TracePush::flags has kTraceFlagAov.
-// 96 bytes, total: 96 bytes
+// 112 bytes
 struct TraceAov {
   float distance;   // 4: to the first hit along the unit primary ray; -1 on a miss
   uint instance;    // 4: draw item of the first hit, kNoHit on a miss
@@ -250,6 +250,11 @@ struct TraceAov {
   uint deadVisits;    // 4
   uint culledVisits;  // 4
   uint leafVisits;  // 4
+  // Passes of the leaf loops (their triangle tests) that this lane led for
+  // its subgroup, as subgroupSteps does for the traversal loops:
+  // sum(leafVisits) / sum(leafSteps x subgroupSize) is the share of a
+  // subgroup's lanes at work while any of them tests a leaf.
+  uint leafSteps;   // 4
 };
 
 SNELL_CONST kNoHit = 0xffffffffu;

@@ -44,6 +44,9 @@ struct CostCounters {
   /// The traversal loops' lanes at work: the share of a subgroup's lanes still
   /// walking, over the passes it made (0: not counted, as by the driver's pipeline).
   double laneUtilisation = 0;
+  /// The leaf loops' lanes at work: the share of a subgroup's lanes testing a
+  /// triangle in each pass of a leaf loop (the others wait for them).
+  double leafLaneUtilisation = 0;
   /// How much longer a subgroup's longest walk is than its pixels' mean walk:
   /// the sum over pixels of their subgroup's most node visits over the sum of their own.
   double longestOverMean = 0;
@@ -53,11 +56,12 @@ CostCounters countersOf(const std::vector<gpu::TraceAov>& aov) {
   CostCounters c;
   std::vector<uint32_t> visits;
   visits.reserve(aov.size());
-  double laneSteps = 0, subgroupLanes = 0, longest = 0;
+  double laneSteps = 0, subgroupLanes = 0, longest = 0, leafLanes = 0;
   for (const gpu::TraceAov& a : aov) {
     laneSteps += a.walkSteps;
     subgroupLanes += double(a.subgroupSteps) * a.subgroupSize;
     longest += a.subgroupVisits;
+    leafLanes += double(a.leafSteps) * a.subgroupSize;
     c.segments += a.segments;
     c.visits += a.nodeVisits;
     c.boxTests += a.boxTests;
@@ -70,6 +74,7 @@ CostCounters countersOf(const std::vector<gpu::TraceAov>& aov) {
   }
   if (subgroupLanes > 0) c.laneUtilisation = laneSteps / subgroupLanes;
   if (c.visits > 0) c.longestOverMean = longest / c.visits;
+  if (leafLanes > 0) c.leafLaneUtilisation = c.leafVisits / leafLanes;  // before the sums become means
   double n = std::max<double>(double(aov.size()), 1.0);
   for (double* v : {&c.segments, &c.visits, &c.boxTests, &c.triangleTests, &c.deadVisits, &c.culledVisits, &c.leafVisits}) {
     *v /= n;
@@ -163,6 +168,8 @@ int runCost(const Options& o) {
               "a subgroup's longest walk is %.2fx its pixels' mean\n",
               100.0 * cost.laneUtilisation, pixels.aov.empty() ? 0u : pixels.aov.front().subgroupSize,
               cost.longestOverMean);
+  std::printf("leaves: %.1f%% of a subgroup's lanes test a triangle in each pass of the leaf loops\n",
+              100.0 * cost.leafLaneUtilisation);
   if (driver) std::printf("driver-rt: %.3f segments per pixel\n", driverCost.segments);
   std::printf("\n%-22s %10s %12s\n", "trace", "median ms", "G segments/s");
   for (const std::string& row : rows) {
@@ -195,6 +202,7 @@ int runCost(const Options& o) {
     j["child_tests_per_visit"] = cost.visits > 0 ? cost.boxTests / cost.visits : 0.0;
     j["triangle_tests_per_leaf"] = cost.leafVisits > 0 ? cost.triangleTests / cost.leafVisits : 0.0;
     j["lane_utilisation"] = cost.laneUtilisation;
+    j["leaf_lane_utilisation"] = cost.leafLaneUtilisation;
     j["subgroup_longest_over_mean_visits"] = cost.longestOverMean;
     j["subgroup_size"] = pixels.aov.empty() ? 0u : pixels.aov.front().subgroupSize;
     if (driver) j["driver_segments_per_pixel"] = driverCost.segments;

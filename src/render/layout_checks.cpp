@@ -55,7 +55,7 @@ static_assert(sizeof(GpuMaterial) == 288 && offsetof(GpuMaterial, transmission) 
 static_assert(sizeof(GpuTexture) == 16 && offsetof(GpuTexture, flags) == 12);
 static_assert(sizeof(TextureMipPush) == 32 && offsetof(TextureMipPush, srgb) == 24);
 static_assert(sizeof(GpuLight) == 64 && offsetof(GpuLight, cone) == 48);
-static_assert(sizeof(TraceAov) == 108 && offsetof(TraceAov, deadVisits) == 96 && offsetof(TraceAov, leafVisits) == 104 && offsetof(TraceAov, walkSteps) == 76 && offsetof(TraceAov, subgroupVisits) == 84 &&
+static_assert(sizeof(TraceAov) == 112 && offsetof(TraceAov, deadVisits) == 96 && offsetof(TraceAov, leafVisits) == 104 && offsetof(TraceAov, leafSteps) == 108 && offsetof(TraceAov, walkSteps) == 76 && offsetof(TraceAov, subgroupVisits) == 84 &&
               offsetof(TraceAov, segments) == 64 && offsetof(TraceAov, triangleTests) == 72 && offsetof(TraceAov, nodeVisits) == 20 && offsetof(TraceAov, landingV) == 28 &&
               offsetof(TraceAov, landingMaterial) == 32 && offsetof(TraceAov, shineR) == 40 && offsetof(TraceAov, weightB) == 60);
 static_assert(sizeof(TraceHitRecord) == 32 && offsetof(TraceHitRecord, bary) == 16);
