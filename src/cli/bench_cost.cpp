@@ -226,10 +226,13 @@ void addBenchCost(CLI::App& bench, Runner& run) {
       "reports per pixel the closest-hit queries (segments), BVH node visits and\n"
       "the child boxes and triangles tested, the visits that entered no child (of\n"
       "those, the ones whose children lie beyond the nearest hit) and the\n"
-      "triangles tested a leaf reached. Then the hit-replay ablation: each\n"
-      "segment's closest hit is recorded and the frame traced again reading them\n"
-      "instead of traversing (the first 8 segments of a pixel; later ones are\n"
-      "traced in both), which leaves the path's work without the traversal.\n"
+      "triangles tested a leaf reached, and the share of a subgroup's lanes at\n"
+      "work in the traversal loops' passes and in the leaf loops' (a pass in\n"
+      "which some lanes test a triangle holds up the others). Then the\n"
+      "hit-replay ablation: each segment's closest hit is recorded and the\n"
+      "frame traced again reading them instead of traversing (the first 8\n"
+      "segments of a pixel; later ones are traced in both), which leaves the\n"
+      "path's work without the traversal.\n"
       "Medians over --frames rounds, each drawing the trace, the replay and the\n"
       "driver's ray tracing (where the device has it) in turn.");
   sub->footer(kHelpFooter);
