@@ -242,6 +242,20 @@ TEST(BenchScale, ACageOfSeveralMaterialsIsRefinedOnceAFrame) {
   EXPECT_GT(row.at("refit_ms").get<double>(), 0.0);
 }
 
+// What "refit ms" after a refine times: the refined surface's trees refit
+// (two triangles a refined vertex), and none rebuilt while the cage waves.
+TEST(BenchScale, ARefinedCageMovedEveryFrameIsRefitNotRebuilt) {
+  TempFolder dir("bench_scale_refit");
+  std::string out = dir / "scale.json";
+  CommandRun run = snell("bench scale --triangles 0 --crowds 0 --refined 10000 --frames 3 --json " + shellQuoted(out));
+  ASSERT_EQ(run.exitCode, 0) << run.output;
+  io::Json row = readJson(out).at("subdivision").at(0);
+  EXPECT_EQ(row.at("trees_built").get<int>(), 0);
+  EXPECT_EQ(row.at("trees_refit").get<int>(), 3) << "one tree, each timed frame";
+  EXPECT_NEAR(row.at("triangles").get<double>(), 2.0 * row.at("refined_vertices").get<double>(),
+              0.05 * row.at("refined_vertices").get<double>());
+}
+
 TEST(JsonWriter, DeviceNamesWithQuotesAndNonAsciiComeOutAsValidJson) {
   vk::DeviceFacts facts;
   facts.name = "GPU \"fast\" \\ Größe \x01";

@@ -168,6 +168,11 @@ struct RefineRow {
   double refinePasses = 0;  ///< refine passes a frame (median): one whatever the materials
   double refineMs = 0, refitMs = 0;  ///< medians
   double refineMinMs = 0, refineMaxMs = 0, refitMinMs = 0, refitMaxMs = 0;  ///< the spread of the frames timed
+  uint64_t triangles = 0;  ///< of the refined surface, which its trees hold
+  /// Of the trees' work in the timed frames, how many bottom-level trees were
+  /// rebuilt (their SAH grew past the rebuild policy's bound) and refit:
+  /// "refit ms" is a refit's time only where none was rebuilt.
+  uint32_t treesBuilt = 0, treesRefit = 0;
 };
 
 // Frames drawn before a refine row's timed ones: its tables and the trees
@@ -219,6 +224,7 @@ RefineRow measureRefine(vk::Context& context, uint64_t target, uint32_t frames, 
   request.views.push_back(view);
   renderer.wait(renderer.submit(request));  // the first build
   std::vector<double> refine, refit, refinePasses;
+  uint32_t built = 0, refitTrees = 0;
   for (uint32_t f = 0; f < frames + kRefineWarmupFrames; ++f) {
     render::KeptVertices kept = renderer.keptVertices(0);
     for (uint32_t v = 0; v < kept.count; ++v) {
@@ -232,6 +238,8 @@ RefineRow measureRefine(vk::Context& context, uint64_t target, uint32_t frames, 
       if (p.name == pass::kRefine) refineMs += p.milliseconds, ++passes;
       if (p.name == pass::kBlasRefit || p.name == pass::kBlasBuild) refitMs += p.milliseconds;
     }
+    built += result.stats.treesBuilt;
+    refitTrees += result.stats.treesRefit;
     refine.push_back(refineMs);
     refit.push_back(refitMs);
     refinePasses.push_back(passes);
@@ -240,6 +248,9 @@ RefineRow measureRefine(vk::Context& context, uint64_t target, uint32_t frames, 
   row.cageVertices = uint32_t(cage.positions.size());
   row.cageFaces = uint32_t(cage.faceVertexCounts.size());
   row.refinedVertices = uint32_t(s.shapes[0].vertexCount());
+  for (const scene::Shape& part : s.shapes) row.triangles += part.triangleCount();
+  row.treesBuilt = built;
+  row.treesRefit = refitTrees;
   row.materials = materials;
   row.refinePasses = io::median(refinePasses);
   row.refineMs = io::median(refine);
@@ -409,15 +420,16 @@ int runScale(const Options& o) {
                 "warm-up frames, and their spread)%s\n",
                 frames, kRefineWarmupFrames,
                 o.refinedMaterials > 1 ? (", " + std::to_string(o.refinedMaterials) + " materials a cage").c_str() : "");
-    std::printf("%12s %12s %14s %11s %17s %14s %10s %17s %8s\n", "cage verts", "cage faces", "refined verts", "refine ms",
-                "refine min-max", "M verts/s", "refit ms", "refit min-max", "refines");
+    std::printf("%12s %12s %14s %11s %17s %14s %10s %17s %8s %11s %14s\n", "cage verts", "cage faces", "refined verts",
+                "refine ms", "refine min-max", "M verts/s", "refit ms", "refit min-max", "refines", "triangles",
+                "trees b / r");
   }
   for (uint64_t target : refineSizes) {
     RefineRow r = measureRefine(*context, target, frames, o.compactTrees, o.refinedMaterials);
-    std::printf("%12u %12u %14u %11.4f %8.4f-%-8.4f %14.1f %10.4f %8.4f-%-8.4f %8.0f\n", r.cageVertices, r.cageFaces,
-                r.refinedVertices, r.refineMs, r.refineMinMs, r.refineMaxMs,
+    std::printf("%12u %12u %14u %11.4f %8.4f-%-8.4f %14.1f %10.4f %8.4f-%-8.4f %8.0f %11llu %6u / %-6u\n", r.cageVertices,
+                r.cageFaces, r.refinedVertices, r.refineMs, r.refineMinMs, r.refineMaxMs,
                 r.refineMs > 0 ? r.refinedVertices / r.refineMs / 1e3 : 0.0, r.refitMs, r.refitMinMs, r.refitMaxMs,
-                r.refinePasses);
+                r.refinePasses, static_cast<unsigned long long>(r.triangles), r.treesBuilt, r.treesRefit);
     std::fflush(stdout);
     refineRows.push_back(r);
   }
@@ -475,6 +487,9 @@ int runScale(const Options& o) {
                                     {"refine_max_ms", r.refineMaxMs},
                                     {"refit_ms", r.refitMs},
                                     {"refit_min_ms", r.refitMinMs},
+                                    {"triangles", r.triangles},
+                                    {"trees_built", r.treesBuilt},
+                                    {"trees_refit", r.treesRefit},
                                     {"refit_max_ms", r.refitMaxMs},
                                     {"warmup_frames", kRefineWarmupFrames}});
     }
@@ -507,10 +522,12 @@ void addBenchScale(CLI::App& bench, Runner& run) {
       "\n"
       "Refined vertices: a Catmull-Clark cage of n x n quads refined twice, which\n"
       "the host moves every frame: the refine pass's GPU time, vertices refined per\n"
-      "second, and the refit of the refined surface's tree after it. With\n"
-      "--refined-materials the cage's faces carry that many materials in bands:\n"
-      "it is still refined once (\"refines\": refine passes a frame), with a tree\n"
-      "a material.");
+      "second, and the refit of the refined surface's tree after it, with the\n"
+      "triangles it holds and how many trees the timed frames rebuilt and refit\n"
+      "(\"trees b / r\": a rebuild, where the surface's SAH grew too far, counts\n"
+      "in \"refit ms\"). With --refined-materials the cage's faces carry that\n"
+      "many materials in bands: it is still refined once (\"refines\": refine\n"
+      "passes a frame), with a tree a material.");
   sub->footer(kHelpFooter);
   // Lists take one word each, so they never swallow the words after them.
   sub->add_option("--triangles", o->triangles, "sphere sizes (default 10000,100000,1000000,10000000; 0 skips)")
