@@ -487,10 +487,10 @@ int runScale(const Options& o) {
                                     {"refine_max_ms", r.refineMaxMs},
                                     {"refit_ms", r.refitMs},
                                     {"refit_min_ms", r.refitMinMs},
+                                    {"refit_max_ms", r.refitMaxMs},
                                     {"triangles", r.triangles},
                                     {"trees_built", r.treesBuilt},
                                     {"trees_refit", r.treesRefit},
-                                    {"refit_max_ms", r.refitMaxMs},
                                     {"warmup_frames", kRefineWarmupFrames}});
     }
     j["subdivision"] = std::move(refineJson);
