@@ -89,6 +89,7 @@ SNELL_CONST kBvhFlagWideRecords = 8u; // and each node's 4-wide record (BvhWideE
 // most of what a walk spends (bench/results/walk-counts.md). Such a forest's
 // nodes hold only links (child, parent, the refit's arrival bit): no pass
 // writes or reads their quantised fields.
+SNELL_CONST kBvhChildBoxBytes = 48;  // a node's exact child boxes, as above
 // 40 bytes, total: 40 bytes
 struct BvhNode {
   float origin[3];  // 12: the node box's low corner

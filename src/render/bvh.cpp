@@ -125,7 +125,7 @@ Bvh BvhBuilder::makeBvh(const std::vector<uint32_t>& groupSizes, BvhLeaves leave
   // Every build and refit passes exact boxes up through them.
   bvh.exactBoxes = vk::storageBuffer(context_, primitives * 24, name + " exact boxes");
   bool exact = childBoxes == BvhChildBoxes::Exact;
-  bvh.exactChildBoxes = vk::storageBuffer(context_, exact ? primitives * 48 : 16, name + " exact child boxes");
+  bvh.exactChildBoxes = vk::storageBuffer(context_, exact ? primitives * gpu::kBvhChildBoxBytes : 16, name + " exact child boxes");
   bvh.wideRecords = vk::storageBuffer(context_, bvh.hasWideRecords() ? primitives * 4 * sizeof(gpu::BvhWideEntry) : 16,
                                       name + " 4-wide records");
 

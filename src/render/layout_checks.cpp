@@ -31,6 +31,8 @@ static_assert(sizeof(DeformJob) == 48 && offsetof(DeformJob, outputFirst) == 12 
 // deform.comp reads these as std430 uvec4[], vec4[] and mat4[].
 static_assert(sizeof(glm::uvec4) == 16 && sizeof(glm::vec4) == 16 && sizeof(glm::mat4) == 64);
 
+// The exact child boxes: three vec4s a node (bvh_quantise, bvh_refit and trace.comp index them so).
+static_assert(kBvhChildBoxBytes == 3 * sizeof(glm::vec4));
 static_assert(sizeof(BvhNode) == 40 && offsetof(BvhNode, scale) == 12 && offsetof(BvhNode, quant) == 16 &&
               offsetof(BvhNode, child) == 28 && offsetof(BvhNode, parent) == 36);
 static_assert(sizeof(BvhWideEntry) == 32 && offsetof(BvhWideEntry, ref) == 12 && offsetof(BvhWideEntry, hi) == 16 &&

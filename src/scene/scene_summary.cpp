@@ -22,8 +22,8 @@ constexpr uint64_t kMorphBytesPerVertexTarget = 24;  // position + normal delta
 constexpr uint64_t kSkinBytesPerVertex = 32;         // 4 joints (u32) + 4 weights
 constexpr uint64_t kDeformedBytesPerVertex = 24;     // deformed position + normal
 // The default trees' n - 1 nodes (a leaf is a child reference), each with its
-// children's exact boxes (48 bytes) and its 4-wide record (shared/bvh.h).
-constexpr uint64_t kBvhBytesPerTriangle = sizeof(gpu::BvhNode) + 48 + 4 * sizeof(gpu::BvhWideEntry);
+// children's exact boxes and its 4-wide record (shared/bvh.h).
+constexpr uint64_t kBvhBytesPerTriangle = sizeof(gpu::BvhNode) + gpu::kBvhChildBoxBytes + 4 * sizeof(gpu::BvhWideEntry);
 // rgba16f trace and composite, depth, the transmissive mask, the masked trace's pixel list
 constexpr uint64_t kTraceBytesPerPixel = 8 + 8 + 4 + 4 + 4;
 
